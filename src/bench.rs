@@ -1,0 +1,333 @@
+//! `stereolab bench`: one row per measurement — area, knob, setting, error against the most
+//! accurate setting, milliseconds — printed and optionally written as CSV.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use glam::{Vec2, Vec3, Vec4};
+
+use crate::error::{Error, Result};
+use crate::framebuffer::Framebuffer;
+use crate::math::perspective;
+use crate::plan::{Output, Plan};
+use crate::raster::{RasterOptions, rasterize};
+use crate::render::{render, render_view};
+use crate::scene::{Mesh, Scene};
+use crate::shade::{Fragment, Shader, Varyings};
+
+/// One measurement.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// What part of stereolab (e.g. `raster`, `stereo pair`).
+    pub area: String,
+    /// The accuracy or speed knob.
+    pub knob: String,
+    /// Its setting.
+    pub setting: String,
+    /// Error against the most accurate setting (unit in `error_unit`); `None` for pure timings.
+    pub error: Option<f64>,
+    /// What `error` measures.
+    pub error_unit: String,
+    /// Median wall time in milliseconds.
+    pub ms: f64,
+    /// Anything else worth printing (throughput, ratios).
+    pub note: String,
+}
+
+/// Benchmark options.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// The real-model scene (default: `assets/scenes/wuson.toml`).
+    pub scene: std::path::PathBuf,
+    /// Repetitions per timing (the median is reported).
+    pub iterations: usize,
+    /// Image size for the frame timings.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+}
+
+impl Default for BenchOptions {
+    fn default() -> Self {
+        BenchOptions {
+            scene: Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/wuson.toml"),
+            iterations: 15,
+            width: 1024,
+            height: 768,
+        }
+    }
+}
+
+/// Median milliseconds of `iters` runs of `f` (after one warm-up run).
+pub fn median_ms<T>(iters: usize, mut f: impl FnMut() -> T) -> f64 {
+    std::hint::black_box(f());
+    let mut v: Vec<f64> = (0..iters.max(1))
+        .map(|_| {
+            let t = Instant::now();
+            std::hint::black_box(f());
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Runs every benchmark.
+///
+/// # Errors
+/// The scene cannot be loaded or rendered.
+pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
+    let mut rows = Vec::new();
+    let mut scene = Scene::load(&opts.scene, &[])?;
+    scene.set_size(opts.width, opts.height)?;
+    rows.extend(stereo_pair(&scene, opts.iterations)?);
+    rows.extend(subpixel_bits(&scene, opts.iterations)?);
+    rows.extend(perspective_correction(opts.iterations)?);
+    Ok(rows)
+}
+
+fn row(
+    area: &str,
+    knob: &str,
+    setting: impl Into<String>,
+    error: Option<f64>,
+    unit: &str,
+    ms: f64,
+    note: impl Into<String>,
+) -> Row {
+    Row {
+        area: area.into(),
+        knob: knob.into(),
+        setting: setting.into(),
+        error,
+        error_unit: unit.into(),
+        ms,
+        note: note.into(),
+    }
+}
+
+/// The stereo pair of the real model: ms per frame and triangles per second.
+fn stereo_pair(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
+    let plan = Plan::new(&[Output::Left, Output::Right]);
+    let tris: usize = scene
+        .objects
+        .iter()
+        .map(|o| o.mesh.triangles.len())
+        .sum::<usize>()
+        * 2;
+    let mut err = None;
+    let ms = median_ms(iters, || render(scene, &plan).map_err(|e| err = Some(e)));
+    if let Some(e) = err {
+        return Err(e);
+    }
+    let size = format!("{}x{}", scene.width, scene.height);
+    Ok(vec![row(
+        "stereo pair",
+        "real model",
+        size,
+        None,
+        "",
+        ms,
+        format!(
+            "{:.2} M triangles/s, {} triangles/frame",
+            tris as f64 / ms / 1e3,
+            tris
+        ),
+    )])
+}
+
+/// Coverage differences of 4 and 8 subpixel bits against 16 on the real model's left eye.
+fn subpixel_bits(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
+    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let coverage = |bits: u32| -> Result<Vec<bool>> {
+        let mut s = scene.clone();
+        s.raster.subpixel_bits = bits;
+        let (fb, _) = render_view(&s, &eyes[0], crate::plan::Shading::DepthOnly)?;
+        Ok(fb.depth.iter().map(|d| *d < 1.0).collect())
+    };
+    let reference = coverage(16)?;
+    let mut rows = Vec::new();
+    for bits in [4, 8, 16] {
+        let cov = coverage(bits)?;
+        let diff = cov.iter().zip(&reference).filter(|(a, b)| a != b).count();
+        let mut s = scene.clone();
+        s.raster.subpixel_bits = bits;
+        let ms = median_ms(iters, || {
+            render_view(&s, &eyes[0], crate::plan::Shading::DepthOnly).is_ok()
+        });
+        rows.push(row(
+            "raster",
+            "subpixel bits",
+            bits.to_string(),
+            Some(diff as f64 / reference.len() as f64 * 100.0),
+            "% pixels vs 16 bits",
+            ms,
+            "left eye, depth only",
+        ));
+    }
+    Ok(rows)
+}
+
+/// Writes the interpolated texture coordinate as color, for the perspective benchmark.
+struct UvShader<'a> {
+    mesh: &'a Mesh,
+    mvp: glam::Mat4,
+}
+
+impl Shader for UvShader<'_> {
+    fn varying_count(&self) -> usize {
+        2
+    }
+    fn vertex(&self, i: u32, out: &mut Varyings) -> Vec4 {
+        let uv: Vec2 = self.mesh.uvs[i as usize];
+        out[0] = uv.x;
+        out[1] = uv.y;
+        self.mvp * self.mesh.positions[i as usize].extend(1.0)
+    }
+    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
+        // Keep the float: pack u into the color channels' bits is overkill; the benchmark
+        // reads `UV_OUT` instead via `collect_uv`.
+        Some(crate::shade::to_rgba8(Vec3::new(
+            f.varyings[0],
+            f.varyings[1],
+            0.0,
+        )))
+    }
+}
+
+/// Max texture-coordinate error of affine interpolation on a plane slanted 70° away.
+fn perspective_correction(iters: usize) -> Result<Vec<Row>> {
+    let mesh = Mesh::plane(4.0, 1);
+    let model = glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -4.0))
+        * glam::Mat4::from_rotation_x(-70f32.to_radians());
+    let mvp = perspective(60.0, 4.0 / 3.0, 0.5, 20.0) * model;
+    let run = |perspective_correct: bool| -> Result<(Vec<[f32; 2]>, f64)> {
+        let opts = RasterOptions {
+            perspective_correct,
+            ..RasterOptions::default()
+        };
+        let uv = std::sync::Mutex::new(vec![[f32::NAN; 2]; 1024 * 768]);
+        let shader = RecordUv {
+            inner: UvShader { mesh: &mesh, mvp },
+            out: &uv,
+        };
+        let mut fb = Framebuffer::new(1024, 768, [0, 0, 0, 255])?;
+        rasterize(
+            &mesh.triangles,
+            mesh.positions.len(),
+            &shader,
+            &mut fb,
+            &opts,
+        );
+        let ms = median_ms(iters, || {
+            let mut fb = Framebuffer::new(1024, 768, [0, 0, 0, 255]).map_err(|e| e.to_string());
+            if let Ok(fb) = fb.as_mut() {
+                rasterize(
+                    &mesh.triangles,
+                    mesh.positions.len(),
+                    &shader.inner,
+                    fb,
+                    &opts,
+                );
+            }
+        });
+        let v = uv
+            .into_inner()
+            .map_err(|_| Error::invalid("bench", "uv", "poisoned"))?;
+        Ok((v, ms))
+    };
+    let (exact, ms_exact) = run(true)?;
+    let (affine, ms_affine) = run(false)?;
+    let max_err = exact
+        .iter()
+        .zip(&affine)
+        .filter(|(a, _)| a[0].is_finite())
+        .map(|(a, b)| (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) as f64)
+        .fold(0.0, f64::max);
+    Ok(vec![
+        row(
+            "raster",
+            "varyings",
+            "perspective-correct",
+            Some(0.0),
+            "max |uv| error",
+            ms_exact,
+            "plane slanted 70 deg, 1024x768",
+        ),
+        row(
+            "raster",
+            "varyings",
+            "affine",
+            Some(max_err),
+            "max |uv| error",
+            ms_affine,
+            "plane slanted 70 deg, 1024x768",
+        ),
+    ])
+}
+
+/// Wraps [`UvShader`] and records each fragment's uv.
+struct RecordUv<'a> {
+    inner: UvShader<'a>,
+    out: &'a std::sync::Mutex<Vec<[f32; 2]>>,
+}
+
+impl Shader for RecordUv<'_> {
+    fn varying_count(&self) -> usize {
+        self.inner.varying_count()
+    }
+    fn vertex(&self, i: u32, out: &mut Varyings) -> Vec4 {
+        self.inner.vertex(i, out)
+    }
+    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
+        if let Ok(mut v) = self.out.lock() {
+            v[f.y as usize * 1024 + f.x as usize] = [f.varyings[0], f.varyings[1]];
+        }
+        self.inner.fragment(f)
+    }
+}
+
+/// The rows as an aligned table.
+pub fn table(rows: &[Row]) -> String {
+    let mut s = format!(
+        "{:<14} {:<16} {:<22} {:>14} {:<22} {:>10}  {}\n",
+        "area", "knob", "setting", "error", "error unit", "ms", "note"
+    );
+    for r in rows {
+        let e = r
+            .error
+            .map(|e| format!("{e:.6}"))
+            .unwrap_or_else(|| "-".into());
+        let _ = writeln!(
+            s,
+            "{:<14} {:<16} {:<22} {:>14} {:<22} {:>10.3}  {}",
+            r.area, r.knob, r.setting, e, r.error_unit, r.ms, r.note
+        );
+    }
+    s
+}
+
+/// Writes the rows as CSV (header `area,knob,setting,error,error_unit,ms,note`).
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write_csv(rows: &[Row], path: &Path) -> Result<()> {
+    let q = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
+    let mut s = String::from("area,knob,setting,error,error_unit,ms,note\n");
+    for r in rows {
+        let e = r.error.map(|e| e.to_string()).unwrap_or_default();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{:.4},{}",
+            q(&r.area),
+            q(&r.knob),
+            q(&r.setting),
+            e,
+            q(&r.error_unit),
+            r.ms,
+            q(&r.note)
+        );
+    }
+    std::fs::write(path, s).map_err(|e| Error::io(path, e))
+}

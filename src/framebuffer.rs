@@ -1,0 +1,97 @@
+//! Color + depth render targets, and the pair of eye framebuffers.
+
+use crate::error::{Error, Result};
+
+/// Largest image side we accept; refusing earlier than allocation keeps absurd sizes from
+/// asking for gigabytes (16384² RGBA + f32 depth is 2 GiB, the most we allow).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// An RGBA8 color buffer and an f32 depth buffer in [0, 1] (1 = far plane), row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Framebuffer {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major RGBA8 pixels, row 0 at the top.
+    pub color: Vec<[u8; 4]>,
+    /// Row-major window depth, `glDepthRange(0, 1)`.
+    pub depth: Vec<f32>,
+}
+
+/// Index of the left eye in an eye pair (seed 004: 0 = left, 1 = right).
+pub const LEFT: usize = 0;
+/// Index of the right eye in an eye pair.
+pub const RIGHT: usize = 1;
+
+/// The two eye framebuffers, index 0 left and 1 right as in seed 004.
+pub type EyePair = [Framebuffer; 2];
+
+impl Framebuffer {
+    /// A framebuffer cleared to `clear_color` and depth 1.0.
+    ///
+    /// # Errors
+    /// A zero side, or a side above [`MAX_IMAGE_SIDE`].
+    pub fn new(width: u32, height: u32, clear_color: [u8; 4]) -> Result<Self> {
+        check_size(width, height)?;
+        let n = width as usize * height as usize;
+        Ok(Framebuffer {
+            width,
+            height,
+            color: vec![clear_color; n],
+            depth: vec![1.0; n],
+        })
+    }
+
+    /// Index of pixel (x, y) in the row-major buffers.
+    #[inline]
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        y as usize * self.width as usize + x as usize
+    }
+
+    /// Color of pixel (x, y).
+    #[inline]
+    pub fn pixel(&self, x: u32, y: u32) -> [u8; 4] {
+        self.color[self.index(x, y)]
+    }
+
+    /// The color buffer as an `image` RGBA image.
+    pub fn to_rgba_image(&self) -> image::RgbaImage {
+        let bytes: Vec<u8> = self.color.iter().flatten().copied().collect();
+        image::RgbaImage::from_raw(self.width, self.height, bytes).expect("buffer size matches")
+    }
+
+    /// The depth buffer as a 16-bit grayscale image (0 = near, 65535 = far plane/background).
+    pub fn depth_image(&self) -> image::ImageBuffer<image::Luma<u16>, Vec<u16>> {
+        let data = self
+            .depth
+            .iter()
+            .map(|d| (d.clamp(0.0, 1.0) * 65535.0).round() as u16)
+            .collect();
+        image::ImageBuffer::from_raw(self.width, self.height, data).expect("buffer size matches")
+    }
+}
+
+/// Checks an image size before anything is allocated.
+///
+/// # Errors
+/// `Invalid` for a zero side or a side above [`MAX_IMAGE_SIDE`].
+pub fn check_size(width: u32, height: u32) -> Result<()> {
+    for (name, v) in [("width", width), ("height", height)] {
+        if v == 0 {
+            return Err(Error::invalid(
+                format!("image.{name}"),
+                v,
+                "must be at least 1 pixel",
+            ));
+        }
+        if v > MAX_IMAGE_SIDE {
+            return Err(Error::invalid(
+                format!("image.{name}"),
+                v,
+                format!("must be at most {MAX_IMAGE_SIDE} pixels"),
+            ));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,125 @@
+//! `stereolab info`: the derived cameras and the scene's parallax range (seed 003's budget).
+
+use std::fmt::Write as _;
+
+use crate::error::Result;
+use crate::math::{StereoRig, project_ndc};
+use crate::scene::Scene;
+
+/// Seed 003: keep negative and positive parallax each within about 3% of the image width.
+pub const PARALLAX_BUDGET_PERCENT: f32 = 3.0;
+
+/// Horizontal and vertical parallax range over the scene's vertices, in percent of image width
+/// (horizontal) and height (vertical): `(x_right − x_left)` in NDC / 2 · 100.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParallaxRange {
+    /// Most negative horizontal parallax (in front of the screen), % of width.
+    pub min_percent: f32,
+    /// Most positive horizontal parallax (behind the screen), % of width.
+    pub max_percent: f32,
+    /// Largest |vertical parallax|, % of height (non-zero only for toe-in).
+    pub max_vertical_percent: f32,
+    /// Vertices visible in both eyes that were measured.
+    pub vertices: usize,
+}
+
+/// Parallax of every scene vertex that lies inside both eyes' frusta.
+///
+/// # Errors
+/// Invalid camera or rig.
+pub fn parallax_range(scene: &Scene) -> Result<ParallaxRange> {
+    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let mut r = ParallaxRange {
+        min_percent: f32::INFINITY,
+        max_percent: f32::NEG_INFINITY,
+        max_vertical_percent: 0.0,
+        vertices: 0,
+    };
+    let inside = |p: glam::Vec3| p.abs().max_element() <= 1.0;
+    for p in scene.world_points() {
+        let (Some(l), Some(rr)) = (project_ndc(&eyes[0].mvp, p), project_ndc(&eyes[1].mvp, p))
+        else {
+            continue;
+        };
+        if !inside(l) || !inside(rr) {
+            continue;
+        }
+        let h = (rr.x - l.x) * 50.0;
+        r.min_percent = r.min_percent.min(h);
+        r.max_percent = r.max_percent.max(h);
+        r.max_vertical_percent = r.max_vertical_percent.max(((rr.y - l.y) * 50.0).abs());
+        r.vertices += 1;
+    }
+    Ok(r)
+}
+
+/// The text `stereolab info` prints.
+///
+/// # Errors
+/// Invalid camera or rig.
+pub fn describe(scene: &Scene) -> Result<String> {
+    let mut s = String::new();
+    let resolved = scene.rig.resolve(&scene.camera, scene.aspect())?;
+    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let center = StereoRig::center(&scene.camera, scene.aspect())?;
+    let _ = writeln!(
+        s,
+        "image: {}x{}  aspect {:.4}",
+        scene.width,
+        scene.height,
+        scene.aspect()
+    );
+    let _ = writeln!(
+        s,
+        "rig: {:?}, lighting {:?}",
+        scene.rig.mode, scene.rig.lighting
+    );
+    let _ = writeln!(
+        s,
+        "  eye separation d = {:.6} ({:?}, user_offset {})",
+        resolved.eye_separation, scene.rig.separation, scene.rig.user_offset
+    );
+    let _ = writeln!(
+        s,
+        "  zero-parallax distance z0 = {:.6} ({:?}), user_balance {}",
+        resolved.zero_parallax_distance, scene.rig.zero_parallax, scene.rig.user_balance
+    );
+    let _ = writeln!(s, "  view width at z0 (Xrange) = {:.6}", resolved.xrange);
+    for (name, m) in [("center", center), ("left", eyes[0]), ("right", eyes[1])] {
+        let f = m.frustum;
+        let _ = writeln!(
+            s,
+            "  {name:6} eye at ({:.4}, {:.4}, {:.4})  frustum l={:.6} r={:.6} b={:.6} t={:.6} n={} f={}",
+            m.eye_world.x, m.eye_world.y, m.eye_world.z, f[0], f[1], f[2], f[3], f[4], f[5]
+        );
+    }
+    let p = parallax_range(scene)?;
+    if p.vertices == 0 {
+        let _ = writeln!(s, "parallax: no vertex lies inside both frusta");
+        return Ok(s);
+    }
+    let _ = writeln!(
+        s,
+        "parallax over {} vertices: {:+.3}% .. {:+.3}% of image width ({:+.1} .. {:+.1} px); max vertical {:.3}% of height",
+        p.vertices,
+        p.min_percent,
+        p.max_percent,
+        p.min_percent * scene.width as f32 / 100.0,
+        p.max_percent * scene.width as f32 / 100.0,
+        p.max_vertical_percent
+    );
+    if p.min_percent < -PARALLAX_BUDGET_PERCENT || p.max_percent > PARALLAX_BUDGET_PERCENT {
+        let _ = writeln!(
+            s,
+            "warning: parallax exceeds seed 003's ~{PARALLAX_BUDGET_PERCENT}% budget; reduce eye_separation or user_offset"
+        );
+    }
+    if p.max_vertical_percent > 0.01 {
+        let _ = writeln!(
+            s,
+            "warning: vertical parallax (toe-in?) of {:.3}% of height strains fusion (seed 003)",
+            p.max_vertical_percent
+        );
+    }
+    Ok(s)
+}

@@ -1,0 +1,103 @@
+//! Turns a rendered [`Frame`] into the images the scene asked for, and writes them.
+
+use std::path::{Path, PathBuf};
+
+use crate::effects::layout;
+use crate::error::{Error, Result};
+use crate::framebuffer::Framebuffer;
+use crate::plan::{Output, View};
+use crate::render::Frame;
+use crate::scene::Scene;
+
+/// One finished output image.
+pub enum Image {
+    /// 8-bit RGBA.
+    Rgba(image::RgbaImage),
+    /// 16-bit grayscale (depth).
+    Gray16(image::ImageBuffer<image::Luma<u16>, Vec<u16>>),
+}
+
+impl Image {
+    /// Writes the image as PNG.
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn save_png(&self, path: &Path) -> Result<()> {
+        let r = match self {
+            Image::Rgba(i) => i.save_with_format(path, image::ImageFormat::Png),
+            Image::Gray16(i) => i.save_with_format(path, image::ImageFormat::Png),
+        };
+        r.map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
+    }
+}
+
+fn need<'a>(frame: &'a Frame, view: View, output: Output) -> Result<&'a Framebuffer> {
+    frame.view(view).ok_or_else(|| {
+        Error::invalid(
+            "plan",
+            output.name(),
+            format!("the {view:?} pass was not run"),
+        )
+    })
+}
+
+/// Produces `output` from `frame`.
+///
+/// # Errors
+/// A pass the output needs is missing from the frame (a plan bug), or a layout error.
+pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
+    let eye = |v| need(frame, v, output);
+    Ok(match output {
+        Output::Left => Image::Rgba(eye(View::Left)?.to_rgba_image()),
+        Output::Right => Image::Rgba(eye(View::Right)?.to_rgba_image()),
+        Output::LeftDepth => Image::Gray16(eye(View::Left)?.depth_image()),
+        Output::RightDepth => Image::Gray16(eye(View::Right)?.depth_image()),
+        Output::SideBySide => {
+            Image::Rgba(layout::side_by_side(eye(View::Left)?, eye(View::Right)?)?)
+        }
+        Output::CrossEyed => {
+            Image::Rgba(layout::side_by_side(eye(View::Right)?, eye(View::Left)?)?)
+        }
+        Output::AboveBelow => {
+            Image::Rgba(layout::above_below(eye(View::Left)?, eye(View::Right)?)?)
+        }
+        Output::AboveBelowSquashed => Image::Rgba(layout::above_below_squashed(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            scene.blank_interval,
+        )?),
+        Output::InterlacedRows => Image::Rgba(layout::interleave(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            |_, y| y % 2 == 0,
+        )?),
+        Output::InterlacedColumns => Image::Rgba(layout::interleave(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            |x, _| x % 2 == 0,
+        )?),
+        Output::Checkerboard => Image::Rgba(layout::interleave(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            |x, y| (x + y) % 2 == 0,
+        )?),
+    })
+}
+
+/// Produces and writes every requested output as `DIR/<name>.png`; returns the paths.
+///
+/// # Errors
+/// The folder cannot be created, or an output fails.
+pub fn write_all(frame: &Frame, scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    frame
+        .plan
+        .outputs
+        .iter()
+        .map(|&o| {
+            let path = dir.join(format!("{}.png", o.name()));
+            produce(o, frame, scene)?.save_png(&path)?;
+            Ok(path)
+        })
+        .collect()
+}

@@ -1,0 +1,211 @@
+//! Outputs → the passes they need, nothing more (standing demand 3: simulate only the effects
+//! a scene calls for).
+
+use std::fmt::Write as _;
+
+use crate::error::{Error, Result};
+
+/// Everything a scene can ask `stereolab render` to write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Output {
+    /// Left eye color.
+    Left,
+    /// Right eye color.
+    Right,
+    /// Left eye depth (16-bit grayscale).
+    LeftDepth,
+    /// Right eye depth (16-bit grayscale).
+    RightDepth,
+    /// Left | right, for parallel (wall-eyed) free viewing.
+    SideBySide,
+    /// Right | left, for cross-eyed free viewing.
+    CrossEyed,
+    /// Left on top of right, each full size.
+    AboveBelow,
+    /// Seed 003's sync-doubling format: both eyes squashed 1:2 into one frame, left on top,
+    /// separated by a black blank interval.
+    AboveBelowSquashed,
+    /// Even rows left, odd rows right (row-interleaved polarized displays).
+    InterlacedRows,
+    /// Even columns left, odd columns right (column-interleaved displays).
+    InterlacedColumns,
+    /// Left where x + y is even, right elsewhere (DLP checkerboard).
+    Checkerboard,
+}
+
+/// Which camera a pass renders from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum View {
+    /// The left eye (index 0).
+    Left,
+    /// The right eye (index 1).
+    Right,
+    /// The cyclopean eye: the camera itself.
+    Center,
+}
+
+/// What a pass computes per fragment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Shading {
+    /// Depth only: no fragment shading at all.
+    DepthOnly,
+    /// Shaded color (and depth).
+    Color,
+}
+
+/// One rasterization pass over the whole scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Pass {
+    /// The camera.
+    pub view: View,
+    /// Depth only, or shaded.
+    pub shading: Shading,
+}
+
+impl Output {
+    /// Every output, in the order `--help` lists them.
+    pub const ALL: &'static [Output] = &[
+        Output::Left,
+        Output::Right,
+        Output::LeftDepth,
+        Output::RightDepth,
+        Output::SideBySide,
+        Output::CrossEyed,
+        Output::AboveBelow,
+        Output::AboveBelowSquashed,
+        Output::InterlacedRows,
+        Output::InterlacedColumns,
+        Output::Checkerboard,
+    ];
+
+    /// The name used in scene files and for the PNG written.
+    pub fn name(self) -> &'static str {
+        match self {
+            Output::Left => "left",
+            Output::Right => "right",
+            Output::LeftDepth => "left_depth",
+            Output::RightDepth => "right_depth",
+            Output::SideBySide => "side_by_side",
+            Output::CrossEyed => "cross_eyed",
+            Output::AboveBelow => "above_below",
+            Output::AboveBelowSquashed => "above_below_squashed",
+            Output::InterlacedRows => "interlaced_rows",
+            Output::InterlacedColumns => "interlaced_columns",
+            Output::Checkerboard => "checkerboard",
+        }
+    }
+
+    /// Parses a name as written in a scene file.
+    ///
+    /// # Errors
+    /// `Invalid` listing the known names.
+    pub fn parse(name: &str) -> Result<Output> {
+        Output::ALL
+            .iter()
+            .copied()
+            .find(|o| o.name() == name)
+            .ok_or_else(|| {
+                let known: Vec<&str> = Output::ALL.iter().map(|o| o.name()).collect();
+                Error::invalid(
+                    "outputs",
+                    format!("\"{name}\""),
+                    format!("unknown output; known: {}", known.join(", ")),
+                )
+            })
+    }
+
+    /// The passes this output reads.
+    pub fn needs(self) -> Vec<Pass> {
+        let color = |view| Pass {
+            view,
+            shading: Shading::Color,
+        };
+        let depth = |view| Pass {
+            view,
+            shading: Shading::DepthOnly,
+        };
+        match self {
+            Output::Left => vec![color(View::Left)],
+            Output::Right => vec![color(View::Right)],
+            Output::LeftDepth => vec![depth(View::Left)],
+            Output::RightDepth => vec![depth(View::Right)],
+            _ => vec![color(View::Left), color(View::Right)],
+        }
+    }
+}
+
+/// The passes a set of outputs needs. A color pass also produces depth, so a depth-only pass of
+/// the same view is dropped when a color pass of it runs anyway.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Requested outputs, deduplicated, in request order.
+    pub outputs: Vec<Output>,
+    /// Passes to run, sorted by view.
+    pub passes: Vec<Pass>,
+}
+
+impl Plan {
+    /// Builds the plan for `outputs`.
+    pub fn new(outputs: &[Output]) -> Plan {
+        let mut uniq: Vec<Output> = Vec::new();
+        for o in outputs {
+            if !uniq.contains(o) {
+                uniq.push(*o);
+            }
+        }
+        let mut passes: Vec<Pass> = uniq.iter().flat_map(|o| o.needs()).collect();
+        passes.sort();
+        passes.dedup();
+        // Keep the strongest shading per view (Color > DepthOnly).
+        let mut merged: Vec<Pass> = Vec::new();
+        for p in passes {
+            match merged.iter_mut().find(|m| m.view == p.view) {
+                Some(m) => m.shading = m.shading.max(p.shading),
+                None => merged.push(p),
+            }
+        }
+        Plan {
+            outputs: uniq,
+            passes: merged,
+        }
+    }
+
+    /// The pass that renders `view`, if any.
+    pub fn pass(&self, view: View) -> Option<Pass> {
+        self.passes.iter().copied().find(|p| p.view == view)
+    }
+
+    /// Human-readable: which passes run, for which outputs, and which do not run.
+    pub fn explain(&self) -> String {
+        let mut s = String::from("plan:\n");
+        for p in &self.passes {
+            let users: Vec<&str> = self
+                .outputs
+                .iter()
+                .filter(|o| o.needs().iter().any(|n| n.view == p.view))
+                .map(|o| o.name())
+                .collect();
+            let _ = writeln!(
+                s,
+                "  pass {:?} eye, {}: for {}",
+                p.view,
+                shading_name(p.shading),
+                users.join(", ")
+            );
+        }
+        for view in [View::Left, View::Right, View::Center] {
+            if self.pass(view).is_none() {
+                let _ = writeln!(s, "  not run: {view:?} eye (no requested output needs it)");
+            }
+        }
+        let _ = writeln!(s, "  passes run: {}", self.passes.len());
+        s
+    }
+}
+
+fn shading_name(s: Shading) -> &'static str {
+    match s {
+        Shading::Color => "color + depth (shaded)",
+        Shading::DepthOnly => "depth only (no shading)",
+    }
+}

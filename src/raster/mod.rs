@@ -1,0 +1,127 @@
+//! Triangle rasterization with llvmpipe's exact fixed-point rules (see DESIGN.md).
+//!
+//! Pipeline per triangle: vertex stage → clip → perspective divide → viewport → snap to the
+//! subpixel grid → orient → edge functions with the top-left tie-break → depth test LESS →
+//! fragment stage. Nothing here knows about stereo.
+
+mod clip;
+mod setup;
+
+pub use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
+pub use setup::{WindowVertex, rasterize_window_triangle, snap};
+
+use crate::framebuffer::Framebuffer;
+use crate::shade::{Shader, Varyings};
+
+/// Rasterizer knobs. The defaults are what lavapipe does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RasterOptions {
+    /// Skip triangles whose front face (counter-clockwise in NDC) points away.
+    pub cull_back: bool,
+    /// Subpixel precision of the snapped window coordinates (llvmpipe: 8). 1..=16.
+    pub subpixel_bits: u32,
+    /// Perspective-correct varyings (true) or affine screen-space interpolation (false).
+    pub perspective_correct: bool,
+    /// Depth test LESS with depth writes (true), or no depth test and no depth writes.
+    pub depth_test: bool,
+}
+
+impl Default for RasterOptions {
+    fn default() -> Self {
+        RasterOptions {
+            cull_back: false,
+            subpixel_bits: 8,
+            perspective_correct: true,
+            depth_test: true,
+        }
+    }
+}
+
+/// Counts from one `rasterize` call.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RasterStats {
+    /// Triangles submitted.
+    pub triangles: usize,
+    /// Triangles dropped because a vertex had a NaN or infinite clip coordinate.
+    pub non_finite: usize,
+    /// Triangles that needed clipping.
+    pub clipped: usize,
+    /// Triangles removed by back-face culling.
+    pub culled: usize,
+    /// Fragments that passed the depth test.
+    pub fragments: usize,
+}
+
+/// Rasterizes `triangles` (indices into the shader's vertices) into `fb`.
+pub fn rasterize<S: Shader>(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    shader: &S,
+    fb: &mut Framebuffer,
+    opts: &RasterOptions,
+) -> RasterStats {
+    let nvar = shader.varying_count().min(crate::shade::MAX_VARYINGS);
+    // Vertex stage, once per vertex (a post-transform cache, like a GPU's).
+    let verts: Vec<ClipVertex> = (0..vertex_count as u32)
+        .map(|i| {
+            let mut var: Varyings = [0.0; crate::shade::MAX_VARYINGS];
+            let pos = shader.vertex(i, &mut var);
+            ClipVertex { pos, var }
+        })
+        .collect();
+    let mut stats = RasterStats {
+        triangles: triangles.len(),
+        ..Default::default()
+    };
+    let mut poly = [verts.first().copied().unwrap_or(ClipVertex {
+        pos: glam::Vec4::ZERO,
+        var: [0.0; 8],
+    }); MAX_CLIPPED + 3];
+    for tri in triangles {
+        let Some(t) = tri
+            .iter()
+            .map(|&i| verts.get(i as usize).copied())
+            .collect::<Option<Vec<_>>>()
+        else {
+            stats.non_finite += 1;
+            continue;
+        };
+        let t = [t[0], t[1], t[2]];
+        if t.iter().any(|v| !v.pos.is_finite()) {
+            stats.non_finite += 1;
+            continue;
+        }
+        let codes = [outcode(t[0].pos), outcode(t[1].pos), outcode(t[2].pos)];
+        if codes[0] & codes[1] & codes[2] != 0 {
+            continue; // all three outside the same plane
+        }
+        let n = if codes[0] | codes[1] | codes[2] == 0 {
+            poly[..3].copy_from_slice(&t);
+            3
+        } else {
+            stats.clipped += 1;
+            clip_triangle(t, nvar, &mut poly)
+        };
+        // The clipped polygon is convex: draw it as a fan around its first vertex.
+        let win: Vec<Option<WindowVertex>> = poly[..n]
+            .iter()
+            .map(|v| WindowVertex::from_clip(v, fb.width, fb.height))
+            .collect();
+        for k in 1..n.saturating_sub(1) {
+            let (Some(a), Some(b), Some(c)) = (win[0], win[k], win[k + 1]) else {
+                continue;
+            };
+            let r = rasterize_window_triangle(
+                [a, b, c],
+                [&poly[0].var, &poly[k].var, &poly[k + 1].var],
+                nvar,
+                shader,
+                fb,
+                opts,
+            );
+            stats.culled += r.culled;
+            stats.fragments += r.fragments;
+        }
+    }
+    stats
+}

@@ -1,0 +1,199 @@
+//! The TOML scene format (serde), before validation.
+
+use serde::Deserialize;
+
+use crate::math::{Camera, CameraMode, Lighting};
+
+/// A scene file as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Output image.
+    pub image: ImageSpec,
+    /// The (cyclopean) camera.
+    pub camera: Camera,
+    /// The stereo rig.
+    #[serde(default)]
+    pub stereo: StereoSpec,
+    /// The light.
+    #[serde(default)]
+    pub light: LightSpec,
+    /// Layout options.
+    #[serde(default)]
+    pub layout: LayoutSpec,
+    /// Rasterizer options.
+    #[serde(default)]
+    pub raster: RasterSpec,
+    /// Objects, in `[[mesh]]` tables.
+    #[serde(default, rename = "mesh")]
+    pub meshes: Vec<MeshSpec>,
+    /// Requested outputs by name.
+    pub outputs: Vec<String>,
+}
+
+/// `[image]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageSpec {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Clear color, 0..1. Default mid-gray (seed 003: a gray background reduces ghosting).
+    #[serde(default = "default_background")]
+    pub background: [f32; 3],
+}
+
+fn default_background() -> [f32; 3] {
+    [0.5, 0.5, 0.5]
+}
+
+/// Eye separation: a number or `"auto"`.
+#[derive(Debug, Deserialize, Clone)]
+#[serde(untagged)]
+pub enum SeparationSpec {
+    /// World units.
+    Value(f32),
+    /// Should be `"auto"`.
+    Word(String),
+}
+
+/// `[stereo]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StereoSpec {
+    /// `off-axis` (default), `toe-in`, `parallel`.
+    #[serde(default)]
+    pub mode: CameraMode,
+    /// Number or `"auto"` (default).
+    #[serde(default)]
+    pub eye_separation: Option<SeparationSpec>,
+    /// Absolute zero-parallax distance.
+    #[serde(default)]
+    pub zero_parallax: Option<f32>,
+    /// Zero-parallax position between near (0) and far (1); default 0.5 if neither is given.
+    #[serde(default)]
+    pub zero_parallax_fraction: Option<f32>,
+    /// Seed 003 `UserOffsetAdjustment`.
+    #[serde(default = "one")]
+    pub user_offset: f32,
+    /// Seed 003 `UserBalanceAdjustment`.
+    #[serde(default = "one")]
+    pub user_balance: f32,
+    /// `per-eye` (default) or `cyclopic`.
+    #[serde(default)]
+    pub lighting: Lighting,
+}
+
+impl Default for StereoSpec {
+    fn default() -> Self {
+        StereoSpec {
+            mode: CameraMode::OffAxis,
+            eye_separation: None,
+            zero_parallax: None,
+            zero_parallax_fraction: None,
+            user_offset: 1.0,
+            user_balance: 1.0,
+            lighting: Lighting::PerEye,
+        }
+    }
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+/// `[light]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightSpec {
+    /// World position.
+    pub position: [f32; 3],
+    /// Ambient 0..1.
+    #[serde(default = "ambient")]
+    pub ambient: f32,
+    /// Specular 0..1.
+    #[serde(default = "specular")]
+    pub specular: f32,
+    /// Blinn-Phong exponent.
+    #[serde(default = "shininess")]
+    pub shininess: f32,
+}
+
+fn ambient() -> f32 {
+    0.15
+}
+fn specular() -> f32 {
+    0.35
+}
+fn shininess() -> f32 {
+    32.0
+}
+
+impl Default for LightSpec {
+    fn default() -> Self {
+        LightSpec {
+            position: [5.0, 8.0, 10.0],
+            ambient: ambient(),
+            specular: specular(),
+            shininess: shininess(),
+        }
+    }
+}
+
+/// `[layout]`.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct LayoutSpec {
+    /// Black rows between the two views of `above_below_squashed` (seed 003: 20–50 typical).
+    #[serde(default)]
+    pub blank_interval: u32,
+}
+
+/// `[raster]`.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RasterSpec {
+    /// Back-face culling.
+    #[serde(default)]
+    pub cull_back: bool,
+}
+
+/// One `[[mesh]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// `obj`, `sphere`, `cube`, `torus`, `plane`, `triangles`.
+    pub kind: String,
+    /// OBJ path, relative to the scene file.
+    #[serde(default)]
+    pub path: Option<String>,
+    /// Radius (sphere), edge (cube, plane), major radius (torus).
+    #[serde(default)]
+    pub size: Option<f32>,
+    /// Torus tube radius.
+    #[serde(default)]
+    pub minor: Option<f32>,
+    /// Tessellation (segments / divisions).
+    #[serde(default)]
+    pub detail: Option<u32>,
+    /// Triangle count for `triangles`.
+    #[serde(default)]
+    pub count: Option<u32>,
+    /// Translation (world).
+    #[serde(default)]
+    pub translate: [f32; 3],
+    /// Rotation in degrees about X, then Y, then Z.
+    #[serde(default)]
+    pub rotate: [f32; 3],
+    /// Uniform scale.
+    #[serde(default = "one")]
+    pub scale: f32,
+    /// Material color 0..1.
+    #[serde(default = "default_color")]
+    pub color: [f32; 3],
+}
+
+fn default_color() -> [f32; 3] {
+    [0.8, 0.8, 0.8]
+}

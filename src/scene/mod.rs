@@ -1,0 +1,354 @@
+//! Scenes: the TOML file, OBJ models, procedural shapes.
+
+mod file;
+mod mesh;
+mod obj;
+
+pub use file::SceneFile;
+pub use mesh::Mesh;
+pub use obj::load_obj;
+
+use std::path::{Path, PathBuf};
+
+use glam::{EulerRot, Mat4, Quat, Vec3};
+
+use crate::error::{Error, Result};
+use crate::framebuffer::check_size;
+use crate::math::{Camera, Separation, StereoRig, ZeroParallax};
+use crate::plan::Output;
+use crate::raster::RasterOptions;
+use crate::shade::{Light, to_rgba8};
+
+/// One object: a mesh placed in the world with a color.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// What the scene calls it (`mesh[i] kind`).
+    pub name: String,
+    /// The geometry in object space.
+    pub mesh: Mesh,
+    /// Object → world.
+    pub model: Mat4,
+    /// Material color 0..1.
+    pub color: Vec3,
+}
+
+/// A validated scene, ready to render.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Clear color.
+    pub background: [u8; 4],
+    /// The cyclopean camera.
+    pub camera: Camera,
+    /// The stereo rig.
+    pub rig: StereoRig,
+    /// The light.
+    pub light: Light,
+    /// Objects.
+    pub objects: Vec<Object>,
+    /// Requested outputs.
+    pub outputs: Vec<Output>,
+    /// Black rows between the views of `above_below_squashed`.
+    pub blank_interval: u32,
+    /// Rasterizer options.
+    pub raster: RasterOptions,
+}
+
+impl Scene {
+    /// Reads a scene file, applies `--set key=value` overrides, loads its models, validates it.
+    ///
+    /// # Errors
+    /// Any I/O, TOML, OBJ or validation error, naming the file and the field.
+    pub fn load(path: &Path, sets: &[String]) -> Result<Scene> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Scene::from_toml(&text, path, &base, sets)
+    }
+
+    /// Parses scene text; `path` is used in messages, `base_dir` resolves relative model paths.
+    ///
+    /// # Errors
+    /// As [`Scene::load`].
+    pub fn from_toml(text: &str, path: &Path, base_dir: &Path, sets: &[String]) -> Result<Scene> {
+        let mut table: toml::Table =
+            toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        for s in sets {
+            apply_set(&mut table, s)?;
+        }
+        let file: SceneFile = table.try_into().map_err(|e: toml::de::Error| {
+            // After --set the spans refer to nothing; re-parse the text for a line number when we can.
+            match toml::from_str::<SceneFile>(text) {
+                Err(orig) if sets.is_empty() => toml_error(path, text, &orig),
+                _ => Error::parse(path, None, e.message().to_string()),
+            }
+        })?;
+        Scene::from_file(file, base_dir).map_err(|e| e.in_file(path))
+    }
+
+    /// Validates a parsed scene file and loads its meshes.
+    ///
+    /// # Errors
+    /// The first invalid field.
+    pub fn from_file(f: SceneFile, base_dir: &Path) -> Result<Scene> {
+        check_size(f.image.width, f.image.height)?;
+        f.camera.validate()?;
+        let separation = match &f.stereo.eye_separation {
+            None => Separation::Auto,
+            Some(file::SeparationSpec::Value(v)) => Separation::Absolute(*v),
+            Some(file::SeparationSpec::Word(w)) if w == "auto" => Separation::Auto,
+            Some(file::SeparationSpec::Word(w)) => {
+                return Err(Error::invalid(
+                    "stereo.eye_separation",
+                    format!("\"{w}\""),
+                    "must be a number or \"auto\"",
+                ));
+            }
+        };
+        let zero_parallax = match (f.stereo.zero_parallax, f.stereo.zero_parallax_fraction) {
+            (Some(_), Some(_)) => {
+                return Err(Error::invalid(
+                    "stereo.zero_parallax",
+                    "both given",
+                    "give zero_parallax or zero_parallax_fraction, not both",
+                ));
+            }
+            (Some(d), None) => ZeroParallax::Distance(d),
+            (None, Some(t)) => ZeroParallax::Fraction(t),
+            (None, None) => ZeroParallax::Fraction(0.5),
+        };
+        let rig = StereoRig {
+            mode: f.stereo.mode,
+            separation,
+            zero_parallax,
+            user_offset: f.stereo.user_offset,
+            user_balance: f.stereo.user_balance,
+            lighting: f.stereo.lighting,
+        };
+        let aspect = f.image.width as f32 / f.image.height as f32;
+        rig.resolve(&f.camera, aspect)?;
+        check_finite("light.position", &f.light.position)?;
+        check_finite("image.background", &f.image.background)?;
+        let light = Light {
+            position: f.light.position.into(),
+            ambient: f.light.ambient,
+            specular: f.light.specular,
+            shininess: f.light.shininess,
+        };
+        if f.image.height < 2 * f.layout.blank_interval + 2
+            && f.outputs.iter().any(|o| o == "above_below_squashed")
+        {
+            return Err(Error::invalid(
+                "layout.blank_interval",
+                f.layout.blank_interval,
+                "leaves no rows for the two views",
+            ));
+        }
+        let outputs = f
+            .outputs
+            .iter()
+            .map(|o| Output::parse(o))
+            .collect::<Result<Vec<_>>>()?;
+        if outputs.is_empty() {
+            return Err(Error::invalid(
+                "outputs",
+                "[]",
+                "ask for at least one output",
+            ));
+        }
+        let objects = f
+            .meshes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| load_object(i, m, base_dir))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Scene {
+            width: f.image.width,
+            height: f.image.height,
+            background: to_rgba8(f.image.background.into()),
+            camera: f.camera,
+            rig,
+            light,
+            objects,
+            outputs,
+            blank_interval: f.layout.blank_interval,
+            raster: RasterOptions {
+                cull_back: f.raster.cull_back,
+                ..RasterOptions::default()
+            },
+        })
+    }
+
+    /// Width / height.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// Overrides the image size (CLI `--size WxH`), checking it before anything is allocated.
+    ///
+    /// # Errors
+    /// A zero or oversized side, or a size that leaves the rig invalid.
+    pub fn set_size(&mut self, width: u32, height: u32) -> Result<()> {
+        check_size(width, height)?;
+        self.width = width;
+        self.height = height;
+        self.rig.resolve(&self.camera, self.aspect())?;
+        Ok(())
+    }
+
+    /// Every object's vertices in world space.
+    pub fn world_points(&self) -> impl Iterator<Item = Vec3> + '_ {
+        self.objects.iter().flat_map(|o| {
+            o.mesh
+                .positions
+                .iter()
+                .map(move |p| o.model.transform_point3(*p))
+        })
+    }
+}
+
+fn check_finite(field: &str, v: &[f32]) -> Result<()> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::invalid(field, format!("{v:?}"), "must be finite"))
+    }
+}
+
+/// Builds one `[[mesh]]` entry.
+fn load_object(i: usize, m: &file::MeshSpec, base_dir: &Path) -> Result<Object> {
+    let field = |f: &str| format!("mesh[{i}].{f}");
+    let positive = |name: &str, v: Option<f32>, default: f32| -> Result<f32> {
+        let v = v.unwrap_or(default);
+        if v > 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            Err(Error::invalid(
+                field(name),
+                v,
+                "must be a finite number > 0",
+            ))
+        }
+    };
+    let detail = m.detail.unwrap_or(32);
+    if !(3..=4096).contains(&detail) {
+        return Err(Error::invalid(
+            field("detail"),
+            detail,
+            "must lie in 3..=4096",
+        ));
+    }
+    let mesh = match m.kind.as_str() {
+        "obj" => {
+            let p = m.path.as_ref().ok_or_else(|| {
+                Error::invalid(field("path"), "missing", "an obj mesh needs a path")
+            })?;
+            let full: PathBuf = base_dir.join(p);
+            load_obj(&full)?
+        }
+        "sphere" => Mesh::sphere(positive("size", m.size, 1.0)?, detail, detail / 2),
+        "cube" => Mesh::cube(positive("size", m.size, 1.0)?),
+        "torus" => Mesh::torus(
+            positive("size", m.size, 1.0)?,
+            positive("minor", m.minor, 0.3)?,
+            detail,
+            detail / 2,
+        ),
+        "plane" => Mesh::plane(positive("size", m.size, 1.0)?, detail.min(512)),
+        "triangles" => {
+            let n = m.count.unwrap_or(1000);
+            if !(1..=10_000_000).contains(&n) {
+                return Err(Error::invalid(
+                    field("count"),
+                    n,
+                    "must lie in 1..=10000000",
+                ));
+            }
+            Mesh::triangle_grid(n)
+        }
+        other => {
+            return Err(Error::invalid(
+                field("kind"),
+                format!("\"{other}\""),
+                "known kinds: obj, sphere, cube, torus, plane, triangles",
+            ));
+        }
+    };
+    check_finite(&field("translate"), &m.translate)?;
+    check_finite(&field("rotate"), &m.rotate)?;
+    check_finite(&field("color"), &m.color)?;
+    if !(m.scale > 0.0 && m.scale.is_finite()) {
+        return Err(Error::invalid(
+            field("scale"),
+            m.scale,
+            "must be a finite number > 0",
+        ));
+    }
+    let r = m.rotate.map(f32::to_radians);
+    let model = Mat4::from_scale_rotation_translation(
+        Vec3::splat(m.scale),
+        Quat::from_euler(EulerRot::ZYX, r[2], r[1], r[0]),
+        m.translate.into(),
+    );
+    Ok(Object {
+        name: format!("mesh[{i}] {}", m.kind),
+        mesh,
+        model,
+        color: m.color.into(),
+    })
+}
+
+/// A TOML error with the line it points at.
+fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
+    let line = e
+        .span()
+        .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+    Error::parse(path, line, e.message().to_string())
+}
+
+/// Applies one `key.path=value` override; the value is read as TOML (`0.3`, `"auto"`, `[1,2,3]`)
+/// or, failing that, as a bare string. Numeric segments index arrays (`mesh.0.color`).
+fn apply_set(table: &mut toml::Table, set: &str) -> Result<()> {
+    let (key, raw) = set
+        .split_once('=')
+        .ok_or_else(|| Error::invalid("--set", set, "expected key=value"))?;
+    let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(raw.to_string()));
+    let parts: Vec<&str> = key.trim().split('.').collect();
+    set_path(table, &parts, value).map_err(|reason| Error::invalid("--set", set, reason))
+}
+
+/// Walks `parts` down from `cur`, creating tables as needed, and sets the last one.
+fn set_path(
+    cur: &mut toml::Table,
+    parts: &[&str],
+    value: toml::Value,
+) -> std::result::Result<(), String> {
+    let (first, rest) = parts.split_first().ok_or("empty key")?;
+    if rest.is_empty() {
+        cur.insert(first.to_string(), value);
+        return Ok(());
+    }
+    match cur
+        .entry(first.to_string())
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+    {
+        toml::Value::Table(t) => set_path(t, rest, value),
+        toml::Value::Array(a) => {
+            let len = a.len();
+            let idx: usize = rest[0]
+                .parse()
+                .map_err(|_| format!("{first} is a list: give an index, e.g. {first}.0"))?;
+            match a.get_mut(idx) {
+                Some(toml::Value::Table(t)) if rest.len() > 1 => set_path(t, &rest[1..], value),
+                Some(_) => Err(format!("{first}.{idx} is not a table with that field")),
+                None => Err(format!("{first} has {len} entries")),
+            }
+        }
+        _ => Err(format!("{first} is not a table")),
+    }
+}

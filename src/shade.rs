@@ -1,0 +1,150 @@
+//! The programmable stages as a trait, so a pass is `rasterize(triangles, &shader, &mut fb)`,
+//! and the default Blinn-Phong shader.
+
+use glam::{Mat3, Mat4, Vec3, Vec4};
+
+/// How many f32 varyings a vertex can hand to the fragment stage.
+pub const MAX_VARYINGS: usize = 8;
+
+/// The varyings of one vertex or fragment; a shader uses the first [`Shader::varying_count`].
+pub type Varyings = [f32; MAX_VARYINGS];
+
+/// What the fragment stage sees of one covered, depth-passing pixel.
+#[derive(Clone, Copy, Debug)]
+pub struct Fragment<'a> {
+    /// Pixel column.
+    pub x: u32,
+    /// Pixel row (0 = top).
+    pub y: u32,
+    /// Window depth in [0, 1].
+    pub depth: f32,
+    /// Interpolated varyings (perspective-correct unless the pass asked for affine).
+    pub varyings: &'a Varyings,
+    /// Counter-clockwise in NDC (OpenGL's default front face).
+    pub front_facing: bool,
+}
+
+/// A vertex + fragment program pair, like a GL program object.
+pub trait Shader: Sync {
+    /// Number of varyings `vertex` writes (≤ [`MAX_VARYINGS`]); only these are interpolated.
+    fn varying_count(&self) -> usize {
+        0
+    }
+    /// Vertex stage: returns the clip-space position of vertex `index`, writes its varyings.
+    fn vertex(&self, index: u32, varyings: &mut Varyings) -> Vec4;
+    /// Fragment stage: the color, or `None` to discard (then neither color nor depth is written).
+    fn fragment(&self, fragment: &Fragment) -> Option<[u8; 4]>;
+    /// `false` for depth-only passes: the fragment stage is skipped entirely.
+    fn writes_color(&self) -> bool {
+        true
+    }
+}
+
+/// A point light and the ambient term, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// Light position (world).
+    pub position: Vec3,
+    /// Ambient intensity, 0..1.
+    pub ambient: f32,
+    /// Specular intensity, 0..1.
+    pub specular: f32,
+    /// Blinn-Phong exponent.
+    pub shininess: f32,
+}
+
+impl Default for Light {
+    fn default() -> Self {
+        Light {
+            position: Vec3::new(5.0, 8.0, 10.0),
+            ambient: 0.15,
+            specular: 0.35,
+            shininess: 32.0,
+        }
+    }
+}
+
+/// Blinn-Phong in eye space: the modelview it is given decides whether each eye lights from its
+/// own position (per-eye) or both from the cyclopean eye (cyclopic), seed 004.
+pub struct BlinnPhong<'a> {
+    /// Object positions.
+    pub positions: &'a [Vec3],
+    /// Object normals, one per position.
+    pub normals: &'a [Vec3],
+    /// Model matrix (object → world).
+    pub model: Mat4,
+    /// Modelview used for lighting (world → eye space of the lighting eye).
+    pub view: Mat4,
+    /// Projection completing `view` so that `projection · view · model` is the eye's MVP.
+    pub projection: Mat4,
+    /// Material color, linear 0..1.
+    pub color: Vec3,
+    /// The light.
+    pub light: Light,
+}
+
+impl Shader for BlinnPhong<'_> {
+    fn varying_count(&self) -> usize {
+        6
+    }
+
+    fn vertex(&self, index: u32, out: &mut Varyings) -> Vec4 {
+        let i = index as usize;
+        let mv = self.view * self.model;
+        let p_eye = mv.transform_point3(self.positions[i]);
+        // Normals transform by the inverse transpose of the modelview's linear part.
+        let n_eye = Mat3::from_mat4(mv).inverse().transpose() * self.normals[i];
+        out[..3].copy_from_slice(&p_eye.to_array());
+        out[3..6].copy_from_slice(&n_eye.to_array());
+        self.projection * p_eye.extend(1.0)
+    }
+
+    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
+        let v = f.varyings;
+        let p = Vec3::new(v[0], v[1], v[2]);
+        let mut n = Vec3::new(v[3], v[4], v[5]).normalize_or_zero();
+        if !f.front_facing {
+            n = -n; // two-sided lighting: back faces lit as seen
+        }
+        let light_eye = self.view.transform_point3(self.light.position);
+        let l = (light_eye - p).normalize_or_zero();
+        let view_dir = (-p).normalize_or_zero();
+        let h = (l + view_dir).normalize_or_zero();
+        let diffuse = n.dot(l).max(0.0);
+        let spec = if diffuse > 0.0 {
+            n.dot(h).max(0.0).powf(self.light.shininess) * self.light.specular
+        } else {
+            0.0
+        };
+        let c = self.color * (self.light.ambient + (1.0 - self.light.ambient) * diffuse)
+            + Vec3::splat(spec);
+        Some(to_rgba8(c))
+    }
+}
+
+/// Converts a 0..1 color to RGBA8 (alpha 255), rounding to nearest.
+#[inline]
+pub fn to_rgba8(c: Vec3) -> [u8; 4] {
+    let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    [q(c.x), q(c.y), q(c.z), 255]
+}
+
+/// Depth only: no fragment stage at all (SIRDS and depth outputs need nothing else).
+pub struct DepthOnly<'a> {
+    /// Object positions.
+    pub positions: &'a [Vec3],
+    /// Full model-view-projection.
+    pub mvp: Mat4,
+}
+
+impl Shader for DepthOnly<'_> {
+    fn vertex(&self, index: u32, _: &mut Varyings) -> Vec4 {
+        self.mvp * self.positions[index as usize].extend(1.0)
+    }
+    fn fragment(&self, _: &Fragment) -> Option<[u8; 4]> {
+        None
+    }
+    fn writes_color(&self) -> bool {
+        false
+    }
+}
