@@ -107,15 +107,15 @@ pub fn render_view(
         let mesh = &o.mesh;
         let s = match shading {
             Shading::Color => {
-                let shader = BlinnPhong {
-                    positions: &mesh.positions,
-                    normals: &mesh.normals,
-                    model: o.model,
-                    view: m.view,
-                    projection: m.projection,
-                    color: o.color,
-                    light: scene.light,
-                };
+                let shader = BlinnPhong::new(
+                    &mesh.positions,
+                    &mesh.normals,
+                    o.model,
+                    m.view,
+                    m.projection,
+                    o.color,
+                    scene.light,
+                );
                 rasterize(
                     &mesh.triangles,
                     mesh.positions.len(),

@@ -67,20 +67,43 @@ impl Default for Light {
 /// Blinn-Phong in eye space: the modelview it is given decides whether each eye lights from its
 /// own position (per-eye) or both from the cyclopean eye (cyclopic), seed 004.
 pub struct BlinnPhong<'a> {
-    /// Object positions.
-    pub positions: &'a [Vec3],
-    /// Object normals, one per position.
-    pub normals: &'a [Vec3],
-    /// Model matrix (object → world).
-    pub model: Mat4,
-    /// Modelview used for lighting (world → eye space of the lighting eye).
-    pub view: Mat4,
-    /// Projection completing `view` so that `projection · view · model` is the eye's MVP.
-    pub projection: Mat4,
-    /// Material color, linear 0..1.
-    pub color: Vec3,
-    /// The light.
-    pub light: Light,
+    positions: &'a [Vec3],
+    normals: &'a [Vec3],
+    /// view · model.
+    modelview: Mat4,
+    /// Inverse transpose of the modelview's linear part: normals transform by it.
+    normal_matrix: Mat3,
+    projection: Mat4,
+    color: Vec3,
+    light: Light,
+    /// The light position in the lighting eye's space.
+    light_eye: Vec3,
+}
+
+impl<'a> BlinnPhong<'a> {
+    /// A Blinn-Phong program for one object seen by one eye: `view` is the modelview the eye
+    /// lights in, `projection` completes it so that `projection · view · model` is the eye's MVP.
+    pub fn new(
+        positions: &'a [Vec3],
+        normals: &'a [Vec3],
+        model: Mat4,
+        view: Mat4,
+        projection: Mat4,
+        color: Vec3,
+        light: Light,
+    ) -> Self {
+        let modelview = view * model;
+        BlinnPhong {
+            positions,
+            normals,
+            modelview,
+            normal_matrix: Mat3::from_mat4(modelview).inverse().transpose(),
+            projection,
+            color,
+            light,
+            light_eye: view.transform_point3(light.position),
+        }
+    }
 }
 
 impl Shader for BlinnPhong<'_> {
@@ -90,10 +113,8 @@ impl Shader for BlinnPhong<'_> {
 
     fn vertex(&self, index: u32, out: &mut Varyings) -> Vec4 {
         let i = index as usize;
-        let mv = self.view * self.model;
-        let p_eye = mv.transform_point3(self.positions[i]);
-        // Normals transform by the inverse transpose of the modelview's linear part.
-        let n_eye = Mat3::from_mat4(mv).inverse().transpose() * self.normals[i];
+        let p_eye = self.modelview.transform_point3(self.positions[i]);
+        let n_eye = self.normal_matrix * self.normals[i];
         out[..3].copy_from_slice(&p_eye.to_array());
         out[3..6].copy_from_slice(&n_eye.to_array());
         self.projection * p_eye.extend(1.0)
@@ -106,10 +127,8 @@ impl Shader for BlinnPhong<'_> {
         if !f.front_facing {
             n = -n; // two-sided lighting: back faces lit as seen
         }
-        let light_eye = self.view.transform_point3(self.light.position);
-        let l = (light_eye - p).normalize_or_zero();
-        let view_dir = (-p).normalize_or_zero();
-        let h = (l + view_dir).normalize_or_zero();
+        let l = (self.light_eye - p).normalize_or_zero();
+        let h = (l + (-p).normalize_or_zero()).normalize_or_zero();
         let diffuse = n.dot(l).max(0.0);
         let spec = if diffuse > 0.0 {
             n.dot(h).max(0.0).powf(self.light.shininess) * self.light.specular

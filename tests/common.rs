@@ -1,0 +1,35 @@
+//! Helpers shared by the integration tests.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A file under `assets/`.
+pub fn asset(rel: &str) -> PathBuf {
+    root().join("assets").join(rel)
+}
+
+/// A fresh folder under `target/test-out/<name>` for files a test writes.
+pub fn out_dir(name: &str) -> PathBuf {
+    let d = root().join("target").join("test-out").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("create test output folder");
+    d
+}
+
+/// Where failing image tests write `expected | diff | actual` (ignored by git).
+pub fn failure_dir() -> PathBuf {
+    let d = root().join("tests").join("failures");
+    std::fs::create_dir_all(&d).expect("create tests/failures");
+    d
+}
+
+/// True when `path` exists.
+pub fn exists(p: &Path) -> bool {
+    p.exists()
+}

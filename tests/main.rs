@@ -1,0 +1,3 @@
+//! One integration-test binary (tiny-skia's layout): `mod` per area.
+
+mod common;
