@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod bench;
+pub mod compare;
 pub mod effects;
 pub mod error;
 pub mod framebuffer;
