@@ -3,3 +3,6 @@
 mod common;
 mod rig;
 mod conformance;
+mod determinism;
+mod layout;
+mod cli;
