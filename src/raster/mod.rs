@@ -73,20 +73,15 @@ pub fn rasterize<S: Shader>(
         triangles: triangles.len(),
         ..Default::default()
     };
-    let mut poly = [verts.first().copied().unwrap_or(ClipVertex {
-        pos: glam::Vec4::ZERO,
-        var: [0.0; 8],
-    }); MAX_CLIPPED + 3];
+    let blank = ClipVertex { pos: glam::Vec4::ZERO, var: [0.0; crate::shade::MAX_VARYINGS] };
+    let mut poly = [blank; MAX_CLIPPED + 3];
+    let mut win: [Option<WindowVertex>; MAX_CLIPPED + 3] = [None; MAX_CLIPPED + 3];
     for tri in triangles {
-        let Some(t) = tri
-            .iter()
-            .map(|&i| verts.get(i as usize).copied())
-            .collect::<Option<Vec<_>>>()
-        else {
-            stats.non_finite += 1;
+        let (Some(a), Some(b), Some(c)) = (verts.get(tri[0] as usize), verts.get(tri[1] as usize), verts.get(tri[2] as usize)) else {
+            stats.non_finite += 1; // an index past the vertex count: nothing sensible to draw
             continue;
         };
-        let t = [t[0], t[1], t[2]];
+        let t = [*a, *b, *c];
         if t.iter().any(|v| !v.pos.is_finite()) {
             stats.non_finite += 1;
             continue;
@@ -102,23 +97,13 @@ pub fn rasterize<S: Shader>(
             stats.clipped += 1;
             clip_triangle(t, nvar, &mut poly)
         };
+        for k in 0..n {
+            win[k] = WindowVertex::from_clip(&poly[k], fb.width, fb.height);
+        }
         // The clipped polygon is convex: draw it as a fan around its first vertex.
-        let win: Vec<Option<WindowVertex>> = poly[..n]
-            .iter()
-            .map(|v| WindowVertex::from_clip(v, fb.width, fb.height))
-            .collect();
         for k in 1..n.saturating_sub(1) {
-            let (Some(a), Some(b), Some(c)) = (win[0], win[k], win[k + 1]) else {
-                continue;
-            };
-            let r = rasterize_window_triangle(
-                [a, b, c],
-                [&poly[0].var, &poly[k].var, &poly[k + 1].var],
-                nvar,
-                shader,
-                fb,
-                opts,
-            );
+            let (Some(a), Some(b), Some(c)) = (win[0], win[k], win[k + 1]) else { continue };
+            let r = rasterize_window_triangle([a, b, c], [&poly[0].var, &poly[k].var, &poly[k + 1].var], nvar, shader, fb, opts);
             stats.culled += r.culled;
             stats.fragments += r.fragments;
         }
