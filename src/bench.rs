@@ -169,7 +169,7 @@ fn subpixel_bits(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// Writes the interpolated texture coordinate as color, for the perspective benchmark.
+/// Writes the interpolated texture coordinate as color (the timed shader of the perspective benchmark).
 struct UvShader<'a> {
     mesh: &'a Mesh,
     mvp: glam::Mat4,

@@ -56,7 +56,7 @@ fn info_prints_both_frusta_and_the_parallax_range() {
     let out = stereolab(&["info", &wuson()]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success());
-    for needle in ["left   eye", "right  eye", "zero-parallax distance z0 = 4.6", "% of image width"] {
+    for needle in ["left   eye", "right  eye", "zero-parallax distance z0 = 4.8", "% of image width"] {
         assert!(text.contains(needle), "missing {needle:?} in\n{text}");
     }
     let wide = stereolab(&["info", &wuson(), "--set", "stereo.user_offset=2", "--set", "stereo.zero_parallax=2"]);
