@@ -21,10 +21,17 @@ struct Counter {
 
 impl Counter {
     fn new(clip: Vec<Vec4>, width: u32, height: u32) -> Self {
-        Counter { clip, width, counts: (0..width * height).map(|_| AtomicU32::new(0)).collect() }
+        Counter {
+            clip,
+            width,
+            counts: (0..width * height).map(|_| AtomicU32::new(0)).collect(),
+        }
     }
     fn counts(&self) -> Vec<u32> {
-        self.counts.iter().map(|c| c.load(Ordering::Relaxed)).collect()
+        self.counts
+            .iter()
+            .map(|c| c.load(Ordering::Relaxed))
+            .collect()
     }
 }
 
@@ -45,7 +52,10 @@ const H: u32 = 48;
 fn count(clip: Vec<Vec4>, tris: &[[u32; 3]], width: u32, height: u32) -> Vec<u32> {
     let shader = Counter::new(clip, width, height);
     let mut fb = Framebuffer::new(width, height, [0, 0, 0, 255]).unwrap();
-    let opts = RasterOptions { depth_test: false, ..RasterOptions::default() };
+    let opts = RasterOptions {
+        depth_test: false,
+        ..RasterOptions::default()
+    };
     rasterize(tris, shader.clip.len(), &shader, &mut fb, &opts);
     shader.counts()
 }
@@ -59,7 +69,9 @@ fn win(x: f32, y: f32) -> Vec4 {
 /// strip (expected | diff | actual) to tests/failures/.
 fn check(name: &str, counts: &[u32], expected: impl Fn(usize) -> u32, width: u32) {
     let height = counts.len() as u32 / width;
-    let bad: Vec<usize> = (0..counts.len()).filter(|&i| counts[i] != expected(i)).collect();
+    let bad: Vec<usize> = (0..counts.len())
+        .filter(|&i| counts[i] != expected(i))
+        .collect();
     if bad.is_empty() {
         return;
     }
@@ -81,7 +93,8 @@ fn check(name: &str, counts: &[u32], expected: impl Fn(usize) -> u32, width: u32
             actual_fb.color[i] = [255, 0, 255, 255]; // double hits in magenta
         }
     }
-    let path = stereolab::compare::write_diff_strip(&to_fb(&exp), &actual_fb, &failure_dir(), name).ok();
+    let path =
+        stereolab::compare::write_diff_strip(&to_fb(&exp), &actual_fb, &failure_dir(), name).ok();
     let doubles = counts.iter().filter(|&&c| c > 1).count();
     panic!(
         "{name}: {} pixels differ ({doubles} double hits); first at ({}, {}): count {} expected {}\n{}\nwrote {:?}",
@@ -98,7 +111,12 @@ fn check(name: &str, counts: &[u32], expected: impl Fn(usize) -> u32, width: u32
 #[test]
 fn full_screen_clipped_quad_covers_every_pixel_exactly_once() {
     // Corners far outside the viewport: both triangles are clipped.
-    let clip = vec![Vec4::new(-3.0, -3.0, 0.0, 1.0), Vec4::new(3.0, -3.0, 0.0, 1.0), Vec4::new(3.0, 3.0, 0.0, 1.0), Vec4::new(-3.0, 3.0, 0.0, 1.0)];
+    let clip = vec![
+        Vec4::new(-3.0, -3.0, 0.0, 1.0),
+        Vec4::new(3.0, -3.0, 0.0, 1.0),
+        Vec4::new(3.0, 3.0, 0.0, 1.0),
+        Vec4::new(-3.0, 3.0, 0.0, 1.0),
+    ];
     let counts = count(clip, &[[0, 1, 2], [0, 2, 3]], W, H);
     check("full_screen_quad", &counts, |_| 1, W);
 }
@@ -120,8 +138,12 @@ fn fan_around_shared_vertex_has_no_cracks_or_double_hits() {
 fn grid_of_quads_covers_each_pixel_once() {
     // 7×5 quads on non-integer boundaries, extended beyond the viewport on all sides.
     let (nx, ny) = (7, 5);
-    let xs: Vec<f32> = (0..=nx).map(|i| -5.3 + i as f32 * (W as f32 + 10.0) / nx as f32).collect();
-    let ys: Vec<f32> = (0..=ny).map(|j| -4.1 + j as f32 * (H as f32 + 8.0) / ny as f32).collect();
+    let xs: Vec<f32> = (0..=nx)
+        .map(|i| -5.3 + i as f32 * (W as f32 + 10.0) / nx as f32)
+        .collect();
+    let ys: Vec<f32> = (0..=ny)
+        .map(|j| -4.1 + j as f32 * (H as f32 + 8.0) / ny as f32)
+        .collect();
     let mut clip = Vec::new();
     for y in &ys {
         for x in &xs {
@@ -151,7 +173,8 @@ fn rotated_grids_at_15_degree_steps_cover_each_pixel_once() {
         let mut clip = Vec::new();
         for j in 0..=n {
             for i in 0..=n {
-                let p = c + rot * (Vec2::new(i as f32, j as f32) - Vec2::splat(n as f32 / 2.0)) * cell;
+                let p =
+                    c + rot * (Vec2::new(i as f32, j as f32) - Vec2::splat(n as f32 / 2.0)) * cell;
                 clip.push(win(p.x, p.y));
             }
         }
@@ -164,7 +187,12 @@ fn rotated_grids_at_15_degree_steps_cover_each_pixel_once() {
                 tris.push([a, b + 1, b]);
             }
         }
-        check(&format!("rotated_{}deg", step * 15), &count(clip, &tris, W, H), |_| 1, W);
+        check(
+            &format!("rotated_{}deg", step * 15),
+            &count(clip, &tris, W, H),
+            |_| 1,
+            W,
+        );
     }
 }
 
@@ -178,16 +206,36 @@ fn random_w_changes_nothing_in_coverage() {
         rng ^= rng << 17;
         (rng >> 40) as f32 / (1u64 << 24) as f32
     };
-    let base = [Vec4::new(-3.0, -3.0, 0.0, 1.0), Vec4::new(3.0, -3.0, 0.0, 1.0), Vec4::new(3.0, 3.0, 0.0, 1.0), Vec4::new(-3.0, 3.0, 0.0, 1.0)];
-    let inner = [win(10.2, 7.7), win(50.6, 9.1), win(44.4, 40.3), win(13.9, 37.5)];
+    let base = [
+        Vec4::new(-3.0, -3.0, 0.0, 1.0),
+        Vec4::new(3.0, -3.0, 0.0, 1.0),
+        Vec4::new(3.0, 3.0, 0.0, 1.0),
+        Vec4::new(-3.0, 3.0, 0.0, 1.0),
+    ];
+    let inner = [
+        win(10.2, 7.7),
+        win(50.6, 9.1),
+        win(44.4, 40.3),
+        win(13.9, 37.5),
+    ];
     let tris = [[0, 1, 2], [0, 2, 3]];
     let reference = count(inner.to_vec(), &tris, W, H);
     for trial in 0..20 {
         let clip: Vec<Vec4> = base.iter().map(|v| *v * (0.1 + 3.9 * next())).collect();
-        check(&format!("random_w_full_{trial}"), &count(clip, &tris, W, H), |_| 1, W);
+        check(
+            &format!("random_w_full_{trial}"),
+            &count(clip, &tris, W, H),
+            |_| 1,
+            W,
+        );
         let clip: Vec<Vec4> = inner.iter().map(|v| *v * (0.1 + 3.9 * next())).collect();
         let counts = count(clip, &tris, W, H);
-        check(&format!("random_w_inner_{trial}"), &counts, |i| reference[i], W);
+        check(
+            &format!("random_w_inner_{trial}"),
+            &counts,
+            |i| reference[i],
+            W,
+        );
     }
 }
 
@@ -197,28 +245,49 @@ fn axis_aligned_edges_follow_top_left_rule() {
     // edges own their pixels, the right and bottom edges do not.
     let clip = vec![win(2.5, 2.5), win(6.5, 2.5), win(6.5, 6.5), win(2.5, 6.5)];
     let counts = count(clip, &[[0, 2, 1], [0, 3, 2]], W, H);
-    check("top_left", &counts, |i| ((2..6).contains(&(i as u32 % W)) && (2..6).contains(&(i as u32 / W))) as u32, W);
+    check(
+        "top_left",
+        &counts,
+        |i| ((2..6).contains(&(i as u32 % W)) && (2..6).contains(&(i as u32 / W))) as u32,
+        W,
+    );
 }
 
 #[test]
 fn zero_area_and_subpixel_triangles_cover_nothing() {
     let cases = [
-        vec![win(10.0, 10.0), win(10.0, 10.0), win(10.0, 10.0)],   // a point
-        vec![win(3.0, 3.0), win(20.0, 20.0), win(40.0, 40.0)],     // collinear
-        vec![win(10.6, 10.6), win(10.9, 10.6), win(10.6, 10.9)],   // between sample points
+        vec![win(10.0, 10.0), win(10.0, 10.0), win(10.0, 10.0)], // a point
+        vec![win(3.0, 3.0), win(20.0, 20.0), win(40.0, 40.0)],   // collinear
+        vec![win(10.6, 10.6), win(10.9, 10.6), win(10.6, 10.9)], // between sample points
         vec![win(10.5, 10.5), win(10.5, 10.5), win(10.50001, 10.5)], // rounds to zero area
     ];
     for (k, clip) in cases.into_iter().enumerate() {
-        check(&format!("degenerate_{k}"), &count(clip, &[[0, 1, 2]], W, H), |_| 0, W);
+        check(
+            &format!("degenerate_{k}"),
+            &count(clip, &[[0, 1, 2]], W, H),
+            |_| 0,
+            W,
+        );
     }
 }
 
 #[test]
 fn non_finite_vertices_are_dropped_not_drawn() {
-    let clip = vec![Vec4::new(f32::NAN, 0.0, 0.0, 1.0), Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 1.0, 0.0, 1.0), Vec4::new(0.0, 0.0, f32::INFINITY, 1.0)];
+    let clip = vec![
+        Vec4::new(f32::NAN, 0.0, 0.0, 1.0),
+        Vec4::new(1.0, 0.0, 0.0, 1.0),
+        Vec4::new(0.0, 1.0, 0.0, 1.0),
+        Vec4::new(0.0, 0.0, f32::INFINITY, 1.0),
+    ];
     let shader = Counter::new(clip, W, H);
     let mut fb = Framebuffer::new(W, H, [0, 0, 0, 255]).unwrap();
-    let stats = rasterize(&[[0, 1, 2], [1, 2, 3], [1, 2, 7]], 4, &shader, &mut fb, &RasterOptions::default());
+    let stats = rasterize(
+        &[[0, 1, 2], [1, 2, 3], [1, 2, 7]],
+        4,
+        &shader,
+        &mut fb,
+        &RasterOptions::default(),
+    );
     assert_eq!(stats.non_finite, 3, "{stats:?}");
     assert!(shader.counts().iter().all(|&c| c == 0));
 }
@@ -237,7 +306,9 @@ fn eye_triangle(tri: [Vec3; 3], width: u32, height: u32) -> Framebuffer {
         }
     }
     let p: Mat4 = stereolab::math::perspective(60.0, width as f32 / height as f32, 1.0, 50.0);
-    let shader = Eye { clip: tri.iter().map(|v| p * v.extend(1.0)).collect() };
+    let shader = Eye {
+        clip: tri.iter().map(|v| p * v.extend(1.0)).collect(),
+    };
     let mut fb = Framebuffer::new(width, height, [0, 0, 0, 255]).unwrap();
     rasterize(&[[0, 1, 2]], 3, &shader, &mut fb, &RasterOptions::default());
     fb
@@ -263,13 +334,30 @@ fn clip_near(poly: &[Vec3], near: f32) -> Vec<Vec3> {
 fn triangles_crossing_the_near_plane_or_behind_the_eye_match_the_clipped_result() {
     let (w, h) = (96, 72);
     let cases = [
-        [Vec3::new(-1.0, -1.0, -4.0), Vec3::new(1.5, -0.5, -0.5), Vec3::new(0.0, 1.0, -3.0)], // crosses near
-        [Vec3::new(-2.0, -1.0, -5.0), Vec3::new(2.0, -1.0, -5.0), Vec3::new(0.3, 0.5, 3.0)],  // one vertex behind the eye
-        [Vec3::new(-2.0, -1.0, 2.0), Vec3::new(2.0, -1.0, 1.0), Vec3::new(0.0, 1.0, -6.0)],   // two behind
+        [
+            Vec3::new(-1.0, -1.0, -4.0),
+            Vec3::new(1.5, -0.5, -0.5),
+            Vec3::new(0.0, 1.0, -3.0),
+        ], // crosses near
+        [
+            Vec3::new(-2.0, -1.0, -5.0),
+            Vec3::new(2.0, -1.0, -5.0),
+            Vec3::new(0.3, 0.5, 3.0),
+        ], // one vertex behind the eye
+        [
+            Vec3::new(-2.0, -1.0, 2.0),
+            Vec3::new(2.0, -1.0, 1.0),
+            Vec3::new(0.0, 1.0, -6.0),
+        ], // two behind
     ];
     for (k, tri) in cases.iter().enumerate() {
         let fb = eye_triangle(*tri, w, h);
-        assert!(fb.depth.iter().all(|d| d.is_finite() && (0.0..=1.0).contains(d)), "case {k}: depth out of range");
+        assert!(
+            fb.depth
+                .iter()
+                .all(|d| d.is_finite() && (0.0..=1.0).contains(d)),
+            "case {k}: depth out of range"
+        );
         let poly = clip_near(tri, 1.0);
         let mut expected = Framebuffer::new(w, h, [0, 0, 0, 255]).unwrap();
         for i in 1..poly.len() - 1 {
@@ -278,12 +366,19 @@ fn triangles_crossing_the_near_plane_or_behind_the_eye_match_the_clipped_result(
                 *e = e.min(*p);
             }
         }
-        let (a, b) = (stereolab::compare::coverage(&expected), stereolab::compare::coverage(&fb));
+        let (a, b) = (
+            stereolab::compare::coverage(&expected),
+            stereolab::compare::coverage(&fb),
+        );
         let covered = a.iter().filter(|c| **c).count();
         let diff = a.iter().zip(&b).filter(|(x, y)| x != y).count();
         // Clipping in clip space vs in eye space rounds differently: allow edge pixels only.
         assert!(covered > 100, "case {k}: only {covered} pixels covered");
-        assert!(diff <= 3, "case {k}: {diff} pixels differ from the analytically clipped triangle\n{}", ascii_map(&a, &b, w as usize, 96));
+        assert!(
+            diff <= 3,
+            "case {k}: {diff} pixels differ from the analytically clipped triangle\n{}",
+            ascii_map(&a, &b, w as usize, 96)
+        );
     }
 }
 

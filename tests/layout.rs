@@ -8,7 +8,10 @@ const BLUE: [u8; 4] = [0, 0, 255, 255];
 const BLACK: [u8; 4] = [0, 0, 0, 255];
 
 fn pair(w: u32, h: u32) -> (Framebuffer, Framebuffer) {
-    (Framebuffer::new(w, h, RED).unwrap(), Framebuffer::new(w, h, BLUE).unwrap())
+    (
+        Framebuffer::new(w, h, RED).unwrap(),
+        Framebuffer::new(w, h, BLUE).unwrap(),
+    )
 }
 
 #[test]
@@ -30,7 +33,11 @@ fn above_below_squash_averages_row_pairs() {
     for y in 0..8 {
         for x in 0..4 {
             let i = l.index(x, y);
-            l.color[i] = if y % 2 == 0 { [0, 0, 0, 255] } else { [255, 255, 255, 255] };
+            l.color[i] = if y % 2 == 0 {
+                [0, 0, 0, 255]
+            } else {
+                [255, 255, 255, 255]
+            };
         }
     }
     let img = layout::above_below_squashed(&l, &r, 0).unwrap();
@@ -45,16 +52,31 @@ fn side_by_side_interlaced_and_checkerboard_pick_the_right_eye() {
     let ab = layout::above_below(&l, &r).unwrap();
     assert_eq!((ab.get_pixel(0, 3).0, ab.get_pixel(0, 4).0), (RED, BLUE));
     let rows = layout::interleave(&l, &r, |_, y| y % 2 == 0).unwrap();
-    assert_eq!((rows.get_pixel(3, 0).0, rows.get_pixel(3, 1).0), (RED, BLUE));
+    assert_eq!(
+        (rows.get_pixel(3, 0).0, rows.get_pixel(3, 1).0),
+        (RED, BLUE)
+    );
     let checker = layout::interleave(&l, &r, |x, y| (x + y) % 2 == 0).unwrap();
-    assert_eq!((checker.get_pixel(0, 0).0, checker.get_pixel(1, 0).0, checker.get_pixel(1, 1).0), (RED, BLUE, RED));
+    assert_eq!(
+        (
+            checker.get_pixel(0, 0).0,
+            checker.get_pixel(1, 0).0,
+            checker.get_pixel(1, 1).0
+        ),
+        (RED, BLUE, RED)
+    );
 }
 
 #[test]
 fn layouts_refuse_mismatched_eyes_and_blank_intervals_without_rows() {
     let l = Framebuffer::new(4, 4, RED).unwrap();
     let r = Framebuffer::new(5, 4, BLUE).unwrap();
-    assert!(layout::side_by_side(&l, &r).unwrap_err().to_string().contains("4x4 vs 5x4"));
+    assert!(
+        layout::side_by_side(&l, &r)
+            .unwrap_err()
+            .to_string()
+            .contains("4x4 vs 5x4")
+    );
     let r = Framebuffer::new(4, 4, BLUE).unwrap();
     assert!(layout::above_below_squashed(&l, &r, 3).is_err());
 }

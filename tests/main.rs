@@ -1,8 +1,9 @@
 //! One integration-test binary (tiny-skia's layout): `mod` per area.
 
+mod cli;
 mod common;
-mod rig;
 mod conformance;
 mod determinism;
+mod golden;
 mod layout;
-mod cli;
+mod rig;

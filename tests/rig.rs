@@ -3,15 +3,29 @@
 use glam::{Vec3, Vec3Swizzles};
 use proptest::prelude::*;
 use stereolab::Error;
-use stereolab::math::{Camera, CameraMode, Lighting, Separation, StereoRig, ZeroParallax, frustum, project_ndc};
+use stereolab::math::{
+    Camera, CameraMode, Lighting, Separation, StereoRig, ZeroParallax, frustum, project_ndc,
+};
 
 fn seed003_camera() -> Camera {
     // Seed 003 §5: camera at (0, 0, 9) looking at the xy plane; fov 90° so the plane spans ±9.
-    Camera { eye: [0.0, 0.0, 9.0], target: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], fov_y: 90.0, near: 1.0, far: 100.0 }
+    Camera {
+        eye: [0.0, 0.0, 9.0],
+        target: [0.0, 0.0, 0.0],
+        up: [0.0, 1.0, 0.0],
+        fov_y: 90.0,
+        near: 1.0,
+        far: 100.0,
+    }
 }
 
 fn rig(mode: CameraMode, separation: f32, z0: f32) -> StereoRig {
-    StereoRig { mode, separation: Separation::Absolute(separation), zero_parallax: ZeroParallax::Distance(z0), ..StereoRig::default() }
+    StereoRig {
+        mode,
+        separation: Separation::Absolute(separation),
+        zero_parallax: ZeroParallax::Distance(z0),
+        ..StereoRig::default()
+    }
 }
 
 #[test]
@@ -21,8 +35,14 @@ fn seed003_worked_example_projects_to_5_875_and_6_125() {
     // NDC → coordinates on the zero-parallax plane z = 0, which spans ±9 (tan 45° · 9).
     let on_plane = |m: &glam::Mat4| project_ndc(m, Vec3::new(8.0, -5.0, -3.0)).unwrap().xy() * 9.0;
     let (l, r) = (on_plane(&eyes[0].mvp), on_plane(&eyes[1].mvp));
-    assert!((l.x - 5.875).abs() < 1e-5 && (l.y + 3.75).abs() < 1e-5, "left {l}");
-    assert!((r.x - 6.125).abs() < 1e-5 && (r.y + 3.75).abs() < 1e-5, "right {r}");
+    assert!(
+        (l.x - 5.875).abs() < 1e-5 && (l.y + 3.75).abs() < 1e-5,
+        "left {l}"
+    );
+    assert!(
+        (r.x - 6.125).abs() < 1e-5 && (r.y + 3.75).abs() < 1e-5,
+        "right {r}"
+    );
 }
 
 #[test]
@@ -37,7 +57,11 @@ fn frustum_matches_seed004_entries() {
     ];
     for (i, row) in expect.iter().enumerate() {
         for (j, e) in row.iter().enumerate() {
-            assert!((m.row(i)[j] - e).abs() < 1e-6, "P[{i}][{j}] = {} expected {e}", m.row(i)[j]);
+            assert!(
+                (m.row(i)[j] - e).abs() < 1e-6,
+                "P[{i}][{j}] = {} expected {e}",
+                m.row(i)[j]
+            );
         }
     }
     // Near plane maps to NDC z = −1, far plane to +1 (OpenGL).
@@ -62,18 +86,32 @@ fn off_axis_frustum_shift_is_seed003_asymmetry() {
 #[test]
 fn auto_separation_is_twice_seed003_camera_offset() {
     let cam = seed003_camera();
-    let r = StereoRig { separation: Separation::Auto, zero_parallax: ZeroParallax::Distance(9.0), user_offset: 0.5, ..StereoRig::default() };
+    let r = StereoRig {
+        separation: Separation::Auto,
+        zero_parallax: ZeroParallax::Distance(9.0),
+        user_offset: 0.5,
+        ..StereoRig::default()
+    };
     let res = r.resolve(&cam, 2.0).unwrap();
     let xrange = 2.0 * 9.0 * 1.0 * 2.0; // 2 z0 tan(hfov/2), aspect 2
     assert!((res.xrange - xrange).abs() < 1e-4);
-    assert!((res.eye_separation - 2.0 * xrange * 0.035 * 0.5).abs() < 1e-5, "{}", res.eye_separation);
+    assert!(
+        (res.eye_separation - 2.0 * xrange * 0.035 * 0.5).abs() < 1e-5,
+        "{}",
+        res.eye_separation
+    );
 }
 
 #[test]
 fn zero_parallax_fraction_is_between_near_and_far() {
     let cam = seed003_camera();
-    let r = StereoRig { zero_parallax: ZeroParallax::Fraction(0.25), ..StereoRig::default() };
-    assert!((r.resolve(&cam, 1.0).unwrap().zero_parallax_distance - (1.0 + 0.25 * 99.0)).abs() < 1e-4);
+    let r = StereoRig {
+        zero_parallax: ZeroParallax::Fraction(0.25),
+        ..StereoRig::default()
+    };
+    assert!(
+        (r.resolve(&cam, 1.0).unwrap().zero_parallax_distance - (1.0 + 0.25 * 99.0)).abs() < 1e-4
+    );
 }
 
 #[test]
@@ -98,7 +136,10 @@ fn toe_in_rotates_each_eye_by_atan_half_iod_over_fusion() {
         // The eye's forward axis is −Z of its view; its angle to the camera's −Z axis.
         let forward = e.view.inverse().transform_vector3(Vec3::NEG_Z).normalize();
         let angle = forward.angle_between(Vec3::NEG_Z);
-        assert!((angle - (0.5f32 / 9.0).atan()).abs() < 1e-5, "eye {i}: {angle}");
+        assert!(
+            (angle - (0.5f32 / 9.0).atan()).abs() < 1e-5,
+            "eye {i}: {angle}"
+        );
         assert!((e.eye_world.x - if i == 0 { -0.5 } else { 0.5 }).abs() < 1e-6);
     }
 }
@@ -108,7 +149,10 @@ fn toe_in_has_vertical_parallax_off_center() {
     let cam = seed003_camera();
     let eyes = rig(CameraMode::ToeIn, 1.0, 9.0).eyes(&cam, 1.0).unwrap();
     let vertical_px = |p: Vec3| {
-        let (l, r) = (project_ndc(&eyes[0].mvp, p).unwrap(), project_ndc(&eyes[1].mvp, p).unwrap());
+        let (l, r) = (
+            project_ndc(&eyes[0].mvp, p).unwrap(),
+            project_ndc(&eyes[1].mvp, p).unwrap(),
+        );
         (r.y - l.y) * 0.5 * 1024.0 // in pixels of a 1024-row image
     };
     // On the vertical center line the two rotations are mirror images: no vertical parallax.
@@ -116,7 +160,10 @@ fn toe_in_has_vertical_parallax_off_center() {
     // Off center (seed 003's point): the keystone distortion differs between the eyes.
     let v = vertical_px(Vec3::new(8.0, -5.0, -3.0));
     println!("toe-in vertical parallax of (8,-5,-3), d = 1, z0 = 9, 1024 rows: {v:.3} px");
-    assert!(v.abs() > 0.5, "expected a visible vertical parallax, got {v} px");
+    assert!(
+        v.abs() > 0.5,
+        "expected a visible vertical parallax, got {v} px"
+    );
 }
 
 proptest! {
@@ -153,17 +200,52 @@ fn invalid_field(e: Error) -> String {
 #[test]
 fn bad_rig_parameters_name_their_field() {
     let cam = seed003_camera();
-    assert_eq!(invalid_field(rig(CameraMode::OffAxis, -0.1, 9.0).eyes(&cam, 1.0).unwrap_err()), "stereo.eye_separation");
-    assert_eq!(invalid_field(rig(CameraMode::OffAxis, f32::NAN, 9.0).eyes(&cam, 1.0).unwrap_err()), "stereo.eye_separation");
-    assert_eq!(invalid_field(rig(CameraMode::OffAxis, 1.0, 0.5).eyes(&cam, 1.0).unwrap_err()), "stereo.zero_parallax");
-    assert_eq!(invalid_field(rig(CameraMode::OffAxis, 1.0, 100.0).eyes(&cam, 1.0).unwrap_err()), "stereo.zero_parallax");
+    assert_eq!(
+        invalid_field(
+            rig(CameraMode::OffAxis, -0.1, 9.0)
+                .eyes(&cam, 1.0)
+                .unwrap_err()
+        ),
+        "stereo.eye_separation"
+    );
+    assert_eq!(
+        invalid_field(
+            rig(CameraMode::OffAxis, f32::NAN, 9.0)
+                .eyes(&cam, 1.0)
+                .unwrap_err()
+        ),
+        "stereo.eye_separation"
+    );
+    assert_eq!(
+        invalid_field(
+            rig(CameraMode::OffAxis, 1.0, 0.5)
+                .eyes(&cam, 1.0)
+                .unwrap_err()
+        ),
+        "stereo.zero_parallax"
+    );
+    assert_eq!(
+        invalid_field(
+            rig(CameraMode::OffAxis, 1.0, 100.0)
+                .eyes(&cam, 1.0)
+                .unwrap_err()
+        ),
+        "stereo.zero_parallax"
+    );
     let mut r = rig(CameraMode::OffAxis, 1.0, 9.0);
     r.user_balance = 2.5;
-    assert_eq!(invalid_field(r.eyes(&cam, 1.0).unwrap_err()), "stereo.user_balance");
+    assert_eq!(
+        invalid_field(r.eyes(&cam, 1.0).unwrap_err()),
+        "stereo.user_balance"
+    );
     let bad = |f: fn(&mut Camera)| {
         let mut c = seed003_camera();
         f(&mut c);
-        invalid_field(rig(CameraMode::OffAxis, 1.0, 9.0).eyes(&c, 1.0).unwrap_err())
+        invalid_field(
+            rig(CameraMode::OffAxis, 1.0, 9.0)
+                .eyes(&c, 1.0)
+                .unwrap_err(),
+        )
     };
     assert_eq!(bad(|c| c.near = 0.0), "camera.near");
     assert_eq!(bad(|c| c.far = 0.5), "camera.far");

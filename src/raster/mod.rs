@@ -73,11 +73,18 @@ pub fn rasterize<S: Shader>(
         triangles: triangles.len(),
         ..Default::default()
     };
-    let blank = ClipVertex { pos: glam::Vec4::ZERO, var: [0.0; crate::shade::MAX_VARYINGS] };
+    let blank = ClipVertex {
+        pos: glam::Vec4::ZERO,
+        var: [0.0; crate::shade::MAX_VARYINGS],
+    };
     let mut poly = [blank; MAX_CLIPPED + 3];
     let mut win: [Option<WindowVertex>; MAX_CLIPPED + 3] = [None; MAX_CLIPPED + 3];
     for tri in triangles {
-        let (Some(a), Some(b), Some(c)) = (verts.get(tri[0] as usize), verts.get(tri[1] as usize), verts.get(tri[2] as usize)) else {
+        let (Some(a), Some(b), Some(c)) = (
+            verts.get(tri[0] as usize),
+            verts.get(tri[1] as usize),
+            verts.get(tri[2] as usize),
+        ) else {
             stats.non_finite += 1; // an index past the vertex count: nothing sensible to draw
             continue;
         };
@@ -102,8 +109,17 @@ pub fn rasterize<S: Shader>(
         }
         // The clipped polygon is convex: draw it as a fan around its first vertex.
         for k in 1..n.saturating_sub(1) {
-            let (Some(a), Some(b), Some(c)) = (win[0], win[k], win[k + 1]) else { continue };
-            let r = rasterize_window_triangle([a, b, c], [&poly[0].var, &poly[k].var, &poly[k + 1].var], nvar, shader, fb, opts);
+            let (Some(a), Some(b), Some(c)) = (win[0], win[k], win[k + 1]) else {
+                continue;
+            };
+            let r = rasterize_window_triangle(
+                [a, b, c],
+                [&poly[0].var, &poly[k].var, &poly[k + 1].var],
+                nvar,
+                shader,
+                fb,
+                opts,
+            );
             stats.culled += r.culled;
             stats.fragments += r.fragments;
         }
