@@ -240,10 +240,8 @@ pub fn traverse<S: Shader>(
     let step = [t.dcdx[0] * s, t.dcdx[1] * s, t.dcdx[2] * s];
     for py in py0..=py1 {
         let sy = py * s;
-        let mut e = [0i64; 3];
-        for i in 0..3 {
-            e[i] = t.c[i] + t.dcdy[i] * sy - t.dcdx[i] * t.px0 * s;
-        }
+        let mut e: [i64; 3] =
+            std::array::from_fn(|i| t.c[i] + t.dcdy[i] * sy - t.dcdx[i] * t.px0 * s);
         let fy = py as f32 + 0.5 - t.y0;
         let row = (py - band.y0 as i64) as usize * band.width as usize;
         for px in t.px0..=t.px1 {
