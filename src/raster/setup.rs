@@ -260,9 +260,9 @@ pub fn traverse<S: Shader>(
             }
             if writes_color {
                 let inv_w = t.inv_w.at(fx, fy);
-                for k in 0..t.nvar {
-                    let a = t.var[k].at(fx, fy);
-                    frag_var[k] = if opts.perspective_correct {
+                for (out, plane) in frag_var.iter_mut().zip(&t.var[..t.nvar]) {
+                    let a = plane.at(fx, fy);
+                    *out = if opts.perspective_correct {
                         a / inv_w
                     } else {
                         a
@@ -275,9 +275,10 @@ pub fn traverse<S: Shader>(
                     varyings: &frag_var,
                     front_facing: t.front_facing,
                 };
+                // A discarded fragment writes neither color nor depth.
                 let Some(col) = shader.fragment(&f) else {
                     continue;
-                }; // discard: no writes
+                };
                 band.color[idx] = col;
             }
             if opts.depth_test {
