@@ -9,6 +9,7 @@ pub mod bench;
 pub mod compare;
 pub mod effects;
 pub mod error;
+pub mod figures;
 pub mod framebuffer;
 pub mod info;
 pub mod math;
