@@ -183,6 +183,10 @@ fn bad_scene_values_name_the_field_and_value() {
             &["image.width = 100000", "at most 16384"],
         ),
         (&["--size", "12by7"], &["--size = 12by7"]),
+        (
+            &["--size", "16000x16000"],
+            &["image size = 16000x16000", "pixels"],
+        ),
         (&["--set", "camera.near=0"], &["camera.near = 0"]),
         (&["--set", "camera.far=0.5"], &["camera.far = 0.5"]),
         (

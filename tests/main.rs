@@ -7,3 +7,4 @@ mod determinism;
 mod golden;
 mod layout;
 mod rig;
+mod stability;

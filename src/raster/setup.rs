@@ -29,11 +29,19 @@ impl WindowVertex {
             return None;
         }
         let (hw, hh) = (width as f32 * 0.5, height as f32 * 0.5);
+        let inv_w = 1.0 / p.w;
+        if !inv_w.is_finite() {
+            return None; // w so small its reciprocal overflows: nothing sensible to draw
+        }
+        // After clipping |x|, |y|, |z| ≤ w holds mathematically; with extreme magnitudes the
+        // intersection rounding can leave a vertex far outside. Clamping NDC to [−1, 1] changes
+        // no sample point inside the viewport and keeps the fixed-point math from overflowing.
+        let ndc = |c: f32| (c / p.w).clamp(-1.0, 1.0);
         Some(WindowVertex {
-            x: (p.x / p.w) * hw + hw,
-            y: (p.y / p.w) * -hh + hh,
-            z: (p.z / p.w) * 0.5 + 0.5,
-            inv_w: 1.0 / p.w,
+            x: ndc(p.x) * hw + hw,
+            y: ndc(p.y) * -hh + hh,
+            z: ndc(p.z) * 0.5 + 0.5,
+            inv_w,
         })
     }
 }
@@ -172,6 +180,10 @@ pub fn setup_triangle(
     };
     let z = plane([v[0].z, v[1].z, v[2].z]);
     let inv_w = plane([v[0].inv_w, v[1].inv_w, v[2].inv_w]);
+    let finite = |p: &Plane| p.a0.is_finite() && p.dadx.is_finite() && p.dady.is_finite();
+    if !finite(&z) || !finite(&inv_w) {
+        return Setup::Empty; // a sliver so thin its gradients overflow f32
+    }
     let mut var_planes = [z; MAX_VARYINGS];
     for (k, p) in var_planes.iter_mut().enumerate().take(nvar) {
         *p = if opts.perspective_correct {
