@@ -221,7 +221,10 @@ pub fn triangulate(path: &Path, points: &[TerrainPoint]) -> Result<Terrain> {
             )
         },
     );
-    let extent = [(hi[0] - lo[0]).max(f64::MIN_POSITIVE), (hi[1] - lo[1]).max(f64::MIN_POSITIVE)];
+    let extent = [
+        (hi[0] - lo[0]).max(f64::MIN_POSITIVE),
+        (hi[1] - lo[1]).max(f64::MIN_POSITIVE),
+    ];
     let mut mesh = Mesh {
         positions: sums
             .iter()

@@ -33,7 +33,7 @@ far = 20.0
 [[mesh]]
 kind = "plane"
 size = 4.0
-detail = 1
+detail = 3
 translate = [0.0, 0.0, -4.0]
 rotate = [-70.0, 0.0, 0.0]
 "#;
@@ -66,7 +66,12 @@ fn row(knob: &str, setting: &str, error: Option<f64>, unit: &str, ms: f64, note:
 /// Hue error (degrees, `240° · |Δs|` after clamping) of each texgen mode against `s` from an
 /// exact f64 ray–plane intersection at every pixel center, and the pass time.
 fn texgen_modes(iters: usize) -> Result<Vec<Row>> {
-    let base = Scene::from_toml(SLANTED_PLANE, Path::new("<slanted plane>"), Path::new("."), &[])?;
+    let base = Scene::from_toml(
+        SLANTED_PLANE,
+        Path::new("<slanted plane>"),
+        Path::new("."),
+        &[],
+    )?;
     let center = StereoRig::center(&base.camera, base.aspect())?;
     let settings = ChromaDepthSettings::default();
     let texgen = resolve_texgen(&base, &center, &settings)?;
@@ -211,7 +216,10 @@ fn pass_vs_pair(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             None,
             "",
             one_ms,
-            format!("{size}; time ratio chromadepth/pair = {:.3}", one_ms / pair_ms),
+            format!(
+                "{size}; time ratio chromadepth/pair = {:.3}",
+                one_ms / pair_ms
+            ),
         ),
     ])
 }
@@ -251,7 +259,10 @@ fn glasses_and_terrain(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             None,
             "",
             tri_ms,
-            format!("island.csv: {} points -> {triangles} triangles", points.len()),
+            format!(
+                "island.csv: {} points -> {triangles} triangles",
+                points.len()
+            ),
         ),
     ])
 }

@@ -109,15 +109,17 @@ impl ChromaDepthSettings {
 ///
 /// # Errors
 /// The frame has no ChromaDepth pass (a plan bug), or `output` is not a ChromaDepth output.
-pub fn produce(output: Output, frame: &Frame, settings: &ChromaDepthSettings) -> Result<Framebuffer> {
+pub fn produce(
+    output: Output,
+    frame: &Frame,
+    settings: &ChromaDepthSettings,
+) -> Result<Framebuffer> {
     let fb = frame
         .passes
         .iter()
         .find(|p| Output::ChromaDepth.needs().contains(&p.pass))
         .map(|p| &p.framebuffer)
-        .ok_or_else(|| {
-            Error::invalid("plan", output.name(), "the ChromaDepth pass was not run")
-        })?;
+        .ok_or_else(|| Error::invalid("plan", output.name(), "the ChromaDepth pass was not run"))?;
     let shift = settings.max_shift_px(fb.width);
     let view = |eye| glasses::glasses_view(fb, eye, shift);
     Ok(match output {

@@ -82,7 +82,7 @@ impl Ramp {
     /// nearer than D1 stay red and objects beyond D2 stay blue: a repeat wrap would paint far
     /// objects red again.
     pub fn sample(&self, s: f32, sampling: Sampling) -> Vec3 {
-        let s = s.max(0.0).min(1.0);
+        let s = clamp_unit(s);
         let n = self.texels.len();
         let last = n - 1;
         match sampling {
@@ -101,7 +101,7 @@ impl Ramp {
 /// The exact (continuous) ramp color at `t`, clamped to [0, 1]: what an infinitely fine texture
 /// would hold, and the reference the benchmark measures sampling errors against.
 pub fn exact(kind: RampKind, t: f32) -> Vec3 {
-    let t = t.max(0.0).min(1.0);
+    let t = clamp_unit(t);
     match kind {
         RampKind::Hsv => hsv_to_rgb(FAR_HUE_DEGREES * t, 1.0, 1.0),
         RampKind::RedWhiteBlue if t <= 0.5 => Vec3::new(1.0, 2.0 * t, 2.0 * t),
@@ -110,6 +110,11 @@ pub fn exact(kind: RampKind, t: f32) -> Vec3 {
             Vec3::new(f, f, 1.0)
         }
     }
+}
+
+/// Clamps to [0, 1], NaN to 0 (red): `f32::clamp` would pass the NaN on into the texel index.
+fn clamp_unit(s: f32) -> f32 {
+    if s.is_nan() { 0.0 } else { s.clamp(0.0, 1.0) }
 }
 
 /// HSV → RGB (all in 0..1, hue in degrees, wrapped into [0°, 360°)): the standard hexcone

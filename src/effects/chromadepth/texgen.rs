@@ -93,7 +93,10 @@ pub fn bounding_sphere(points: &[Vec3]) -> Option<(Vec3, f32)> {
         return None;
     }
     let center = (lo + hi) * 0.5;
-    let radius = points.iter().map(|p| p.distance(center)).fold(0.0, f32::max);
+    let radius = points
+        .iter()
+        .map(|p| p.distance(center))
+        .fold(0.0, f32::max);
     Some((center, radius))
 }
 
@@ -106,12 +109,7 @@ pub fn bounding_sphere(points: &[Vec3]) -> Option<(Vec3, f32)> {
 /// # Errors
 /// `Invalid` when the scene has no finite points, or when the sphere lies entirely outside
 /// `near .. far` (nothing of it is visible, so no range can be chosen).
-pub fn auto_range(
-    points: &[Vec3],
-    view: Mat4,
-    near: f32,
-    far: f32,
-) -> Result<(f32, f32)> {
+pub fn auto_range(points: &[Vec3], view: Mat4, near: f32, far: f32) -> Result<(f32, f32)> {
     let (center, radius) = bounding_sphere(points).ok_or_else(|| {
         Error::invalid(
             "chromadepth.d1",
