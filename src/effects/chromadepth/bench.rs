@@ -5,7 +5,7 @@ use std::path::Path;
 
 use glam::{DMat4, DVec3};
 
-use super::glasses::{Eye, glasses_view};
+use super::glasses::glasses_pair;
 use super::ramp::{self, FAR_HUE_DEGREES, Ramp, RampKind, Sampling};
 use super::shader::{render_center_with, resolve_texgen, texgen_map};
 use super::{ChromaDepthSettings, TexgenMode};
@@ -197,6 +197,10 @@ fn pass_vs_pair(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         Ok(())
     });
     let one_ms = run(&mut || render_view(scene, &center, Shading::ChromaDepth).map(|_| ()));
+    let mut lit = scene.clone();
+    lit.chromadepth.lit = true;
+    let lit_ms = run(&mut || render_view(&lit, &center, Shading::ChromaDepth).map(|_| ()));
+    let phong_ms = run(&mut || render_view(scene, &center, Shading::Color).map(|_| ()));
     if let Some(e) = err {
         return Err(e);
     }
@@ -221,6 +225,25 @@ fn pass_vs_pair(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
                 one_ms / pair_ms
             ),
         ),
+        row(
+            "one pass",
+            "lit chromadepth (1 pass)",
+            None,
+            "",
+            lit_ms,
+            format!("{size}; time ratio lit/pair = {:.3}", lit_ms / pair_ms),
+        ),
+        row(
+            "one pass",
+            "blinn-phong (1 center pass)",
+            None,
+            "",
+            phong_ms,
+            format!(
+                "{size}; pass count alone: ratio {:.3}; the rest is the cheaper shader",
+                phong_ms / pair_ms
+            ),
+        ),
     ])
 }
 
@@ -229,12 +252,7 @@ fn glasses_and_terrain(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let center = StereoRig::center(&scene.camera, scene.aspect())?;
     let (fb, _) = render_view(scene, &center, Shading::ChromaDepth)?;
     let shift = scene.chromadepth.max_shift_px(fb.width);
-    let glasses_ms = median_ms(iters, || {
-        (
-            glasses_view(&fb, Eye::Left, shift),
-            glasses_view(&fb, Eye::Right, shift),
-        )
-    });
+    let glasses_ms = median_ms(iters, || glasses_pair(&fb, shift));
     let csv = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/terrain/island.csv");
     let text = std::fs::read_to_string(&csv).map_err(|e| Error::io(&csv, e))?;
     let points = terrain::parse_csv(&csv, &text)?;

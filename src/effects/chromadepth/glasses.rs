@@ -69,11 +69,21 @@ pub fn shift_map(fb: &Framebuffer, max_shift_px: f32) -> Vec<f32> {
 /// would; spots nothing lands on (disocclusions) take the neighbor shifted less (farther), the
 /// usual fill for uncovered background. The depth buffer travels with the colors.
 pub fn glasses_view(fb: &Framebuffer, eye: Eye, max_shift_px: f32) -> Framebuffer {
+    warp(fb, eye, &shift_map(fb, max_shift_px))
+}
+
+/// Both eyes' views through the glasses (left, right), the shift map computed once.
+pub fn glasses_pair(fb: &Framebuffer, max_shift_px: f32) -> [Framebuffer; 2] {
+    let shifts = shift_map(fb, max_shift_px);
+    [warp(fb, Eye::Left, &shifts), warp(fb, Eye::Right, &shifts)]
+}
+
+/// Moves every pixel of `fb` by its entry in `shifts`, inward for `eye` (see [`glasses_view`]).
+fn warp(fb: &Framebuffer, eye: Eye, shifts: &[f32]) -> Framebuffer {
     let direction = match eye {
         Eye::Left => 1.0,
         Eye::Right => -1.0,
     };
-    let shifts = shift_map(fb, max_shift_px);
     let w = fb.width as usize;
     let mut out = fb.clone();
     // Per destination: the source index and its shift.

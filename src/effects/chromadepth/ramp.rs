@@ -88,11 +88,12 @@ impl Ramp {
         match sampling {
             Sampling::Nearest => self.texels[((s * n as f32) as usize).min(last)],
             Sampling::Linear => {
-                let u = s * n as f32 - 0.5;
-                let i0 = u.floor();
-                let t = u - i0;
-                let at = |i: f32| self.texels[(i.max(0.0) as usize).min(last)];
-                at(i0).lerp(at(i0 + 1.0), t)
+                // u + 1 = s N + ½ ≥ ½, so truncation is its floor (no libm `floor` call).
+                let u1 = s * n as f32 + 0.5;
+                let i1 = u1 as usize;
+                let t = u1 - i1 as f32;
+                let at = |i: usize| self.texels[i.min(last)];
+                at(i1.saturating_sub(1)).lerp(at(i1), t)
             }
         }
     }
