@@ -24,6 +24,9 @@ pub struct SceneFile {
     /// Rasterizer options.
     #[serde(default)]
     pub raster: RasterSpec,
+    /// Finalize-pass options (anaglyphs).
+    #[serde(default)]
+    pub finalize: FinalizeSpec,
     /// Objects, in `[[mesh]]` tables.
     #[serde(default, rename = "mesh")]
     pub meshes: Vec<MeshSpec>,
@@ -157,6 +160,18 @@ pub struct RasterSpec {
     /// Back-face culling.
     #[serde(default)]
     pub cull_back: bool,
+}
+
+/// `[finalize]`.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct FinalizeSpec {
+    /// Apply anaglyph matrices to linear-light values (decode sRGB, mix, encode).
+    #[serde(default)]
+    pub linear_light: bool,
+    /// Swap the eyes in anaglyphs (glasses worn the other way round).
+    #[serde(default)]
+    pub swap_eyes: bool,
 }
 
 /// One `[[mesh]]`.

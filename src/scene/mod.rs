@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{EulerRot, Mat4, Quat, Vec3};
 
+use crate::effects::anaglyph::AnaglyphOptions;
 use crate::error::{Error, Result};
 use crate::framebuffer::check_size;
 use crate::math::{Camera, Separation, StereoRig, ZeroParallax};
@@ -55,6 +56,8 @@ pub struct Scene {
     pub blank_interval: u32,
     /// Rasterizer options.
     pub raster: RasterOptions,
+    /// Finalize-pass options from `[finalize]` (anaglyph linear light, swapped eyes).
+    pub finalize: AnaglyphOptions,
 }
 
 impl Scene {
@@ -177,6 +180,10 @@ impl Scene {
             raster: RasterOptions {
                 cull_back: f.raster.cull_back,
                 ..RasterOptions::default()
+            },
+            finalize: AnaglyphOptions {
+                linear_light: f.finalize.linear_light,
+                swap_eyes: f.finalize.swap_eyes,
             },
         })
     }
