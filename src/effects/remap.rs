@@ -85,7 +85,7 @@ impl Remapper {
     ) -> Result<Remapper> {
         let this64 = this_mvp.as_dmat4();
         let det = this64.determinant();
-        if !(det.is_finite() && det != 0.0) || !other_mvp.is_finite() {
+        if !(det.is_finite() && det != 0.0 && other_mvp.is_finite()) {
             return Err(Error::invalid(
                 "eye matrices",
                 format!("det(MVP) = {det}"),
