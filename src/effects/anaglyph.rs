@@ -274,20 +274,23 @@ pub fn anaglyph(
         (left, right)
     };
     let m = kind.matrices();
-    let mut bytes = Vec::with_capacity(left.color.len() * 4);
+    let mut bytes = vec![0u8; left.color.len() * 4];
+    let pixels = bytes
+        .chunks_exact_mut(4)
+        .zip(left.color.iter().zip(&right.color));
     if options.linear_light {
         // A GPU decodes an sRGB texture in the sampler; a 256-entry table is the same thing.
         let decode: Vec<f32> = (0..=255u8)
             .map(|v| srgb_to_linear(v as f32 / 255.0))
             .collect();
-        let lin = |p: [u8; 4]| [p[0], p[1], p[2]].map(|v| decode[v as usize]);
-        for (l, r) in left.color.iter().zip(&right.color) {
-            let out = mix(&m, lin(*l), lin(*r)).map(|c| to_u8(linear_to_srgb(c)));
-            bytes.extend_from_slice(&[out[0], out[1], out[2], 255]);
+        let lin = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| decode[v as usize]);
+        for (out, (l, r)) in pixels {
+            let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
+            out.copy_from_slice(&[c[0], c[1], c[2], 255]);
         }
     } else {
-        for (l, r) in left.color.iter().zip(&right.color) {
-            bytes.extend_from_slice(&anaglyph_pixel(&m, *l, *r, false));
+        for (out, (l, r)) in pixels {
+            out.copy_from_slice(&anaglyph_pixel(&m, *l, *r, false));
         }
     }
     Ok(RgbaImage::from_raw(left.width, left.height, bytes).expect("4 bytes per pixel"))

@@ -171,8 +171,9 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
     Ok(rows)
 }
 
-/// Remap coordinates in f32 (seed 004's shader) and f64: time, and the largest texture-
-/// coordinate difference over drawn pixels (and over all pixels, including the far plane).
+/// Remap coordinates in f32 (seed 004's shader), f32 with the composed matrix, and f64: time,
+/// and the largest texture-coordinate difference to f64 over drawn pixels (and over all pixels,
+/// including the far plane).
 fn remap_precision_rows(
     left: &Framebuffer,
     mvp: &[Mat4; 2],
@@ -180,39 +181,40 @@ fn remap_precision_rows(
     iters: usize,
 ) -> Result<Vec<Row>> {
     let exact = remap_coordinates(left, &mvp[0], &mvp[1], Precision::F64)?;
-    let fast = remap_coordinates(left, &mvp[0], &mvp[1], Precision::F32)?;
-    let (mut drawn, mut all) = (0.0f64, 0.0f64);
-    for ((a, b), d) in exact.iter().zip(&fast).zip(&left.depth) {
-        let e = match (a, b) {
-            (Some(a), Some(b)) => (a.tex[0] - b.tex[0]).abs().max((a.tex[1] - b.tex[1]).abs()),
-            (None, None) => 0.0,
-            _ => f64::INFINITY,
-        };
-        all = all.max(e);
-        if *d < 1.0 {
-            drawn = drawn.max(e);
-        }
-    }
     let mut rows = Vec::new();
-    for (p, name, err) in [
-        (Precision::F64, "f64", 0.0),
-        (Precision::F32, "f32 (seed 004 shader)", drawn),
+    for (p, name) in [
+        (Precision::F64, "f64"),
+        (Precision::F32Composed, "f32 composed"),
+        (Precision::F32, "f32 seed 004"),
     ] {
+        let coords = remap_coordinates(left, &mvp[0], &mvp[1], p)?;
+        let (mut drawn, mut all) = (0.0f64, 0.0f64);
+        for ((a, b), d) in exact.iter().zip(&coords).zip(&left.depth) {
+            let e = match (a, b) {
+                (Some(a), Some(b)) => (a.tex[0] - b.tex[0]).abs().max((a.tex[1] - b.tex[1]).abs()),
+                (None, None) => 0.0,
+                _ => f64::INFINITY,
+            };
+            all = all.max(e);
+            if *d < 1.0 {
+                drawn = drawn.max(e);
+            }
+        }
         let ms = median_ms(iters, || {
             remap_coordinates(left, &mvp[0], &mvp[1], p).is_ok()
         });
         let mut r = row(
             "remap unproject",
             format!("{name}, {label}"),
-            Some(err),
+            Some(drawn),
             "max |tex| error",
             ms,
         );
         r.note = format!(
             "= {:.4} px at width {}; all pixels incl. far plane {:.2e}",
-            err * left.width as f64,
+            drawn * left.width as f64,
             left.width,
-            if p == Precision::F64 { 0.0 } else { all }
+            all
         );
         rows.push(r);
     }
