@@ -6,7 +6,9 @@ use glam::Mat4;
 use super::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
 use super::occlusion::occlusion_image;
 use super::parallax::{ParallaxRig, parallax_image};
-use super::remap::{Precision, remap_color, remap_coordinates};
+use super::remap::{
+    Precision, Remapper, Visibility, remap_color, remap_coordinates, visibility_map,
+};
 use crate::bench::{Row, median_ms};
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
@@ -92,11 +94,17 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             copy_color_depth,
         ));
     }
-    rows.push(with_throughput(
-        row("mode", "occlusion", None, "", occlusion_ms),
-        px * 8,
-        copy_color_depth,
-    ));
+    let map = visibility_map(left, right, &mvp[0], &mvp[1], Precision::F64)?;
+    let n = |v: Visibility| map.iter().filter(|m| **m == v).count();
+    let mut occlusion = row("mode", "occlusion", None, "", occlusion_ms);
+    occlusion.note = format!(
+        "left eye: {} visible, {} occluded, {} out of view, {} farther (silhouette sampling)",
+        n(Visibility::Visible),
+        n(Visibility::Occluded),
+        n(Visibility::OutOfView),
+        n(Visibility::Farther)
+    );
+    rows.push(with_throughput(occlusion, px * 8, copy_color_depth));
     rows.push(with_throughput(
         row("mode", "parallax + legend", None, "", parallax_ms),
         px * 4,
@@ -200,8 +208,18 @@ fn remap_precision_rows(
                 drawn = drawn.max(e);
             }
         }
+        // Time the per-pixel program alone (no coordinate buffer to allocate).
+        let remapper = Remapper::new(&mvp[0], &mvp[1], left.width, left.height, p)?;
         let ms = median_ms(iters, || {
-            remap_coordinates(left, &mvp[0], &mvp[1], p).is_ok()
+            let mut sum = 0.0;
+            for y in 0..left.height {
+                for x in 0..left.width {
+                    if let Some(m) = remapper.remap(x, y, left.depth[left.index(x, y)]) {
+                        sum += m.tex[0] + m.tex[1] + m.depth;
+                    }
+                }
+            }
+            sum
         });
         let mut r = row(
             "remap unproject",
