@@ -31,6 +31,10 @@ pub enum Output {
     InterlacedColumns,
     /// Left where x + y is even, right elsewhere (DLP checkerboard).
     Checkerboard,
+    /// Single-image random-dot stereogram of the cyclopean view (seed 002).
+    Sirds,
+    /// The depth map the SIRDS encodes (16-bit, white = near).
+    SirdsDepth,
 }
 
 /// Which camera a pass renders from.
@@ -76,6 +80,8 @@ impl Output {
         Output::InterlacedRows,
         Output::InterlacedColumns,
         Output::Checkerboard,
+        Output::Sirds,
+        Output::SirdsDepth,
     ];
 
     /// The name used in scene files and for the PNG written.
@@ -92,6 +98,8 @@ impl Output {
             Output::InterlacedRows => "interlaced_rows",
             Output::InterlacedColumns => "interlaced_columns",
             Output::Checkerboard => "checkerboard",
+            Output::Sirds => "sirds",
+            Output::SirdsDepth => "sirds_depth",
         }
     }
 
@@ -129,6 +137,8 @@ impl Output {
             Output::Right => vec![color(View::Right)],
             Output::LeftDepth => vec![depth(View::Left)],
             Output::RightDepth => vec![depth(View::Right)],
+            // One depth pass of the cyclopean view; no color shading at all (seed 002).
+            Output::Sirds | Output::SirdsDepth => vec![depth(View::Center)],
             _ => vec![color(View::Left), color(View::Right)],
         }
     }

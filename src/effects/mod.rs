@@ -2,3 +2,4 @@
 //! ChromaDepth and SIRDS as they land.
 
 pub mod layout;
+pub mod sirds;

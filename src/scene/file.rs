@@ -24,6 +24,9 @@ pub struct SceneFile {
     /// Rasterizer options.
     #[serde(default)]
     pub raster: RasterSpec,
+    /// Autostereogram options.
+    #[serde(default)]
+    pub sirds: crate::effects::sirds::SirdsSpec,
     /// Objects, in `[[mesh]]` tables.
     #[serde(default, rename = "mesh")]
     pub meshes: Vec<MeshSpec>,

@@ -55,6 +55,8 @@ pub struct Scene {
     pub blank_interval: u32,
     /// Rasterizer options.
     pub raster: RasterOptions,
+    /// Autostereogram options (`[sirds]`).
+    pub sirds: crate::effects::sirds::Settings,
 }
 
 impl Scene {
@@ -178,6 +180,7 @@ impl Scene {
                 cull_back: f.raster.cull_back,
                 ..RasterOptions::default()
             },
+            sirds: crate::effects::sirds::Settings::from_spec(&f.sirds, base_dir)?,
         })
     }
 

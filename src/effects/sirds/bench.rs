@@ -1,0 +1,1 @@
+//! SIRDS benchmark rows (placeholder replaced below).

@@ -1,0 +1,250 @@
+//! Reads a finished autostereogram back: per pixel, the separation whose two windows match
+//! best along the row, then depth from the separation. This is how stereolab checks that a
+//! SIRDS encodes the intended scene without anyone staring at it.
+
+use rayon::prelude::*;
+
+use super::disparity::Disparity;
+use crate::error::{Error, Result};
+
+/// Decoder settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DecodeOptions {
+    /// Smallest separation tried, pixels (≥ 1).
+    pub min_separation: u32,
+    /// Largest separation tried, pixels.
+    pub max_separation: u32,
+    /// Window half-width: the window is `2 hw + 1` pixels wide.
+    pub half_width: u32,
+    /// Window half-height: `2 hh + 1` rows (clipped at the image border).
+    pub half_height: u32,
+    /// A pixel counts as matched when its best window cost is at most this fraction of its mean
+    /// cost over all separations tried. In a SIRDS the right separation matches (nearest
+    /// filtering: exactly, cost 0); in noise the best of a few dozen tries of an 11×5 window
+    /// stays near 0.7 of the mean (see the noise test), so 0.35 separates the two.
+    pub max_cost_ratio: f32,
+}
+
+impl DecodeOptions {
+    /// Options covering the separations `d` can produce, with 2 px of margin on either side.
+    pub fn for_disparity(d: &Disparity) -> DecodeOptions {
+        DecodeOptions {
+            min_separation: (d.min_separation().floor() as u32).saturating_sub(2).max(1),
+            max_separation: d.max_separation().ceil() as u32 + 2,
+            half_width: 5,
+            half_height: 2,
+            max_cost_ratio: 0.35,
+        }
+    }
+}
+
+/// The decoder's answer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Decoded {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Separation per pixel (sub-pixel by a parabola through the best three costs); `NaN` where
+    /// nothing matched or no window fits.
+    pub separation: Vec<f32>,
+    /// Share of all pixels that matched.
+    pub matched_share: f64,
+}
+
+/// An image is an autostereogram when at least this share of its pixels matched: a SIRDS
+/// matches almost everywhere (all but its edges and occlusion borders), noise almost nowhere.
+pub const AUTOSTEREOGRAM_SHARE: f64 = 0.5;
+
+impl Decoded {
+    /// Whether the image repeats consistently enough to be an autostereogram at all.
+    pub fn is_autostereogram(&self) -> bool {
+        self.matched_share >= AUTOSTEREOGRAM_SHARE
+    }
+}
+
+/// Rows per band: bands run in parallel, each with `half_height` rows of halo.
+const BAND_ROWS: usize = 16;
+
+/// Decodes `pixels` (row-major RGBA, `width × height`). Cost of separation `s` at pixel x: the
+/// mean over the window of `Σ_rgb |I(x − ⌊s/2⌋) − I(x − ⌊s/2⌋ + s)|`.
+///
+/// # Errors
+/// `Invalid` for a size that does not match, or an empty or inverted separation range.
+pub fn decode(pixels: &[[u8; 4]], width: u32, height: u32, opts: &DecodeOptions) -> Result<Decoded> {
+    let (w, h) = (width as usize, height as usize);
+    if w == 0 || h == 0 || pixels.len() != w * h {
+        return Err(Error::invalid(
+            "decode image",
+            format!("{} pixels", pixels.len()),
+            format!("must be a non-empty {width}×{height} image"),
+        ));
+    }
+    let (lo, hi) = (opts.min_separation.max(1), opts.max_separation);
+    if lo > hi || hi as usize >= w {
+        return Err(Error::invalid(
+            "decode separations",
+            format!("{lo}..={hi}"),
+            format!("must be a non-empty range narrower than the image ({w} px)"),
+        ));
+    }
+    let mut separation = vec![f32::NAN; w * h];
+    separation
+        .par_chunks_mut(w * BAND_ROWS)
+        .enumerate()
+        .for_each(|(band, out)| {
+            decode_band(pixels, w, h, band * BAND_ROWS, out, lo, hi, opts);
+        });
+    let matched = separation.iter().filter(|s| s.is_finite()).count();
+    Ok(Decoded {
+        width,
+        height,
+        separation,
+        matched_share: matched as f64 / (w * h) as f64,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn decode_band(
+    pixels: &[[u8; 4]],
+    w: usize,
+    h: usize,
+    y0: usize,
+    out: &mut [f32],
+    lo: u32,
+    hi: u32,
+    opts: &DecodeOptions,
+) {
+    let rows = out.len() / w;
+    let hh = opts.half_height as usize;
+    let hw = opts.half_width as usize;
+    let (r0, r1) = (y0.saturating_sub(hh), (y0 + rows + hh).min(h));
+    let n = rows * w;
+    let mut best = vec![f32::INFINITY; n];
+    let mut best_s = vec![0u32; n];
+    let mut before = vec![f32::NAN; n];
+    let mut after = vec![f32::NAN; n];
+    let mut sum = vec![0f32; n];
+    let mut count = vec![0u32; n];
+    let mut prev = vec![f32::NAN; n];
+    let mut cost = vec![f32::NAN; n];
+    let mut row_sums = vec![0u32; (r1 - r0) * w];
+    let mut prefix = vec![0u32; w + 1];
+    for s in lo..=hi {
+        let (half, s) = ((s / 2) as usize, s as usize);
+        // Windows that fit: x − half − hw ≥ 0 and x − half + s + hw < w.
+        let (x_first, x_last) = (half + hw, (w + half).checked_sub(s + hw + 1));
+        let Some(x_last) = x_last.filter(|&l| l >= x_first) else {
+            cost.fill(f32::NAN);
+            std::mem::swap(&mut prev, &mut cost);
+            continue;
+        };
+        for (r, rs) in (r0..r1).zip(row_sums.chunks_exact_mut(w)) {
+            let row = &pixels[r * w..(r + 1) * w];
+            for x in 0..w {
+                let diff = match (x.checked_sub(half), x.checked_sub(half).map(|l| l + s)) {
+                    (Some(l), Some(rr)) if rr < w => {
+                        let (a, b) = (row[l], row[rr]);
+                        (0..3).map(|c| a[c].abs_diff(b[c]) as u32).sum()
+                    }
+                    _ => 0,
+                };
+                prefix[x + 1] = prefix[x] + diff;
+            }
+            for x in x_first..=x_last {
+                rs[x] = prefix[x + hw + 1] - prefix[x - hw];
+            }
+        }
+        cost.fill(f32::NAN);
+        for y in 0..rows {
+            let (ya, yb) = ((y0 + y).saturating_sub(hh), (y0 + y + hh + 1).min(h));
+            let area = ((yb - ya) * (2 * hw + 1) * 3) as f32;
+            for x in x_first..=x_last {
+                let total: u32 = (ya..yb).map(|r| row_sums[(r - r0) * w + x]).sum();
+                let i = y * w + x;
+                let c = total as f32 / area;
+                cost[i] = c;
+                sum[i] += c;
+                count[i] += 1;
+                if best_s[i] + 1 == s as u32 {
+                    after[i] = c;
+                }
+                if c < best[i] {
+                    best[i] = c;
+                    best_s[i] = s as u32;
+                    before[i] = prev[i];
+                    after[i] = f32::NAN;
+                }
+            }
+        }
+        std::mem::swap(&mut prev, &mut cost);
+    }
+    for i in 0..n {
+        if count[i] < 2 {
+            continue;
+        }
+        let mean = sum[i] / count[i] as f32;
+        if !(mean > 0.0 && best[i] <= opts.max_cost_ratio * mean) {
+            continue;
+        }
+        let (cm, c0, cp) = (before[i], best[i], after[i]);
+        let denom = cm - 2.0 * c0 + cp;
+        let offset = if c0 > 0.0 && denom > 0.0 {
+            (0.5 * (cm - cp) / denom).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        };
+        out[i] = best_s[i] as f32 + offset;
+    }
+}
+
+/// How well decoded separations agree with the intended ones.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoundTrip {
+    /// Pixels compared (those where a window of the intended separation fits the image).
+    pub compared: usize,
+    /// Share of compared pixels decoded within ±1 px of the intended separation.
+    pub within_one: f64,
+    /// Root-mean-square error over compared pixels that matched, pixels.
+    pub rms: f64,
+    /// Share of compared pixels that matched at all.
+    pub matched: f64,
+}
+
+/// Compares `decoded` with the intended separation per pixel (`intended[i]`, pixels).
+pub fn round_trip(decoded: &Decoded, intended: &[f32], opts: &DecodeOptions) -> RoundTrip {
+    let w = decoded.width as usize;
+    let (mut compared, mut within, mut matched, mut sq) = (0usize, 0usize, 0usize, 0f64);
+    for (i, (&got, &want)) in decoded.separation.iter().zip(intended).enumerate() {
+        let x = i % w;
+        let half = (want / 2.0).ceil() as usize + opts.half_width as usize;
+        if x < half || x + half >= w {
+            continue;
+        }
+        compared += 1;
+        if got.is_finite() {
+            matched += 1;
+            let e = (got - want) as f64;
+            sq += e * e;
+            if e.abs() <= 1.0 {
+                within += 1;
+            }
+        }
+    }
+    let share = |k: usize| k as f64 / compared.max(1) as f64;
+    RoundTrip {
+        compared,
+        within_one: share(within),
+        rms: (sq / matched.max(1) as f64).sqrt(),
+        matched: share(matched),
+    }
+}
+
+/// Nearness per pixel from decoded separations (`NaN` stays `NaN`).
+pub fn depth_from_separation(decoded: &Decoded, d: &Disparity) -> Vec<f32> {
+    decoded
+        .separation
+        .iter()
+        .map(|&s| d.nearness_of_separation(s))
+        .collect()
+}
