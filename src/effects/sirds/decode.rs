@@ -66,8 +66,13 @@ impl Decoded {
 /// Rows per band: bands run in parallel, each with `half_height` rows of halo.
 const BAND_ROWS: usize = 16;
 
-/// Decodes `pixels` (row-major RGBA, `width × height`). Cost of separation `s` at pixel x: the
-/// mean over the window of `Σ_rgb |I(x − ⌊s/2⌋) − I(x − ⌊s/2⌋ + s)|`.
+/// Decodes `pixels` (row-major RGBA, `width × height`). Separations are tried in steps of
+/// `1/SUBSTEPS` pixel; the cost of separation `s = n + k/q` for the pair ending at right pixel
+/// `r` is the smaller of `Σ_rgb |I(r) − lerp(I(r − n), I(r − n − 1), k/q)|` (a right-going
+/// copy) and `Σ_rgb |I(l) − lerp(I(l + n), I(l + n + 1), k/q)|`, `l = r − ⌈s⌉` (a left-going
+/// copy) — zero for the strip algorithm's bilinear copies at their true fractional separation,
+/// and for nearest or TIW copies at whole pixels — averaged over a window centered on the
+/// pair's middle `x = r − s/2`.
 ///
 /// # Errors
 /// `Invalid` for a size that does not match, or an empty or inverted separation range.
@@ -104,6 +109,9 @@ pub fn decode(pixels: &[[u8; 4]], width: u32, height: u32, opts: &DecodeOptions)
     })
 }
 
+/// Sub-pixel steps per pixel of separation the decoder tries.
+pub const SUBSTEPS: u32 = 4;
+
 #[allow(clippy::too_many_arguments)]
 fn decode_band(
     pixels: &[[u8; 4]],
@@ -115,50 +123,66 @@ fn decode_band(
     hi: u32,
     opts: &DecodeOptions,
 ) {
+    let q = SUBSTEPS as usize;
     let rows = out.len() / w;
     let hh = opts.half_height as usize;
     let hw = opts.half_width as usize;
     let (r0, r1) = (y0.saturating_sub(hh), (y0 + rows + hh).min(h));
-    let n = rows * w;
-    let mut best = vec![f32::INFINITY; n];
-    let mut best_s = vec![0u32; n];
-    let mut before = vec![f32::NAN; n];
-    let mut after = vec![f32::NAN; n];
-    let mut sum = vec![0f32; n];
-    let mut count = vec![0u32; n];
-    let mut prev = vec![f32::NAN; n];
-    let mut cost = vec![f32::NAN; n];
+    let n_px = rows * w;
+    let mut best = vec![f32::INFINITY; n_px];
+    let mut best_step = vec![usize::MAX; n_px];
+    let mut before = vec![f32::NAN; n_px];
+    let mut after = vec![f32::NAN; n_px];
+    let mut sum = vec![0f32; n_px];
+    let mut count = vec![0u32; n_px];
+    let mut prev = vec![f32::NAN; n_px];
+    let mut cost = vec![f32::NAN; n_px];
     let mut row_sums = vec![0u32; (r1 - r0) * w];
     let mut prefix = vec![0u32; w + 1];
-    for s in lo..=hi {
-        let (half, s) = ((s / 2) as usize, s as usize);
-        // Windows that fit: x − half − hw ≥ 0 and x − half + s + hw < w.
-        let (x_first, x_last) = (half + hw, (w + half).checked_sub(s + hw + 1));
-        let Some(x_last) = x_last.filter(|&l| l >= x_first) else {
-            cost.fill(f32::NAN);
+    let steps = (hi - lo) as usize * q;
+    for step in 0..=steps {
+        let (n, k) = (lo as usize + step / q, step % q);
+        // The window of pair middle x covers right pixels r = x + half ± hw.
+        let half = (2 * (n * q + k) + q) / (4 * q); // round(s / 2)
+        // Windows of right pixels r = x + half ± hw, each pair reaching back to r − n − 1.
+        let x_first = (n + 1 + hw).saturating_sub(half);
+        cost.fill(f32::NAN);
+        let Some(x_last) = (w - 1).checked_sub(hw + half).filter(|&l| l >= x_first) else {
             std::mem::swap(&mut prev, &mut cost);
             continue;
         };
+        let mix = |a: [u8; 4], b: [u8; 4], c: [u8; 4]| -> u32 {
+            (0..3)
+                .map(|ch| {
+                    let mixed = (q - k) as i32 * b[ch] as i32 + k as i32 * c[ch] as i32;
+                    (q as i32 * a[ch] as i32 - mixed).unsigned_abs()
+                })
+                .sum()
+        };
+        let reach = n + (k > 0) as usize; // ⌈s⌉: the left pixel of the pair ending at r
         for (r, rs) in (r0..r1).zip(row_sums.chunks_exact_mut(w)) {
             let row = &pixels[r * w..(r + 1) * w];
             for x in 0..w {
-                let diff = match (x.checked_sub(half), x.checked_sub(half).map(|l| l + s)) {
-                    (Some(l), Some(rr)) if rr < w => {
-                        let (a, b) = (row[l], row[rr]);
-                        (0..3).map(|c| a[c].abs_diff(b[c]) as u32).sum()
-                    }
-                    _ => 0,
+                let diff = if x > n {
+                    // Right-going copies (left start, right half): I(r) = lerp(I(r−n), I(r−n−1)).
+                    let right = mix(row[x], row[x - n], row[x - n - 1]);
+                    // Left-going copies (center start, left half): I(l) = lerp(I(l+n), I(l+n+1)).
+                    let l = x - reach;
+                    let left = mix(row[l], row[l + n], row[(l + n + 1).min(w - 1)]);
+                    right.min(left)
+                } else {
+                    0
                 };
                 prefix[x + 1] = prefix[x] + diff;
             }
             for x in x_first..=x_last {
-                rs[x] = prefix[x + hw + 1] - prefix[x - hw];
+                let rc = x + half;
+                rs[x] = prefix[rc + hw + 1] - prefix[rc - hw];
             }
         }
-        cost.fill(f32::NAN);
         for y in 0..rows {
             let (ya, yb) = ((y0 + y).saturating_sub(hh), (y0 + y + hh + 1).min(h));
-            let area = ((yb - ya) * (2 * hw + 1) * 3) as f32;
+            let area = ((yb - ya) * (2 * hw + 1) * 3 * q) as f32;
             for x in x_first..=x_last {
                 let total: u32 = (ya..yb).map(|r| row_sums[(r - r0) * w + x]).sum();
                 let i = y * w + x;
@@ -166,12 +190,12 @@ fn decode_band(
                 cost[i] = c;
                 sum[i] += c;
                 count[i] += 1;
-                if best_s[i] + 1 == s as u32 {
+                if best_step[i].wrapping_add(1) == step {
                     after[i] = c;
                 }
                 if c < best[i] {
                     best[i] = c;
-                    best_s[i] = s as u32;
+                    best_step[i] = step;
                     before[i] = prev[i];
                     after[i] = f32::NAN;
                 }
@@ -179,7 +203,7 @@ fn decode_band(
         }
         std::mem::swap(&mut prev, &mut cost);
     }
-    for i in 0..n {
+    for i in 0..n_px {
         if count[i] < 2 {
             continue;
         }
@@ -194,7 +218,7 @@ fn decode_band(
         } else {
             0.0
         };
-        out[i] = best_s[i] as f32 + offset;
+        out[i] = lo as f32 + (best_step[i] as f32 + offset) / q as f32;
     }
 }
 
