@@ -84,6 +84,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     rows.extend(stereo_pair(&scene, opts.iterations)?);
     rows.extend(subpixel_bits(&scene, opts.iterations)?);
     rows.extend(perspective_correction(opts.iterations)?);
+    rows.extend(crate::effects::sirds::bench::rows(opts.iterations)?);
     Ok(rows)
 }
 

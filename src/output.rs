@@ -81,10 +81,14 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             eye(View::Right)?,
             |x, y| (x + y) % 2 == 0,
         )?),
-        Output::Sirds => Image::Rgba(crate::effects::sirds::from_frame(frame, scene)?.to_rgba_image()),
-        Output::SirdsDepth => {
-            Image::Gray16(crate::effects::sirds::scene_depth(frame, scene)?.0.to_image())
+        Output::Sirds => {
+            Image::Rgba(crate::effects::sirds::from_frame(frame, scene)?.to_rgba_image())
         }
+        Output::SirdsDepth => Image::Gray16(
+            crate::effects::sirds::scene_depth(frame, scene)?
+                .0
+                .to_image(),
+        ),
     })
 }
 

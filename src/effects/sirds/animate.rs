@@ -53,18 +53,25 @@ pub fn animate(scene: &Scene, opts: &AnimationOptions, path: &Path) -> Result<()
     if points.is_empty() {
         return Err(Error::invalid("mesh", "none", "an animation needs a model"));
     }
-    let (lo, hi) = points
-        .iter()
-        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), p| {
-            (a.min(*p), b.max(*p))
-        });
+    let (lo, hi) = points.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(a, b), p| (a.min(*p), b.max(*p)),
+    );
     let pivot = (lo + hi) * 0.5;
     let radius = points.iter().map(|p| p.distance(pivot)).fold(0.0, f32::max);
     let distance = -scene.camera.view().transform_point3(pivot).z;
     let (near, far) = (scene.camera.near, scene.camera.far);
     let mut s = scene.clone();
-    s.sirds.front = Some(s.sirds.front.unwrap_or((distance - radius).max(near * 1.01)));
-    s.sirds.back = Some(s.sirds.back.unwrap_or((distance + 1.1 * radius).min(far * 0.99)));
+    s.sirds.front = Some(
+        s.sirds
+            .front
+            .unwrap_or((distance - radius).max(near * 1.01)),
+    );
+    s.sirds.back = Some(
+        s.sirds
+            .back
+            .unwrap_or((distance + 1.1 * radius).min(far * 0.99)),
+    );
     let models: Vec<Mat4> = scene.objects.iter().map(|o| o.model).collect();
     let plan = Plan::new(&[Output::Sirds]);
     let bar = if opts.progress {

@@ -107,12 +107,22 @@ pub fn run(args: &SirdsArgs) -> Result<String> {
             .map_err(|e| e.in_file(path))?;
         let z: Vec<f32> = depth_from_separation(&decoded, &d)
             .into_iter()
-            .map(|z| if z.is_finite() { z.clamp(0.0, 1.0) } else { 0.0 })
+            .map(|z| {
+                if z.is_finite() {
+                    z.clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            })
             .collect();
-        DepthMap { width: w, height: h, z }
-            .to_image()
-            .save(&args.out)
-            .map_err(|e| Error::io(&args.out, std::io::Error::other(e.to_string())))?;
+        DepthMap {
+            width: w,
+            height: h,
+            z,
+        }
+        .to_image()
+        .save(&args.out)
+        .map_err(|e| Error::io(&args.out, std::io::Error::other(e.to_string())))?;
         return Ok(format!(
             "{}: {:.1}% of pixels matched a separation in {}..={} px: {}\n  wrote {}\n",
             path.display(),

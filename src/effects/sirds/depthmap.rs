@@ -70,7 +70,11 @@ impl DepthMap {
     /// NaN or outside [0, 1] (naming the pixel).
     pub fn new(width: u32, height: u32, z: Vec<f32>) -> Result<DepthMap> {
         check_size(width, height).map_err(|e| match e {
-            Error::Invalid { field, value, reason } => Error::Invalid {
+            Error::Invalid {
+                field,
+                value,
+                reason,
+            } => Error::Invalid {
                 field: field.replace("image.", "depth map "),
                 value,
                 reason,
@@ -104,7 +108,11 @@ impl DepthMap {
             .map_err(|e| Error::parse(path, None, format!("cannot read depth map: {e}")))?;
         let gray = img.to_luma16();
         let (w, h) = gray.dimensions();
-        let z = gray.into_raw().iter().map(|&v| v as f32 / 65535.0).collect();
+        let z = gray
+            .into_raw()
+            .iter()
+            .map(|&v| v as f32 / 65535.0)
+            .collect();
         DepthMap::new(w, h, z).map_err(|e| e.in_file(path))
     }
 

@@ -201,9 +201,7 @@ impl Disparity {
         let t = self.depth_of(z.clamp(0.0, 1.0));
         match self.model {
             DisparityModel::ViewAngle => separation_view_angle(t, self.tan_phi),
-            DisparityModel::EyeDistance => {
-                self.eye_separation * t / (t + self.viewing_distance)
-            }
+            DisparityModel::EyeDistance => self.eye_separation * t / (t + self.viewing_distance),
         }
     }
 
@@ -249,7 +247,7 @@ impl Disparity {
     /// separation is under 2 pixels (no room for a single strip).
     pub fn check_width(&self, width: u32) -> Result<()> {
         let (lo, hi) = (self.min_separation(), self.max_separation());
-        if !(hi < width as f32) {
+        if hi.is_nan() || hi >= width as f32 {
             return Err(Error::invalid(
                 "sirds separation",
                 format!("{hi:.1} px"),
@@ -258,7 +256,7 @@ impl Disparity {
                 ),
             ));
         }
-        if !(lo >= 2.0) {
+        if lo.is_nan() || lo < 2.0 {
             return Err(Error::invalid(
                 "sirds separation",
                 format!("{lo:.2} px"),

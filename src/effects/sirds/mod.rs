@@ -65,7 +65,12 @@ impl Sirds {
 ///
 /// # Errors
 /// An invalid range, or a background plane at or beyond the far clip plane.
-pub fn depth_range(settings: &Settings, fb: &Framebuffer, near: f32, far: f32) -> Result<DepthRange> {
+pub fn depth_range(
+    settings: &Settings,
+    fb: &Framebuffer,
+    near: f32,
+    far: f32,
+) -> Result<DepthRange> {
     let auto = DepthMap::auto_range(fb, near, far).unwrap_or(DepthRange {
         front: near,
         back: far * 0.999,
@@ -118,8 +123,15 @@ pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
     let d = s.geometry.to_pixels()?;
     let (mut pixels, iterations) = match s.algorithm {
         Algorithm::PerPixel => {
-            let encoded = if s.cross_eyed { depth.inverted() } else { depth.clone() };
-            (per_pixel::per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?, None)
+            let encoded = if s.cross_eyed {
+                depth.inverted()
+            } else {
+                depth.clone()
+            };
+            (
+                per_pixel::per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?,
+                None,
+            )
         }
         Algorithm::PerVertex => {
             let g = per_vertex::StripGeometry::new(scene, &frame.center, &range, &d, s.cross_eyed);
@@ -154,7 +166,11 @@ pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
 /// As [`per_pixel::per_pixel`].
 pub fn from_depth_map(depth: &DepthMap, s: &Settings) -> Result<Sirds> {
     let d = s.geometry.to_pixels()?;
-    let encoded = if s.cross_eyed { depth.inverted() } else { depth.clone() };
+    let encoded = if s.cross_eyed {
+        depth.inverted()
+    } else {
+        depth.clone()
+    };
     let mut pixels = per_pixel::per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?;
     if s.guide_dots {
         pattern::draw_guide_dots(&mut pixels, depth.width, depth.height, d.max_separation());

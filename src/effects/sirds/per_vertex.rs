@@ -247,10 +247,7 @@ impl Shader for StripShader<'_> {
             if i0 < lo || i1 >= hi {
                 return None;
             }
-            let (a, b) = (
-                self.image[row + i0 as usize],
-                self.image[row + i1 as usize],
-            );
+            let (a, b) = (self.image[row + i0 as usize], self.image[row + i1 as usize]);
             let mix = |k: usize| (a[k] as f32 + (b[k] as f32 - a[k] as f32) * t + 0.5) as u8;
             (i0, [mix(0), mix(1), mix(2), 255])
         } else {
@@ -273,11 +270,21 @@ fn triangle_bounds(clip: &[Vec4], triangles: &[[u32; 3]], w: f32, h: f32) -> Vec
     triangles
         .iter()
         .map(|t| {
-            let mut b = [f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY];
+            let mut b = [
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+            ];
             for &i in t {
                 let c = clip[i as usize];
-                if !(c.w > 0.0) {
-                    return [f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY];
+                if c.w.is_nan() || c.w <= 0.0 {
+                    return [
+                        f32::NEG_INFINITY,
+                        f32::INFINITY,
+                        f32::NEG_INFINITY,
+                        f32::INFINITY,
+                    ];
                 }
                 let (x, y) = ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h);
                 b = [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)];
@@ -320,7 +327,11 @@ pub fn per_vertex(
         Vec::new()
     };
     let bounds_right = triangle_bounds(&right, &geometry.triangles, wf, hf);
-    let bounds_left = triangle_bounds(&left, &geometry.triangles, wf, hf);
+    let bounds_left = if left.is_empty() {
+        Vec::new()
+    } else {
+        triangle_bounds(&left, &geometry.triangles, wf, hf)
+    };
     let band_rows = height.div_ceil(BANDS);
     let raster = RasterOptions::default();
     let bands: Vec<(u32, u32)> = (0..height)
