@@ -38,7 +38,7 @@ fn mix(mut v: u64) -> u64 {
 
 #[inline]
 fn random(seed: u64, x: u32, y: u32) -> u64 {
-    mix(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(((y as u64) << 32) | x as u64))
+    mix(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (((y as u64) << 32) | x as u64))
 }
 
 impl Pattern {

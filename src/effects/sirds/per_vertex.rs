@@ -240,9 +240,8 @@ impl Shader for StripShader<'_> {
         let p = x as f32 - self.strip.toward * f.varyings[0];
         let (lo, hi) = (self.strip.lo, self.strip.hi);
         let (source, color) = if self.bilinear {
-            let i0 = p.floor();
-            let t = p - i0;
-            let i0 = i0 as i64;
+            let i0 = floor(p);
+            let t = p - i0 as f32;
             let i1 = if t > 0.0 { i0 + 1 } else { i0 };
             if i0 < lo || i1 >= hi {
                 return None;
@@ -251,7 +250,7 @@ impl Shader for StripShader<'_> {
             let mix = |k: usize| (a[k] as f32 + (b[k] as f32 - a[k] as f32) * t + 0.5) as u8;
             (i0, [mix(0), mix(1), mix(2), 255])
         } else {
-            let i = (p + 0.5).floor() as i64;
+            let i = floor(p + 0.5);
             if i < lo || i >= hi {
                 return None;
             }
@@ -262,6 +261,13 @@ impl Shader for StripShader<'_> {
         }
         Some(color)
     }
+}
+
+/// `⌊v⌋` without a libm call (the default x86-64 target has no SSE4.1 `roundss`).
+#[inline]
+fn floor(v: f32) -> i64 {
+    let i = v as i64;
+    i - ((i as f32) > v) as i64
 }
 
 /// Window-space bounds `[x0, x1, y0, y1]` of each triangle after the horizontal shift; the
@@ -352,6 +358,9 @@ pub fn per_vertex(
                 Vec::new()
             };
             let (y_lo, y_hi) = (y0 as f32 - 1.0, (y0 + bh) as f32 + 1.0);
+            let n = geometry.clip.len();
+            let (mut seen, mut remap, mut stamp) = (vec![0u32; n], vec![0u32; n], 0u32);
+            let (mut tris, mut local_clip, mut local_sep) = (Vec::new(), Vec::new(), Vec::new());
             for strip in &strips {
                 let (clip, bounds) = if strip.toward > 0.0 {
                     (&right, &bounds_right)
@@ -359,13 +368,27 @@ pub fn per_vertex(
                     (&left, &bounds_left)
                 };
                 let (x_lo, x_hi) = (strip.x0 as f32 - 1.0, (strip.x0 + strip.width) as f32 + 1.0);
-                let tris: Vec<[u32; 3]> = geometry
-                    .triangles
-                    .iter()
-                    .zip(bounds)
-                    .filter(|(_, b)| b[1] >= x_lo && b[0] <= x_hi && b[3] >= y_lo && b[2] <= y_hi)
-                    .map(|(t, _)| *t)
-                    .collect();
+                // Only the triangles that reach this strip × band, with their vertices
+                // compacted, so the vertex stage runs on those alone.
+                tris.clear();
+                local_clip.clear();
+                local_sep.clear();
+                stamp += 1;
+                for (t, b) in geometry.triangles.iter().zip(bounds) {
+                    if !(b[1] >= x_lo && b[0] <= x_hi && b[3] >= y_lo && b[2] <= y_hi) {
+                        continue;
+                    }
+                    tris.push(t.map(|i| {
+                        let i = i as usize;
+                        if seen[i] != stamp {
+                            seen[i] = stamp;
+                            remap[i] = local_clip.len() as u32;
+                            local_clip.push(clip[i]);
+                            local_sep.push(geometry.separation[i]);
+                        }
+                        remap[i]
+                    }));
+                }
                 let sw = strip.width as f32;
                 let bhf = bh as f32;
                 let remap = [
@@ -380,8 +403,8 @@ pub fn per_vertex(
                     row.copy_from_slice(&image[start..start + strip.width as usize]);
                 }
                 let shader = StripShader {
-                    clip,
-                    separation: &geometry.separation,
+                    clip: &local_clip,
+                    separation: &local_sep,
                     remap,
                     image: &image,
                     width: w,
@@ -389,7 +412,7 @@ pub fn per_vertex(
                     bilinear: opts.filter == Filter::Bilinear,
                     links: record_links.then_some(links.as_slice()),
                 };
-                rasterize(&tris, clip.len(), &shader, &mut fb, &raster);
+                rasterize(&tris, local_clip.len(), &shader, &mut fb, &raster);
                 for (r, row) in fb.color.chunks_exact(strip.width as usize).enumerate() {
                     let start = r * w + strip.x0 as usize;
                     image[start..start + strip.width as usize].copy_from_slice(row);
