@@ -74,20 +74,66 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
     if ext == "ppm" || ext == "pnm" {
         let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
-        let mut bytes = Vec::with_capacity(pixels.len() * 3 + 32);
-        bytes.extend_from_slice(format!("P6\n{width} {height}\n255\n").as_bytes());
-        for p in pixels {
-            bytes.extend_from_slice(&p[..3]);
-        }
-        w.write_all(&bytes)
-            .and_then(|_| w.flush())
-            .map_err(|e| Error::io(path, e))
+        let mut write = || -> std::io::Result<()> {
+            write!(w, "P6\n{width} {height}\n255\n")?;
+            let mut row = Vec::with_capacity(width as usize * 3);
+            for line in pixels.chunks_exact(width.max(1) as usize) {
+                row.clear();
+                row.extend(line.iter().flat_map(|p| [p[0], p[1], p[2]]));
+                w.write_all(&row)?;
+            }
+            w.flush()
+        };
+        write().map_err(|e| Error::io(path, e))
     } else {
         let bytes = pixels.iter().flatten().copied().collect();
         let img = image::RgbaImage::from_raw(width, height, bytes).expect("buffer size matches");
         img.save(path)
             .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
     }
+}
+
+/// TIW from a depth-map file straight into a PPM, a chunk of rows at a time: the depth map is
+/// never held as floats, nor the image as RGBA (a 4096×3072 map would need 100 MB for both).
+fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u32, u32)> {
+    let img = image::open(depth)
+        .map_err(|e| Error::parse(depth, None, format!("cannot read depth map: {e}")))?;
+    let (width, height) = (img.width(), img.height());
+    crate::framebuffer::check_size(width, height).map_err(|e| e.in_file(depth))?;
+    let (samples, max): (Vec<u16>, f32) = match img {
+        image::DynamicImage::ImageLuma8(g) => {
+            (g.into_raw().into_iter().map(u16::from).collect(), 255.0)
+        }
+        other => (other.to_luma16().into_raw(), 65535.0),
+    };
+    let invert = settings.cross_eyed;
+    let w = width as usize;
+    let depth_row = |y: u32, row: &mut Vec<f32>| {
+        let line = &samples[y as usize * w..(y as usize + 1) * w];
+        row.extend(line.iter().map(|&v| {
+            let z = v as f32 / max;
+            if invert { 1.0 - z } else { z }
+        }));
+    };
+    let file = std::fs::File::create(out).map_err(|e| Error::io(out, e))?;
+    let mut writer = std::io::BufWriter::with_capacity(1 << 20, file);
+    write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| Error::io(out, e))?;
+    let mut bytes = Vec::new();
+    super::per_pixel::per_pixel_streamed(
+        width,
+        height,
+        depth_row,
+        &settings.geometry.to_pixels()?,
+        &settings.pattern,
+        &settings.per_pixel,
+        |rows| {
+            bytes.clear();
+            bytes.extend(rows.iter().flat_map(|p| [p[0], p[1], p[2]]));
+            writer.write_all(&bytes).map_err(|e| Error::io(out, e))
+        },
+    )?;
+    writer.flush().map_err(|e| Error::io(out, e))?;
+    Ok((width, height))
 }
 
 /// Runs `stereolab sirds`; returns what to print.
@@ -139,16 +185,23 @@ pub fn run(args: &SirdsArgs) -> Result<String> {
     }
     if let Some(path) = &args.depth {
         let settings = settings_from_sets(&args.sets)?;
-        let depth = DepthMap::load(path)?;
-        let sirds = from_depth_map(&depth, &settings)?;
-        save(&sirds.pixels, sirds.width, sirds.height, &args.out)?;
+        let d = settings.geometry.to_pixels()?;
+        let is_ppm = matches!(
+            args.out.extension().and_then(|e| e.to_str()),
+            Some("ppm" | "pnm")
+        );
+        let (w, h) = if is_ppm && !settings.guide_dots {
+            stream_depth_map(path, &settings, &args.out)?
+        } else {
+            let sirds = from_depth_map(DepthMap::load(path)?, &settings)?;
+            save(&sirds.pixels, sirds.width, sirds.height, &args.out)?;
+            (sirds.width, sirds.height)
+        };
         return Ok(format!(
-            "per-pixel SIRDS of {} ({}x{}), separations {:.1}..{:.1} px\n  wrote {}\n",
+            "per-pixel SIRDS of {} ({w}x{h}), separations {:.1}..{:.1} px\n  wrote {}\n",
             path.display(),
-            sirds.width,
-            sirds.height,
-            sirds.disparity.min_separation(),
-            sirds.disparity.max_separation(),
+            d.min_separation(),
+            d.max_separation(),
             args.out.display()
         ));
     }

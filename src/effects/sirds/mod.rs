@@ -164,14 +164,13 @@ pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
 ///
 /// # Errors
 /// As [`per_pixel::per_pixel`].
-pub fn from_depth_map(depth: &DepthMap, s: &Settings) -> Result<Sirds> {
+pub fn from_depth_map(depth: DepthMap, s: &Settings) -> Result<Sirds> {
     let d = s.geometry.to_pixels()?;
-    let encoded = if s.cross_eyed {
-        depth.inverted()
+    let mut pixels = if s.cross_eyed {
+        per_pixel::per_pixel(&depth.inverted(), &d, &s.pattern, &s.per_pixel)?
     } else {
-        depth.clone()
+        per_pixel::per_pixel(&depth, &d, &s.pattern, &s.per_pixel)?
     };
-    let mut pixels = per_pixel::per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?;
     if s.guide_dots {
         pattern::draw_guide_dots(&mut pixels, depth.width, depth.height, d.max_separation());
     }
@@ -179,7 +178,7 @@ pub fn from_depth_map(depth: &DepthMap, s: &Settings) -> Result<Sirds> {
         pixels,
         width: depth.width,
         height: depth.height,
-        depth: depth.clone(),
+        depth,
         disparity: d,
         iterations: None,
     })

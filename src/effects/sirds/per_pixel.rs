@@ -2,8 +2,6 @@
 //! 1994; seed 002's reference 5) on any depth map: per scan line, link the pixel pairs each
 //! visible point constrains (`same[]`), then color right to left.
 
-use std::collections::VecDeque;
-
 use rayon::prelude::*;
 
 use super::depthmap::DepthMap;
@@ -37,7 +35,8 @@ pub const MAX_OVERSAMPLE: u32 = 16;
 /// TIW's `round(X) = (int)(X + 0.5)` for the non-negative separations.
 #[inline]
 fn round_half_up(v: f32) -> usize {
-    (v + 0.5).floor().max(0.0) as usize
+    // Truncation is the floor for the non-negative values we get (and saturates NaN to 0).
+    (v + 0.5).max(0.0) as usize
 }
 
 /// The left pixel of the pair that a point at `x` with separation `s` links. TIW: "left =
@@ -54,7 +53,6 @@ pub struct RowLinker {
     /// `same[x]`: `x` itself (free) or a pixel to the right that must have the same color.
     pub same: Vec<u32>,
     window_max: Vec<f32>,
-    queue: VecDeque<usize>,
 }
 
 impl RowLinker {
@@ -65,8 +63,8 @@ impl RowLinker {
     /// by `tan φ` depth per lateral pixel (eq. 2 under eq. 3, the constant angle under eq. 1), so
     /// at lateral offset `t` a ray is at nearness `zt = z + t · tan φ / (scale (t_far − t_near))`;
     /// the point is hidden when `Z[x − t] ≥ zt` or `Z[x + t] ≥ zt` before `zt` leaves the depth
-    /// range. A sliding maximum over the longest such walk skips the walk where nothing around
-    /// can block (the result is the same).
+    /// range. Block maxima over the longest such walk skip the walk where nothing around can
+    /// block (the result is the same).
     pub fn link_row(&mut self, z: &[f32], y: u32, d: &Disparity, scale: u32, hidden: bool) {
         let n = z.len();
         self.same.clear();
@@ -77,19 +75,32 @@ impl RowLinker {
         let min_rise = d.ray_slope(d.t_near).min(d.ray_slope(d.t_far)) * step_scale;
         let reach = ((1.0 / min_rise).ceil() as usize + 1).min(n);
         if hidden {
-            self.sliding_max(z, reach);
+            self.block_max(z, reach);
         }
+        // Depth maps repeat values (flat regions, 8-bit files): reuse the last separation.
+        let (mut last_z, mut s, mut rise) = (f32::NAN, 0, 0.0);
         for x in 0..n {
             let zx = z[x];
-            let s = round_half_up(d.separation(zx) * scale as f32);
+            if zx != last_z {
+                last_z = zx;
+                s = round_half_up(d.separation(zx) * scale as f32);
+                rise = d.ray_slope(d.depth_of(zx)) * step_scale;
+            }
             let left = left_of_pair(x, s, y);
             let right = left + s as isize;
             if left < 0 || right >= n as isize {
                 continue;
             }
             if hidden {
-                let rise = d.ray_slope(d.depth_of(zx)) * step_scale;
-                if self.window_max[x] >= zx + rise && !ray_clear(z, x, zx, rise) {
+                // The maximum of the ≤ 3 blocks around x bounds everything the walk can meet.
+                let (b0, b2) = (
+                    x.saturating_sub(reach) / reach,
+                    ((x + reach) / reach).min(self.window_max.len() - 1),
+                );
+                let around = self.window_max[b0]
+                    .max(self.window_max[x / reach])
+                    .max(self.window_max[b2]);
+                if around >= zx + rise && !ray_clear(z, x, zx, rise) {
                     continue;
                 }
             }
@@ -108,27 +119,12 @@ impl RowLinker {
         }
     }
 
-    /// `window_max[x] = max z[x − r ..= x + r]` (monotone queue, O(n)).
-    fn sliding_max(&mut self, z: &[f32], r: usize) {
-        let n = z.len();
+    /// `window_max[b] = max z[b r .. (b + 1) r]`: block maxima, so that the three blocks
+    /// around x cover the whole walk `x − r ..= x + r`.
+    fn block_max(&mut self, z: &[f32], r: usize) {
         self.window_max.clear();
-        self.queue.clear();
-        let mut next = 0;
-        for x in 0..n {
-            let hi = (x + r).min(n - 1);
-            while next <= hi {
-                while self.queue.back().is_some_and(|&b| z[b] <= z[next]) {
-                    self.queue.pop_back();
-                }
-                self.queue.push_back(next);
-                next += 1;
-            }
-            let lo = x.saturating_sub(r);
-            while self.queue.front().is_some_and(|&f| f < lo) {
-                self.queue.pop_front();
-            }
-            self.window_max.push(z[self.queue[0]]);
-        }
+        self.window_max
+            .extend(z.chunks(r).map(|c| c.iter().copied().fold(0.0, f32::max)));
     }
 }
 
@@ -169,7 +165,43 @@ pub fn per_pixel(
     pattern: &Pattern,
     opts: &PerPixelOptions,
 ) -> Result<Vec<[u8; 4]>> {
-    check_inputs(depth.width, d, pattern)?;
+    let mut out = Vec::with_capacity(depth.z.len());
+    per_pixel_streamed(
+        depth.width,
+        depth.height,
+        |y, row| row.extend_from_slice(depth.row(y)),
+        d,
+        pattern,
+        opts,
+        |rows| {
+            out.extend_from_slice(rows);
+            Ok(())
+        },
+    )?;
+    Ok(out)
+}
+
+/// Rows per chunk of [`per_pixel_streamed`]: enough to keep both cores busy, small enough that
+/// a 4096-wide image needs only a megabyte of buffers.
+const CHUNK_ROWS: usize = 64;
+
+/// TIW without holding the whole image: `depth_row(y, buf)` appends row y's nearness to `buf`,
+/// and `sink` receives the finished rows in order, `CHUNK_ROWS` at a time. Rows of a chunk run
+/// in parallel; the bytes do not depend on the thread count.
+///
+/// # Errors
+/// As [`per_pixel`], or whatever `sink` returns.
+#[allow(clippy::too_many_arguments)]
+pub fn per_pixel_streamed(
+    width: u32,
+    height: u32,
+    depth_row: impl Fn(u32, &mut Vec<f32>) + Sync,
+    d: &Disparity,
+    pattern: &Pattern,
+    opts: &PerPixelOptions,
+    mut sink: impl FnMut(&[[u8; 4]]) -> Result<()>,
+) -> Result<()> {
+    check_inputs(width, d, pattern)?;
     let o = opts.oversample;
     if !(1..=MAX_OVERSAMPLE).contains(&o) {
         return Err(Error::invalid(
@@ -178,29 +210,37 @@ pub fn per_pixel(
             format!("must lie in 1..={MAX_OVERSAMPLE}"),
         ));
     }
-    let w = depth.width as usize;
-    let mut out = vec![[0u8; 4]; w * depth.height as usize];
-    out.par_chunks_mut(w).enumerate().for_each_init(
-        || (RowLinker::default(), Vec::new(), Vec::new()),
-        |(linker, fine, colors), (y, row_out)| {
-            let y = y as u32;
-            let row = depth.row(y);
-            let z: &[f32] = if o == 1 {
-                row
-            } else {
-                oversample_row(row, o, fine);
-                fine
-            };
-            linker.link_row(z, y, d, o, opts.hidden_surface);
-            color_row(&linker.same, y, o, pattern, colors);
-            if o == 1 {
-                row_out.copy_from_slice(colors);
-            } else {
-                average_subpixels(colors, o, row_out);
-            }
-        },
-    );
-    Ok(out)
+    let w = width as usize;
+    let mut chunk = vec![[0u8; 4]; w * CHUNK_ROWS];
+    for y0 in (0..height as usize).step_by(CHUNK_ROWS) {
+        let rows = CHUNK_ROWS.min(height as usize - y0);
+        chunk[..rows * w]
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each_init(
+                || (RowLinker::default(), Vec::new(), Vec::new(), Vec::new()),
+                |(linker, row, fine, colors), (dy, row_out)| {
+                    let y = (y0 + dy) as u32;
+                    row.clear();
+                    depth_row(y, row);
+                    let z: &[f32] = if o == 1 {
+                        row
+                    } else {
+                        oversample_row(row, o, fine);
+                        fine
+                    };
+                    linker.link_row(z, y, d, o, opts.hidden_surface);
+                    color_row(&linker.same, y, o, pattern, colors);
+                    if o == 1 {
+                        row_out.copy_from_slice(colors);
+                    } else {
+                        average_subpixels(colors, o, row_out);
+                    }
+                },
+            );
+        sink(&chunk[..rows * w])?;
+    }
+    Ok(())
 }
 
 /// Samples a row `o` times per pixel, linearly between pixel centers (clamped at the ends).
