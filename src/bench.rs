@@ -92,6 +92,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         &scene,
         opts.iterations,
     )?);
+    rows.extend(crate::effects::sirds::bench::rows(opts.iterations)?);
     Ok(rows)
 }
 

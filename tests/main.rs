@@ -9,4 +9,5 @@ mod finalize;
 mod golden;
 mod layout;
 mod rig;
+mod sirds;
 mod stability;
