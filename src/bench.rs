@@ -84,6 +84,8 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     rows.extend(stereo_pair(&scene, opts.iterations)?);
     rows.extend(subpixel_bits(&scene, opts.iterations)?);
     rows.extend(perspective_correction(opts.iterations)?);
+    #[cfg(feature = "gpu")]
+    rows.extend(crate::gpu::parity::bench_rows(&scene, opts.iterations)?);
     Ok(rows)
 }
 

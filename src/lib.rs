@@ -10,6 +10,8 @@ pub mod compare;
 pub mod effects;
 pub mod error;
 pub mod framebuffer;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod info;
 pub mod math;
 pub mod output;
