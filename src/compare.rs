@@ -360,3 +360,114 @@ pub fn compare_images(
         strip,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn metrics(coverage_mismatch: usize, max: u8, mean: f64, psnr: f64, depth: f32) -> Metrics {
+        Metrics {
+            pixels: 1000,
+            coverage_mismatch,
+            max_channel_diff: max,
+            mean_channel_diff: mean,
+            psnr,
+            max_depth_diff: depth,
+        }
+    }
+
+    fn row(m: Metrics, has_depth: bool) -> Comparison {
+        Comparison {
+            name: "left pass".into(),
+            metrics: m,
+            has_depth,
+            strip: None,
+        }
+    }
+
+    #[test]
+    fn thresholds_pass_identical_images_and_name_every_exceeded_limit() {
+        let t = Thresholds::default();
+        assert!(
+            t.violations(&[row(metrics(0, 0, 0.0, f64::INFINITY, 0.0), true)])
+                .is_empty()
+        );
+        let bad = t.violations(&[row(metrics(2, 9, 2.0, 20.0, 1e-3), true)]);
+        assert_eq!(bad.len(), 4, "coverage 0.2%, mean, PSNR, depth: {bad:?}");
+        assert!(
+            bad[0].contains("coverage mismatch % = 0.20000"),
+            "{}",
+            bad[0]
+        );
+        // Without depth (PNG files), depth is not judged.
+        let no_depth = t.violations(&[row(metrics(0, 0, 0.0, 90.0, 1.0), false)]);
+        assert!(no_depth.is_empty(), "{no_depth:?}");
+    }
+
+    #[test]
+    fn threshold_settings_parse_and_bad_ones_are_named() {
+        let mut t = Thresholds::default();
+        t.set("coverage=0.5").expect("valid");
+        t.set("max=3").expect("valid");
+        t.set("depth=1e-4").expect("valid");
+        assert_eq!(
+            (t.coverage_percent, t.max_channel, t.max_depth),
+            (0.5, 3, 1e-4)
+        );
+        for bad in [
+            "coverage",
+            "colour=1",
+            "max=256",
+            "psnr=-1",
+            "mean=abc",
+            "depth=inf",
+        ] {
+            let e = t.set(bad).expect_err(bad).to_string();
+            assert!(e.contains(bad), "the message names the setting: {e}");
+        }
+    }
+
+    #[test]
+    fn image_coverage_is_whatever_differs_from_the_background() {
+        let bg = [10, 20, 30, 255];
+        let img = RgbaImage::from_fn(3, 1, |x, _| match x {
+            0 => Rgba(bg),
+            1 => Rgba([10, 20, 31, 255]),
+            _ => Rgba([10, 20, 30, 0]), // alpha is ignored
+        });
+        let fb = framebuffer_from_image(&img, bg);
+        assert_eq!(coverage(&fb), vec![false, true, false]);
+    }
+
+    #[test]
+    fn comparing_two_image_files_reports_differences_and_writes_the_strip() {
+        let dir = std::env::temp_dir().join(format!("stereolab-compare-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let bg = Rgba([0, 0, 0, 255]);
+        let a = RgbaImage::from_fn(8, 8, |x, y| {
+            if (2..5).contains(&x) && (2..5).contains(&y) {
+                Rgba([200, 100, 50, 255])
+            } else {
+                bg
+            }
+        });
+        let mut b = a.clone();
+        b.put_pixel(6, 6, Rgba([200, 100, 50, 255])); // one extra covered pixel
+        b.put_pixel(3, 3, Rgba([204, 100, 50, 255])); // one color off by 4
+        let (pa, pb) = (dir.join("expected.png"), dir.join("actual.png"));
+        a.save(&pa).expect("write");
+        b.save(&pb).expect("write");
+        let c = compare_images(&pa, &pb, None, Some(&dir)).expect("compare");
+        assert_eq!(c.metrics.coverage_mismatch, 1);
+        assert_eq!(c.metrics.max_channel_diff, 200);
+        assert!(c.strip.as_ref().is_some_and(|p| p.exists()));
+        let small = RgbaImage::new(4, 4);
+        let pc = dir.join("small.png");
+        small.save(&pc).expect("write");
+        let e = compare_images(&pa, &pc, None, None)
+            .expect_err("sizes differ")
+            .to_string();
+        assert!(e.contains("8x8 vs 4x4"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -31,7 +31,7 @@ impl Image {
     }
 }
 
-fn need<'a>(frame: &'a Frame, view: View, output: Output) -> Result<&'a Framebuffer> {
+fn need(frame: &Frame, view: View, output: Output) -> Result<&Framebuffer> {
     frame.view(view).ok_or_else(|| {
         Error::invalid(
             "plan",

@@ -81,7 +81,7 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
                 .map(|t| [base + t[0], base + t[1], base + t[2]]),
         );
     }
-    if !has_normals || mesh.normals.iter().any(|n| *n == Vec3::ZERO) {
+    if !has_normals || mesh.normals.contains(&Vec3::ZERO) {
         mesh.compute_normals();
     }
     if mesh.triangles.is_empty() {
