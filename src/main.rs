@@ -191,7 +191,8 @@ fn run(cli: Cli) -> Result<()> {
                     .first()
                     .map_or(0.0, |p| p.time.as_secs_f64() * 1e3);
                 println!(
-                    "  {} passes on the GPU in one submission: {ms:.2} ms including readback",
+                    "  {} passes on the GPU in one submission: {ms:.2} ms including readback \
+                     and, on this first frame, shader compilation",
                     frame.passes.len()
                 );
             }

@@ -6,6 +6,7 @@ use std::sync::Mutex;
 use crate::error::Result;
 
 use super::gpu_error;
+use super::readback::Target;
 
 /// Which pipeline a scene pass needs: its shading and the rasterizer options that change
 /// fixed-function state or the shader (see [`crate::raster::RasterOptions`]).
@@ -29,6 +30,8 @@ pub struct GpuRenderer {
     /// Uniform buffer with dynamic offset, shared by the scene pipelines (group 0).
     pub(crate) uniform_layout: wgpu::BindGroupLayout,
     pub(crate) pipelines: Mutex<HashMap<PipelineKey, wgpu::RenderPipeline>>,
+    /// Targets of earlier frames, reused when the size matches (fresh ones cost page faults).
+    pub(crate) spare_targets: Mutex<Vec<Target>>,
 }
 
 impl GpuRenderer {
@@ -80,6 +83,7 @@ impl GpuRenderer {
             info,
             uniform_layout,
             pipelines: Mutex::new(HashMap::new()),
+            spare_targets: Mutex::new(Vec::new()),
         })
     }
 
@@ -90,6 +94,15 @@ impl GpuRenderer {
             i.name.clone()
         } else {
             format!("{} ({})", i.name, i.driver_info)
+        }
+    }
+
+    /// `lavapipe` for Mesa's CPU driver, else the adapter's name.
+    pub fn short_name(&self) -> String {
+        if self.is_cpu_adapter() && self.info.name.starts_with("llvmpipe") {
+            "lavapipe".into()
+        } else {
+            self.info.name.clone()
         }
     }
 

@@ -188,7 +188,7 @@ impl FullscreenPass {
                 "all inputs must have the same size",
             ));
         }
-        let target = Target::new(r, width, height, DepthKind::ColorR32)?;
+        let target = Target::take(r, width, height, DepthKind::ColorR32)?;
         let mut views = Vec::with_capacity(2 * inputs.len());
         for fb in inputs {
             let color: Vec<u8> = fb.color.iter().flatten().copied().collect();
@@ -259,6 +259,7 @@ impl FullscreenPass {
         }
         target.encode_copies(&mut encoder);
         let mut out = submit_and_read(r, encoder, &[&target])?;
+        Target::give_back(r, [target]);
         out.pop()
             .ok_or_else(|| gpu_error(&self.label, "no framebuffer came back"))
     }

@@ -142,10 +142,10 @@ pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             format!("stereo pair {size}, cpu/gpu time = {ratio:.2}"),
         ),
         row(
-            r.adapter_name(),
+            r.short_name(),
             Some(worst),
             gpu_ms,
-            format!("stereo pair {size} incl. readback"),
+            format!("stereo pair {size} incl. readback; {}", r.adapter_name()),
         ),
     ])
 }

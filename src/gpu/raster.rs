@@ -220,7 +220,7 @@ impl GpuRenderer {
         });
         let targets = views
             .iter()
-            .map(|_| Target::new(self, s.width, s.height, DepthKind::DepthBuffer))
+            .map(|_| Target::take(self, s.width, s.height, DepthKind::DepthBuffer))
             .collect::<Result<Vec<_>>>()?;
         let mut encoder = self
             .device
@@ -285,7 +285,10 @@ impl GpuRenderer {
             t.encode_copies(&mut encoder);
         }
         let refs: Vec<&Target> = targets.iter().collect();
-        submit_and_read(self, encoder, &refs)
+        let framebuffers = submit_and_read(self, encoder, &refs)?;
+        // Only after a clean readback: a failed one may leave a buffer mapped.
+        Target::give_back(self, targets);
+        Ok(framebuffers)
     }
 
     /// The pipeline for `key`, built on first use.

@@ -3,6 +3,8 @@
 
 use std::sync::mpsc;
 
+use rayon::prelude::*;
+
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 
@@ -11,6 +13,9 @@ use super::gpu_error;
 
 /// The color format of every target: 8-bit RGBA, no sRGB conversion (DESIGN.md).
 pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// Spare targets kept between frames: a stereo pair plus a center pass and an effect pass.
+const MAX_SPARE_TARGETS: usize = 4;
 
 /// Where a target's depth lives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,11 +62,38 @@ pub(crate) fn padded_row_bytes(width: u32) -> u32 {
 }
 
 impl Target {
+    /// A `width × height` target: a spare one of an earlier frame, else a new one.
+    ///
+    /// # Errors
+    /// A side the device does not support.
+    pub fn take(r: &GpuRenderer, width: u32, height: u32, depth_kind: DepthKind) -> Result<Self> {
+        if let Ok(mut spare) = r.spare_targets.lock() {
+            let fits =
+                |t: &Target| (t.width, t.height, t.depth_kind) == (width, height, depth_kind);
+            if let Some(i) = spare.iter().position(fits) {
+                return Ok(spare.swap_remove(i));
+            }
+        }
+        Target::new(r, width, height, depth_kind)
+    }
+
+    /// Hands targets back for later frames, keeping at most [`MAX_SPARE_TARGETS`].
+    pub fn give_back(r: &GpuRenderer, targets: impl IntoIterator<Item = Target>) {
+        if let Ok(mut spare) = r.spare_targets.lock() {
+            for t in targets {
+                if spare.len() == MAX_SPARE_TARGETS {
+                    spare.remove(0);
+                }
+                spare.push(t);
+            }
+        }
+    }
+
     /// Allocates a `width × height` target.
     ///
     /// # Errors
     /// A side the device does not support.
-    pub fn new(r: &GpuRenderer, width: u32, height: u32, depth_kind: DepthKind) -> Result<Self> {
+    fn new(r: &GpuRenderer, width: u32, height: u32, depth_kind: DepthKind) -> Result<Self> {
         r.check_target_size(width, height)?;
         let size = wgpu::Extent3d {
             width,
@@ -164,33 +196,37 @@ pub(crate) fn submit_and_read(
     for res in rx.iter() {
         res.map_err(|e| gpu_error("readback", format!("cannot map a buffer: {e}")))?;
     }
-    targets.iter().map(|t| read_target(t)).collect()
+    // One target per thread: unpadding a 1024×768 pair takes 2–6 ms on one thread.
+    targets.par_iter().map(|t| read_target(t)).collect()
 }
 
 /// Unpads the mapped buffers of `t` into a framebuffer, then unmaps them.
 fn read_target(t: &Target) -> Result<Framebuffer> {
-    let mut fb = Framebuffer::new(t.width, t.height, [0; 4])?;
     let (w, row) = (t.width as usize, t.padded_row as usize);
+    let n = w * t.height as usize;
+    let (mut color, mut depth) = (Vec::with_capacity(n), Vec::with_capacity(n));
     {
-        let color = t
-            .color_buffer
-            .get_mapped_range(..)
-            .map_err(|e| gpu_error("readback", format!("color buffer not mapped: {e}")))?;
-        let depth = t
-            .depth_buffer
-            .get_mapped_range(..)
-            .map_err(|e| gpu_error("readback", format!("depth buffer not mapped: {e}")))?;
-        for y in 0..t.height as usize {
-            let (c, d) = (&color[y * row..][..4 * w], &depth[y * row..][..4 * w]);
-            for x in 0..w {
-                let i = y * w + x;
-                fb.color[i].copy_from_slice(&c[4 * x..4 * x + 4]);
-                fb.depth[i] =
-                    f32::from_le_bytes([d[4 * x], d[4 * x + 1], d[4 * x + 2], d[4 * x + 3]]);
-            }
+        let mapped = |b: &wgpu::Buffer| {
+            b.get_mapped_range(..)
+                .map_err(|e| gpu_error("readback", format!("buffer not mapped: {e}")))
+        };
+        let (c, d) = (mapped(&t.color_buffer)?, mapped(&t.depth_buffer)?);
+        // Row by row, dropping the padding; 4-byte texels as [u8; 4] and native-endian f32.
+        for (c, d) in c.chunks_exact(row).zip(d.chunks_exact(row)) {
+            color.extend(c[..4 * w].chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]]));
+            depth.extend(
+                d[..4 * w]
+                    .chunks_exact(4)
+                    .map(|p| f32::from_ne_bytes([p[0], p[1], p[2], p[3]])),
+            );
         }
     }
     t.color_buffer.unmap();
     t.depth_buffer.unmap();
-    Ok(fb)
+    Ok(Framebuffer {
+        width: t.width,
+        height: t.height,
+        color,
+        depth,
+    })
 }
