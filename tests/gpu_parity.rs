@@ -471,3 +471,91 @@ fn clipped_scene_matches_coverage_depth_and_color() {
         );
     }
 }
+
+/// Runs the `stereolab` binary of this build.
+fn stereolab(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(args)
+        .output()
+        .expect("run stereolab")
+}
+
+#[test]
+fn cli_renders_on_the_gpu_and_compares_scenes_and_images() {
+    if gpu().is_none() {
+        return;
+    }
+    let dir = common::out_dir("gpu_cli");
+    let scene = common::asset("scenes/wuson.toml");
+    let (scene, dir_s) = (scene.to_str().expect("utf-8"), dir.to_str().expect("utf-8"));
+    let out = stereolab(&[
+        "render",
+        scene,
+        "--backend",
+        "gpu",
+        "--size",
+        "160x120",
+        "--out",
+        dir_s,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (left, right) = (dir.join("left.png"), dir.join("right.png"));
+    assert!(
+        left.exists() && right.exists(),
+        "the GPU render writes the scene's outputs"
+    );
+
+    let strips = dir.join("strips");
+    let out = stereolab(&[
+        "compare",
+        scene,
+        "--size",
+        "160x120",
+        "--out",
+        strips.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("left pass") && stdout.contains("side_by_side"),
+        "{stdout}"
+    );
+    assert!(strips.join("left_pass.png").exists() && strips.join("side_by_side.png").exists());
+
+    // Two different images: the eyes of a stereo pair differ by their parallax.
+    let (l, r) = (
+        left.to_str().expect("utf-8"),
+        right.to_str().expect("utf-8"),
+    );
+    let out = stereolab(&["compare", l, r]);
+    assert!(
+        !out.status.success(),
+        "left vs right must exceed the default coverage threshold"
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("coverage mismatch %"), "{stderr}");
+    let out = stereolab(&[
+        "compare",
+        l,
+        r,
+        "--threshold",
+        "coverage=100",
+        "--threshold",
+        "psnr=0",
+        "--threshold",
+        "mean=255",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
