@@ -145,9 +145,9 @@ fn compare_scene(scene: &Scene, out: Option<&std::path::Path>) -> Result<Vec<Com
 }
 
 #[cfg(not(feature = "gpu"))]
-fn no_gpu() -> Error {
+fn no_gpu(what: &str) -> Error {
     Error::invalid(
-        "--backend",
+        what,
         "gpu",
         "this stereolab was built without the GPU path: cargo build --release --features gpu",
     )
@@ -155,12 +155,12 @@ fn no_gpu() -> Error {
 
 #[cfg(not(feature = "gpu"))]
 fn render_gpu(_: &Scene, _: &Plan) -> Result<Frame> {
-    Err(no_gpu())
+    Err(no_gpu("--backend"))
 }
 
 #[cfg(not(feature = "gpu"))]
 fn compare_scene(_: &Scene, _: Option<&std::path::Path>) -> Result<Vec<Comparison>> {
-    Err(no_gpu())
+    Err(no_gpu("compare SCENE (CPU against GPU)"))
 }
 
 fn run(cli: Cli) -> Result<()> {
