@@ -11,6 +11,8 @@ pub mod effects;
 pub mod error;
 pub mod figures;
 pub mod framebuffer;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod info;
 pub mod math;
 pub mod output;

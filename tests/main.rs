@@ -7,6 +7,8 @@ mod conformance;
 mod determinism;
 mod finalize;
 mod golden;
+#[cfg(feature = "gpu")]
+mod gpu_parity;
 mod layout;
 mod rig;
 mod sirds;
