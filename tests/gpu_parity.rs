@@ -24,7 +24,7 @@ use stereolab::{Framebuffer, Result};
 use crate::common;
 
 /// The renderer shared by every test (creating a Vulkan device costs about 0.1 s).
-fn gpu() -> Option<&'static GpuRenderer> {
+pub(crate) fn gpu() -> Option<&'static GpuRenderer> {
     static GPU: OnceLock<std::result::Result<GpuRenderer, String>> = OnceLock::new();
     match GPU.get_or_init(|| GpuRenderer::new().map_err(|e| e.to_string())) {
         Ok(r) => Some(r),
