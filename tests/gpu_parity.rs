@@ -558,6 +558,25 @@ fn cli_renders_on_the_gpu_and_compares_scenes_and_images() {
     );
     assert!(strips.join("left_pass.png").exists() && strips.join("side_by_side.png").exists());
 
+    // Finalize outputs are also compared on identical inputs (the CPU eyes into both finalizes).
+    let anaglyph_scene = common::asset("scenes/anaglyph.toml");
+    let out = stereolab(&[
+        "compare",
+        anaglyph_scene.to_str().expect("utf-8"),
+        "--size",
+        "160x120",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    for row in [
+        "anaglyph_dubois (wgsl)",
+        "parallax (wgsl)",
+        "occlusion (wgsl)",
+        "remap_left (wgsl)",
+    ] {
+        assert!(stdout.contains(row), "{row} missing:\n{stdout}");
+    }
+
     // Two different images: the eyes of a stereo pair differ by their parallax.
     let (l, r) = (
         left.to_str().expect("utf-8"),
