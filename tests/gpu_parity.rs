@@ -16,7 +16,7 @@ use stereolab::compare::{Metrics, ascii_map, compare, coverage, write_diff_strip
 use stereolab::gpu::parity::compare_scene;
 use stereolab::gpu::{FullscreenPass, GpuRenderer, GpuScene};
 use stereolab::math::EyeMatrices;
-use stereolab::plan::{Pass, Plan, Shading};
+use stereolab::plan::{Plan, Shading};
 use stereolab::render::render_view;
 use stereolab::scene::{Mesh, Object, Scene};
 use stereolab::{Framebuffer, Result};
@@ -24,7 +24,7 @@ use stereolab::{Framebuffer, Result};
 use crate::common;
 
 /// The renderer shared by every test (creating a Vulkan device costs about 0.1 s).
-fn gpu() -> Option<&'static GpuRenderer> {
+pub(crate) fn gpu() -> Option<&'static GpuRenderer> {
     static GPU: OnceLock<std::result::Result<GpuRenderer, String>> = OnceLock::new();
     match GPU.get_or_init(|| GpuRenderer::new().map_err(|e| e.to_string())) {
         Ok(r) => Some(r),
@@ -329,6 +329,18 @@ const SHIPPED_COVERAGE_PERCENT: f64 = 0.1;
 /// and other Mesa/LLVM versions were not measured.
 const SHIPPED_MAX_CHANNEL_DIFF: u8 = 2;
 
+/// ChromaDepth rows of the shipped scenes (all lit). Measured at 1024×768: mean ≤ 0.00025,
+/// PSNR ≥ 64.6 dB (chromadepth_fault.toml, whose one crease flips 4 pixels); bounds with room
+/// for a few more such pixels.
+const CHROMADEPTH_MEAN_CHANNEL_DIFF: f64 = 0.002;
+/// See [`CHROMADEPTH_MEAN_CHANNEL_DIFF`].
+const CHROMADEPTH_MIN_PSNR: f64 = 55.0;
+
+/// The center pass of a ChromaDepth scene and the outputs made from it.
+fn is_chromadepth(row: &str) -> bool {
+    row == "center pass" || row.starts_with("chromadepth")
+}
+
 #[test]
 fn shipped_scenes_match_coverage_depth_and_color() {
     let Some(r) = gpu() else { return };
@@ -339,31 +351,7 @@ fn shipped_scenes_match_coverage_depth_and_color() {
     );
     for path in scenes {
         let scene = Scene::load(&path, &[]).expect("shipped scene loads");
-        let mut plan = Plan::new(&scene.outputs);
-        if plan
-            .passes
-            .iter()
-            .any(|p| p.shading == Shading::ChromaDepth)
-        {
-            // ChromaDepth shading has no WGSL mirror yet: compare its geometry (coverage and
-            // depth of the same center pass) and none of its outputs.
-            eprintln!(
-                "{}: ChromaDepth shading not mirrored on the GPU yet; comparing the center pass depth-only",
-                path.display()
-            );
-            let passes = plan
-                .passes
-                .iter()
-                .map(|p| Pass {
-                    view: p.view,
-                    shading: Shading::DepthOnly,
-                })
-                .collect();
-            plan = Plan {
-                outputs: Vec::new(),
-                passes,
-            };
-        }
+        let plan = Plan::new(&scene.outputs);
         let rows = compare_scene(r, &scene, &plan, None).expect("both paths render");
         for row in rows {
             let m = row.metrics;
@@ -384,6 +372,20 @@ fn shipped_scenes_match_coverage_depth_and_color() {
                 row.name,
                 m.coverage_mismatch_percent()
             );
+            if is_chromadepth(&row.name) {
+                // Lit ChromaDepth: a crease pixel may show the other face (tests/gpu_finalize.rs
+                // `CREASE_PERCENT`), so the maximum is not bounded there; the mean and PSNR are.
+                assert!(
+                    m.mean_channel_diff <= CHROMADEPTH_MEAN_CHANNEL_DIFF
+                        && m.psnr >= CHROMADEPTH_MIN_PSNR,
+                    "{}: {}: mean {} PSNR {}",
+                    path.display(),
+                    row.name,
+                    m.mean_channel_diff,
+                    m.psnr
+                );
+                continue;
+            }
             assert!(
                 m.max_channel_diff <= SHIPPED_MAX_CHANNEL_DIFF,
                 "{}: {}: max channel difference {}",
@@ -555,6 +557,25 @@ fn cli_renders_on_the_gpu_and_compares_scenes_and_images() {
         "{stdout}"
     );
     assert!(strips.join("left_pass.png").exists() && strips.join("side_by_side.png").exists());
+
+    // Finalize outputs are also compared on identical inputs (the CPU eyes into both finalizes).
+    let anaglyph_scene = common::asset("scenes/anaglyph.toml");
+    let out = stereolab(&[
+        "compare",
+        anaglyph_scene.to_str().expect("utf-8"),
+        "--size",
+        "160x120",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    for row in [
+        "anaglyph_dubois (wgsl)",
+        "parallax (wgsl)",
+        "occlusion (wgsl)",
+        "remap_left (wgsl)",
+    ] {
+        assert!(stdout.contains(row), "{row} missing:\n{stdout}");
+    }
 
     // Two different images: the eyes of a stereo pair differ by their parallax.
     let (l, r) = (

@@ -8,6 +8,8 @@ mod determinism;
 mod finalize;
 mod golden;
 #[cfg(feature = "gpu")]
+mod gpu_finalize;
+#[cfg(feature = "gpu")]
 mod gpu_parity;
 mod layout;
 mod rig;

@@ -12,8 +12,10 @@ use super::readback::Target;
 /// fixed-function state or the shader (see [`crate::raster::RasterOptions`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct PipelineKey {
-    /// Shaded Blinn-Phong (true) or depth only.
+    /// A color stage (Blinn-Phong or ChromaDepth: true) or depth only.
     pub shaded: bool,
+    /// The ChromaDepth program (with its ramp in group 1) instead of Blinn-Phong.
+    pub chromadepth: bool,
     /// Back-face culling.
     pub cull_back: bool,
     /// Perspective-correct varyings (true) or `@interpolate(linear)`.
@@ -29,6 +31,8 @@ pub struct GpuRenderer {
     info: wgpu::AdapterInfo,
     /// Uniform buffer with dynamic offset, shared by the scene pipelines (group 0).
     pub(crate) uniform_layout: wgpu::BindGroupLayout,
+    /// The ChromaDepth ramp's texels as a read-only storage buffer (group 1).
+    pub(crate) ramp_layout: wgpu::BindGroupLayout,
     pub(crate) pipelines: Mutex<HashMap<PipelineKey, wgpu::RenderPipeline>>,
     /// Targets of earlier frames, reused when the size matches (fresh ones cost page faults).
     pub(crate) spare_targets: Mutex<Vec<Target>>,
@@ -77,11 +81,25 @@ impl GpuRenderer {
                 count: None,
             }],
         });
+        let ramp_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("chromadepth ramp"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
         Ok(GpuRenderer {
             device,
             queue,
             info,
             uniform_layout,
+            ramp_layout,
             pipelines: Mutex::new(HashMap::new()),
             spare_targets: Mutex::new(Vec::new()),
         })

@@ -13,16 +13,19 @@
 //! - depth is `Depth32Float`, read back bit for bit.
 //!
 //! Layout: [`device`] (adapter, device, pipeline cache), [`raster`] (scene passes),
-//! [`fullscreen`] (the generic full-screen pass that effects mirror), [`readback`] (textures to
+//! [`fullscreen`] (the generic full-screen pass that effects mirror), [`effects`] (the finalize
+//! effects in WGSL), [`readback`] (textures to
 //! framebuffers), [`parity`] (render both paths and compare, and the benchmark row).
 
 pub mod device;
+pub mod effects;
 pub mod fullscreen;
 pub mod parity;
 pub mod raster;
 mod readback;
 
 pub use device::GpuRenderer;
+pub use effects::GpuFinalize;
 pub use fullscreen::FullscreenPass;
 pub use raster::GpuScene;
 

@@ -1,16 +1,22 @@
-//! Both paths on one scene: `stereolab compare SCENE` and the benchmark's CPU-vs-lavapipe row.
+//! Both paths on one scene: `stereolab compare SCENE` (raster and, on identical inputs, finalize
+//! parity) and the benchmark's CPU-vs-lavapipe row.
 
 use std::path::Path;
 
 use crate::bench::{Row, median_ms};
 use crate::compare::{Comparison, compare, framebuffer_from_image, write_diff_strip};
+use crate::effects::anaglyph;
+use crate::effects::occlusion::occlusion_image;
+use crate::effects::parallax::{ParallaxRig, parallax_image};
+use crate::effects::remap::{Precision, remap_color};
 use crate::error::Result;
 use crate::output::{Image, produce};
-use crate::plan::{Output, Plan};
+use crate::plan::{Output, Plan, View};
 use crate::render::{Frame, render};
 use crate::scene::Scene;
 
 use super::device::GpuRenderer;
+use super::effects::GpuFinalize;
 use super::raster::GpuScene;
 
 /// Outputs that are one pass's framebuffer as it is: compared once, as the pass.
@@ -35,7 +41,74 @@ pub fn compare_scene(
 ) -> Result<Vec<Comparison>> {
     let cpu = render(scene, plan)?;
     let gpu = r.render(&GpuScene::upload(r, scene)?, plan)?;
-    compare_frames(&cpu, &gpu, scene, out)
+    let mut rows = compare_frames(&cpu, &gpu, scene, out)?;
+    rows.extend(compare_finalize(r, &cpu, scene, out)?);
+    Ok(rows)
+}
+
+/// Finalize parity apart from raster parity: every finalize output of the plan (anaglyphs,
+/// remap, occlusion, parallax color) computed from the CPU frame's own eye framebuffers by the
+/// CPU function and by its WGSL mirror ([`GpuFinalize`]). Rows are named `<output> (wgsl)`;
+/// remap and occlusion use `Precision::F32Composed` on both sides, parallax compares the image
+/// area (the legend is tiny-skia's, on the CPU).
+///
+/// # Errors
+/// A finalize function fails on either path, or a strip cannot be written.
+pub fn compare_finalize(
+    r: &GpuRenderer,
+    frame: &Frame,
+    scene: &Scene,
+    out: Option<&Path>,
+) -> Result<Vec<Comparison>> {
+    let (Some(left), Some(right)) = (frame.view(View::Left), frame.view(View::Right)) else {
+        return Ok(Vec::new());
+    };
+    let fin = GpuFinalize::new(r)?;
+    let mvps = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
+    let mut rows = Vec::new();
+    for &o in &frame.plan.outputs {
+        let (cpu, gpu) = match o {
+            Output::Anaglyph(kind) => (
+                anaglyph::anaglyph(left, right, kind, scene.finalize)?,
+                fin.anaglyph(r, left, right, kind, scene.finalize)?,
+            ),
+            Output::RemapLeft | Output::RemapRight => {
+                let k = usize::from(o == Output::RemapRight);
+                let (this, other) = if k == 0 { (left, right) } else { (right, left) };
+                (
+                    remap_color(this, other, mvps[k], mvps[1 - k], Precision::F32Composed)?,
+                    fin.remap_color(r, this, other, mvps[k], mvps[1 - k])?,
+                )
+            }
+            Output::Occlusion => (
+                occlusion_image(left, right, mvps, Precision::F32Composed)?,
+                fin.occlusion_image(r, left, right, mvps)?,
+            ),
+            Output::Parallax => {
+                let rig = ParallaxRig::of_scene(scene)?;
+                let full = parallax_image(left, &rig)?;
+                let cpu = image::imageops::crop_imm(&full, 0, 0, left.width, left.height);
+                (cpu.to_image(), fin.parallax(r, left, &rig)?.1)
+            }
+            _ => continue,
+        };
+        let name = format!("{} (wgsl)", o.name());
+        let (e, a) = (
+            framebuffer_from_image(&cpu, scene.background),
+            framebuffer_from_image(&gpu, scene.background),
+        );
+        let metrics = compare(&e, &a)?;
+        let strip = out
+            .map(|d| write_diff_strip(&e, &a, d, &format!("{}_wgsl", o.name())))
+            .transpose()?;
+        rows.push(Comparison {
+            name,
+            metrics,
+            has_depth: false,
+            strip,
+        });
+    }
+    Ok(rows)
 }
 
 /// Compares two frames of the same plan, as [`compare_scene`] describes.

@@ -3,13 +3,19 @@
 
 use std::time::Instant;
 
+use glam::Mat3;
+
+use crate::effects::chromadepth::TexgenMode;
+use crate::effects::chromadepth::ramp::{Ramp, Sampling};
+use crate::effects::chromadepth::shader::resolve_texgen;
+use crate::effects::chromadepth::texgen::Texgen;
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 use crate::math::{EyeMatrices, StereoRig};
 use crate::plan::{Pass, Plan, Shading, View};
 use crate::raster::{RasterOptions, RasterStats};
 use crate::render::{Frame, PassResult};
-use crate::scene::Scene;
+use crate::scene::{Object, Scene};
 use crate::shade::BlinnPhong;
 
 use super::device::{GpuRenderer, PipelineKey};
@@ -18,12 +24,15 @@ use super::{GL_TO_WGPU_DEPTH, gpu_error};
 
 /// The mirror of [`BlinnPhong`](crate::shade::BlinnPhong).
 const BLINN_PHONG_WGSL: &str = include_str!("shaders/blinn_phong.wgsl");
+/// The mirror of [`ChromaDepthShader`](crate::effects::chromadepth::shader::ChromaDepthShader).
+const CHROMADEPTH_WGSL: &str = include_str!("shaders/chromadepth.wgsl");
 /// The mirror of [`DepthOnly`](crate::shade::DepthOnly).
 const DEPTH_ONLY_WGSL: &str = include_str!("shaders/depth_only.wgsl");
 
 /// Interleaved position + normal, 6 × f32.
 const VERTEX_STRIDE: u64 = 24;
-/// Bytes of the largest uniform block (blinn_phong.wgsl `Uniforms`: 2 mat4, 1 mat3, 3 × 16).
+/// Bytes of the largest uniform block (blinn_phong.wgsl and chromadepth.wgsl `Uniforms`: 2 mat4,
+/// 1 mat3, 3 × 16).
 const UNIFORM_BYTES: u64 = 224;
 
 /// One object's geometry on the GPU.
@@ -180,6 +189,10 @@ impl GpuRenderer {
         let draws = views.len() * s.objects.len();
         let mut uniforms = vec![0u8; (draws as u64 * slot).max(slot) as usize];
         for (v, (m, shading)) in views.iter().enumerate() {
+            // D1/D2 once per view (automatic ones fit a sphere around all of the scene's points).
+            let texgen = (*shading == Shading::ChromaDepth)
+                .then(|| resolve_texgen(s, m, &s.chromadepth))
+                .transpose()?;
             for (k, o) in s.objects.iter().enumerate() {
                 let at = (v * s.objects.len() + k) * slot as usize;
                 let floats = match shading {
@@ -195,12 +208,10 @@ impl GpuRenderer {
                     Shading::DepthOnly => (GL_TO_WGPU_DEPTH * (m.mvp * o.model))
                         .to_cols_array()
                         .to_vec(),
-                    Shading::ChromaDepth => {
-                        return Err(gpu_error(
-                            "render",
-                            "the ChromaDepth pass has no WGSL mirror yet; render it with the CPU backend",
-                        ));
-                    }
+                    Shading::ChromaDepth => match texgen {
+                        Some(texgen) => chromadepth_uniforms(o, m, texgen, s),
+                        None => return Err(gpu_error("chromadepth", "texgen not resolved")),
+                    },
                 };
                 let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_ne_bytes()).collect();
                 uniforms[at..at + bytes.len()].copy_from_slice(&bytes);
@@ -224,6 +235,11 @@ impl GpuRenderer {
                 }),
             }],
         });
+        let ramp_group = views
+            .iter()
+            .any(|(_, shading)| *shading == Shading::ChromaDepth)
+            .then(|| ramp_bind_group(self, s))
+            .transpose()?;
         let targets = views
             .iter()
             .map(|_| Target::take(self, s.width, s.height, DepthKind::DepthBuffer))
@@ -240,7 +256,8 @@ impl GpuRenderer {
         };
         for (v, ((_, shading), target)) in views.iter().zip(&targets).enumerate() {
             let key = PipelineKey {
-                shaded: *shading == Shading::Color,
+                shaded: *shading != Shading::DepthOnly,
+                chromadepth: *shading == Shading::ChromaDepth,
                 cull_back: s.raster.cull_back,
                 perspective_correct: s.raster.perspective_correct,
                 depth_test: s.raster.depth_test,
@@ -279,6 +296,9 @@ impl GpuRenderer {
                 ..Default::default()
             });
             pass.set_pipeline(&pipeline);
+            if let (true, Some(ramp)) = (key.chromadepth, &ramp_group) {
+                pass.set_bind_group(1, ramp, &[]);
+            }
             for (k, mesh) in scene.meshes.iter().enumerate() {
                 let offset = ((v * s.objects.len() + k) as u64 * slot) as u32;
                 pass.set_bind_group(0, &bind_group, &[offset]);
@@ -328,13 +348,69 @@ fn shaded_uniforms(bp: &BlinnPhong) -> Vec<f32> {
     f
 }
 
+/// The floats of chromadepth.wgsl's `Uniforms`, computed as `ChromaDepthShader::new` computes
+/// them (the same glam expressions, so the same bits).
+fn chromadepth_uniforms(o: &Object, m: &EyeMatrices, texgen: Texgen, s: &Scene) -> Vec<f32> {
+    let settings = &s.chromadepth;
+    let modelview = m.view * o.model;
+    let normal_matrix = Mat3::from_mat4(modelview).inverse().transpose();
+    let light_eye = m.view.transform_point3(s.light.position);
+    let mut f = Vec::with_capacity(56);
+    f.extend(modelview.to_cols_array());
+    f.extend((GL_TO_WGPU_DEPTH * m.projection).to_cols_array());
+    for c in [
+        normal_matrix.x_axis,
+        normal_matrix.y_axis,
+        normal_matrix.z_axis,
+    ] {
+        f.extend([c.x, c.y, c.z, 0.0]);
+    }
+    f.extend(light_eye.to_array());
+    f.push(s.light.ambient);
+    f.extend(texgen.plane.to_array());
+    let flags = u32::from(settings.sampling == Sampling::Linear)
+        | (u32::from(settings.texgen == TexgenMode::PerPixel) << 1)
+        | (u32::from(settings.lit) << 2);
+    f.extend([
+        m.projection.z_axis.z,
+        m.projection.w_axis.z,
+        settings.texels as f32,
+        flags as f32,
+    ]);
+    f
+}
+
+/// The scene's ChromaDepth ramp (`Ramp::new`, the CPU's texels) in a storage buffer, bound as
+/// group 1.
+///
+/// # Errors
+/// A bad texel count (as [`Ramp::new`]).
+fn ramp_bind_group(r: &GpuRenderer, s: &Scene) -> Result<wgpu::BindGroup> {
+    let ramp = Ramp::new(s.chromadepth.ramp, s.chromadepth.texels)?;
+    let bytes: Vec<u8> = ramp
+        .texels()
+        .iter()
+        .flat_map(|t| [t.x, t.y, t.z, 1.0])
+        .flat_map(f32::to_ne_bytes)
+        .collect();
+    let buffer = buffer_with(r, "chromadepth ramp", &bytes, wgpu::BufferUsages::STORAGE);
+    Ok(r.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("chromadepth ramp"),
+        layout: &r.ramp_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: buffer.as_entire_binding(),
+        }],
+    }))
+}
+
 /// Builds the render pipeline for a scene pass: triangle list, counter-clockwise front faces
 /// (as the CPU path: counter-clockwise in NDC), depth LESS into `Depth32Float`.
 fn build_scene_pipeline(r: &GpuRenderer, key: PipelineKey) -> wgpu::RenderPipeline {
-    let source = if key.shaded {
-        BLINN_PHONG_WGSL
-    } else {
-        DEPTH_ONLY_WGSL
+    let (source, label) = match (key.shaded, key.chromadepth) {
+        (true, true) => (CHROMADEPTH_WGSL, "chromadepth.wgsl"),
+        (true, false) => (BLINN_PHONG_WGSL, "blinn_phong.wgsl"),
+        (false, _) => (DEPTH_ONLY_WGSL, "depth_only.wgsl"),
     };
     // Affine varyings are the same shader with linear (screen-space) interpolation.
     let source = if key.perspective_correct {
@@ -343,18 +419,15 @@ fn build_scene_pipeline(r: &GpuRenderer, key: PipelineKey) -> wgpu::RenderPipeli
         source.replace("@interpolate(perspective)", "@interpolate(linear)")
     };
     let module = r.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(if key.shaded {
-            "blinn_phong.wgsl"
-        } else {
-            "depth_only.wgsl"
-        }),
+        label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
+    let groups = [Some(&r.uniform_layout), Some(&r.ramp_layout)];
     let layout = r
         .device
         .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("scene"),
-            bind_group_layouts: &[Some(&r.uniform_layout)],
+            bind_group_layouts: &groups[..1 + usize::from(key.chromadepth)],
             immediate_size: 0,
         });
     let attributes = [

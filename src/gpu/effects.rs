@@ -1,0 +1,225 @@
+//! The finalize effects in WGSL: the anaglyph family, parallax color, remap and the
+//! visibility/occlusion classes, each a [`FullscreenPass`] mirroring its CPU function in
+//! `src/effects`. They take framebuffers as input, so feeding them the CPU path's eye
+//! framebuffers compares the effect alone, apart from rasterization (issue 6).
+//!
+//! Every number comes from the CPU modules (matrices from [`AnaglyphKind::matrices`], rig values
+//! from [`ParallaxRig`], colors from `occlusion`, the tolerance from
+//! [`DEPTH_PRECISION`](crate::effects::remap::DEPTH_PRECISION)); the shaders hold formulas only.
+
+use glam::{DMat4, Mat4};
+use image::RgbaImage;
+
+use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions};
+use crate::effects::eye_input::{check_depth, check_same_size};
+use crate::effects::occlusion::{
+    BACKGROUND_COLOR, FARTHER_COLOR, OCCLUDED_COLOR, OUT_OF_VIEW_COLOR,
+};
+use crate::effects::parallax::{PARALLAX_BACKGROUND, ParallaxRig};
+use crate::effects::remap::DEPTH_PRECISION;
+use crate::error::{Error, Result};
+use crate::framebuffer::Framebuffer;
+
+use super::device::GpuRenderer;
+use super::fullscreen::FullscreenPass;
+
+/// The mirror of `anaglyph::anaglyph`.
+const ANAGLYPH_WGSL: &str = include_str!("shaders/anaglyph.wgsl");
+/// The mirror of `parallax::parallax_color` over `parallax_pixels`.
+const PARALLAX_WGSL: &str = include_str!("shaders/parallax.wgsl");
+/// The mirror of `remap_color` and `occlusion_image` (`Precision::F32Composed`).
+const REMAP_WGSL: &str = include_str!("shaders/remap.wgsl");
+
+/// The compiled finalize passes. Build once, run on any framebuffers.
+pub struct GpuFinalize {
+    anaglyph: FullscreenPass,
+    parallax: FullscreenPass,
+    remap: FullscreenPass,
+}
+
+/// An 8-bit color as the shaders' 0..1 floats.
+fn unit_color(c: [u8; 4]) -> [f32; 4] {
+    c.map(|v| v as f32 / 255.0)
+}
+
+/// A framebuffer's color as an image.
+fn image_of(fb: &Framebuffer) -> RgbaImage {
+    fb.to_rgba_image()
+}
+
+/// The nearest and farthest window depth of the drawn pixels (as `occlusion::depth_extremes`):
+/// a reduction over the input, done on the host.
+fn depth_extremes(fb: &Framebuffer) -> (f32, f32) {
+    fb.depth
+        .iter()
+        .filter(|d| **d < 1.0)
+        .fold((1.0f32, 0.0f32), |(lo, hi), d| (lo.min(*d), hi.max(*d)))
+}
+
+impl GpuFinalize {
+    /// Compiles the passes.
+    ///
+    /// # Errors
+    /// A shader that does not compile or validate (naga's message).
+    pub fn new(r: &GpuRenderer) -> Result<GpuFinalize> {
+        Ok(GpuFinalize {
+            anaglyph: FullscreenPass::new(r, "anaglyph.wgsl", ANAGLYPH_WGSL, 2)?,
+            parallax: FullscreenPass::new(r, "parallax.wgsl", PARALLAX_WGSL, 1)?,
+            remap: FullscreenPass::new(r, "remap.wgsl", REMAP_WGSL, 2)?,
+        })
+    }
+
+    /// The anaglyph of two eyes, as [`anaglyph::anaglyph`](crate::effects::anaglyph::anaglyph):
+    /// `clamp(ML · left + MR · right)` on stored values or in linear light, eyes swapped on
+    /// request (the host swaps the inputs, as the CPU function does).
+    ///
+    /// # Errors
+    /// Eyes of different sizes, or a GPU failure.
+    pub fn anaglyph(
+        &self,
+        r: &GpuRenderer,
+        left: &Framebuffer,
+        right: &Framebuffer,
+        kind: AnaglyphKind,
+        options: AnaglyphOptions,
+    ) -> Result<RgbaImage> {
+        check_same_size(left, right)?;
+        let (left, right) = if options.swap_eyes {
+            (right, left)
+        } else {
+            (left, right)
+        };
+        let m = kind.matrices();
+        let mut params = Vec::with_capacity(28);
+        for row in m.left.iter().chain(&m.right) {
+            params.extend([row[0], row[1], row[2], 0.0]);
+        }
+        params.extend([f32::from(u8::from(options.linear_light)), 0.0, 0.0, 0.0]);
+        Ok(image_of(&self.anaglyph.run(r, &[left, right], &params)?))
+    }
+
+    /// Parallax in pixels per pixel of `fb` on the GPU (NaN on the background), and the image
+    /// area of the parallax color image (without the legend bar, which tiny-skia draws on the
+    /// CPU). The color scale is the largest |p| of the GPU's own values (at least ½ pixel,
+    /// as [`color_scale`](crate::effects::parallax::color_scale)): a reduction done on the host
+    /// between two runs of the pass.
+    ///
+    /// # Errors
+    /// A size other than the rig's, a missing or bad depth buffer, or a GPU failure.
+    pub fn parallax(
+        &self,
+        r: &GpuRenderer,
+        fb: &Framebuffer,
+        rig: &ParallaxRig,
+    ) -> Result<(Vec<f32>, RgbaImage)> {
+        if (fb.width, fb.height) != (rig.width, rig.height) {
+            return Err(Error::invalid(
+                "parallax framebuffer",
+                format!("{}x{}", fb.width, fb.height),
+                format!("the rig was resolved for {}x{}", rig.width, rig.height),
+            ));
+        }
+        check_depth("parallax", fb)?;
+        let (n, f, z0) = (rig.near, rig.far, rig.zero_parallax_distance);
+        let k = rig.pixels_per_unit * rig.eye_separation;
+        let a = k * (rig.balance - z0 / n);
+        let b = k * z0 * (f - n) / (n * f);
+        let params = |scale: f32| {
+            let mut p = vec![a as f32, b as f32, scale, 0.0];
+            p.extend(unit_color(PARALLAX_BACKGROUND));
+            p
+        };
+        let first = self.parallax.run(r, &[fb], &params(1.0))?;
+        let scale = first
+            .depth
+            .iter()
+            .filter(|p| !p.is_nan())
+            .fold(0.5f32, |m, p| m.max(p.abs()));
+        let colored = self.parallax.run(r, &[fb], &params(scale))?;
+        Ok((first.depth, image_of(&colored)))
+    }
+
+    /// `this` eye recolored from `other`, as [`remap_color`](crate::effects::remap::remap_color)
+    /// with [`Precision::F32Composed`](crate::effects::remap::Precision::F32Composed).
+    ///
+    /// # Errors
+    /// Different sizes, a missing or bad depth buffer, a singular MVP, or a GPU failure.
+    pub fn remap_color(
+        &self,
+        r: &GpuRenderer,
+        this: &Framebuffer,
+        other: &Framebuffer,
+        this_mvp: &Mat4,
+        other_mvp: &Mat4,
+    ) -> Result<RgbaImage> {
+        check_same_size(this, other)?;
+        check_depth("this", this)?;
+        let params = remap_params(this_mvp, other_mvp, 0.0, (0.0, 1.0))?;
+        Ok(image_of(&self.remap.run(r, &[this, other], &params)?))
+    }
+
+    /// Both eyes' occlusion maps side by side, as
+    /// [`occlusion_image`](crate::effects::occlusion::occlusion_image) with
+    /// `Precision::F32Composed`. The depth extremes that scale the gray are a host reduction.
+    ///
+    /// # Errors
+    /// Different sizes, a missing or bad depth buffer, a singular MVP, or a GPU failure.
+    pub fn occlusion_image(
+        &self,
+        r: &GpuRenderer,
+        left: &Framebuffer,
+        right: &Framebuffer,
+        mvps: [&Mat4; 2],
+    ) -> Result<RgbaImage> {
+        check_same_size(left, right)?;
+        check_depth("left", left)?;
+        check_depth("right", right)?;
+        let eyes = [left, right];
+        let (w, h) = (left.width, left.height);
+        let mut out = RgbaImage::new(2 * w, h);
+        for k in 0..2 {
+            let params = remap_params(mvps[k], mvps[1 - k], 1.0, depth_extremes(eyes[k]))?;
+            let map = self.remap.run(r, &[eyes[k], eyes[1 - k]], &params)?;
+            for y in 0..h {
+                for x in 0..w {
+                    out.put_pixel(k as u32 * w + x, y, image::Rgba(map.pixel(x, y)));
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// remap.wgsl's parameters: `MVP_other · MVP_this⁻¹` composed in f64 and rounded to f32 (as
+/// `Remapper` does for `F32Composed`), the mode, the tolerance, the depth extremes, the colors.
+///
+/// # Errors
+/// `this_mvp` not finite or singular.
+fn remap_params(
+    this_mvp: &Mat4,
+    other_mvp: &Mat4,
+    mode: f32,
+    (near, far): (f32, f32),
+) -> Result<Vec<f32>> {
+    let this64 = this_mvp.as_dmat4();
+    let det = this64.determinant();
+    if !(det.is_finite() && det != 0.0 && other_mvp.is_finite()) {
+        return Err(Error::invalid(
+            "eye matrices",
+            format!("det(MVP) = {det}"),
+            "the eye's MVP must be finite and invertible to unproject its pixels",
+        ));
+    }
+    let composed: DMat4 = other_mvp.as_dmat4() * this64.inverse();
+    let mut p: Vec<f32> = composed.as_mat4().to_cols_array().to_vec();
+    p.extend([mode, DEPTH_PRECISION as f32, near, far]);
+    for c in [
+        BACKGROUND_COLOR,
+        OUT_OF_VIEW_COLOR,
+        OCCLUDED_COLOR,
+        FARTHER_COLOR,
+    ] {
+        p.extend(unit_color(c));
+    }
+    Ok(p)
+}
