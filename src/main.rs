@@ -1,13 +1,14 @@
 //! The `stereolab` command line.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 
 use stereolab::plan::Plan;
 use stereolab::scene::Scene;
-use stereolab::{Error, Result, bench, info, output, render};
+use stereolab::{Error, Result, bench, grade, info, output, render};
 
 #[derive(Parser)]
 #[command(
@@ -38,6 +39,41 @@ enum Command {
         /// Print the plan (which passes run for which outputs) and render nothing.
         #[arg(long)]
         explain: bool,
+        /// Instead of the scene's outputs: the student's exercise (ex1, ex2, ex3) next to the
+        /// reference, as `reference | diff | yours` images.
+        #[arg(long, value_name = "EXERCISE")]
+        exercise: Option<String>,
+        /// With --exercise: the instructor's solution instead of the student's code.
+        #[arg(long, requires = "exercise")]
+        solution: bool,
+        /// With --exercise: the folder holding the exercise crates (default: ./exercises or .).
+        #[arg(long, requires = "exercise")]
+        exercises: Option<PathBuf>,
+    },
+    /// Build and run the student's exercise crates; points table, verdict and hints.
+    Grade {
+        /// ex1, ex2, ex3 or all.
+        exercise: String,
+        /// Also write Gradescope's results.json here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Grade the instructor's solution (the crates' `solution` feature).
+        #[arg(long)]
+        solution: bool,
+        /// The folder holding the exercise crates (default: ./exercises, else .).
+        #[arg(long)]
+        exercises: Option<PathBuf>,
+        /// Time limit per task in seconds (an endless loop costs that task only).
+        #[arg(long, default_value_t = 10.0)]
+        timeout: f64,
+        /// Where failing image checks write `expected | diff | actual`.
+        #[arg(long, default_value = "grade-out")]
+        out: PathBuf,
+    },
+    /// Exercise material.
+    Exercises {
+        #[command(subcommand)]
+        command: ExercisesCommand,
     },
     /// Print the derived cameras and the scene's parallax range.
     Info {
@@ -61,6 +97,27 @@ enum Command {
     },
 }
 
+#[derive(Subcommand)]
+enum ExercisesCommand {
+    /// Write the student handout (stubs, tests, assets, the library with the grader; no
+    /// solutions) to DIR.
+    Export {
+        /// Output folder.
+        dir: PathBuf,
+        /// The stereolab repository (default: . when it has exercises/, else the build's source).
+        #[arg(long)]
+        root: Option<PathBuf>,
+    },
+}
+
+fn parse_timeout(seconds: f64) -> Result<Duration> {
+    if seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0 {
+        Ok(Duration::from_secs_f64(seconds))
+    } else {
+        Err(Error::invalid("--timeout", seconds, "must be between 0 and 3600 seconds"))
+    }
+}
+
 fn parse_size(s: &str) -> Result<(u32, u32)> {
     let bad = || Error::invalid("--size", s, "expected WxH, e.g. 1024x768");
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
@@ -78,11 +135,25 @@ fn run(cli: Cli) -> Result<()> {
             size,
             sets,
             explain,
+            exercise,
+            solution,
+            exercises,
         } => {
             let mut s = Scene::load(&scene, &sets)?;
             if let Some(size) = size {
                 let (w, h) = parse_size(&size)?;
                 s.set_size(w, h)?;
+            }
+            if let Some(name) = exercise {
+                let [ex] = grade::Exercise::parse_list(&name)?[..] else {
+                    return Err(Error::invalid("--exercise", name, "name one exercise: ex1, ex2 or ex3"));
+                };
+                let dir = grade::exercises_dir(exercises)?;
+                let timeout = Duration::from_secs(30);
+                for line in grade::render_exercise(ex, s, &dir, solution, timeout, &out)? {
+                    println!("{line}");
+                }
+                return Ok(());
             }
             let plan = Plan::new(&s.outputs);
             if explain {
@@ -107,6 +178,44 @@ fn run(cli: Cli) -> Result<()> {
             for p in paths {
                 println!("  wrote {}", p.display());
             }
+            Ok(())
+        }
+        Command::Grade {
+            exercise,
+            json,
+            solution,
+            exercises,
+            timeout,
+            out,
+        } => {
+            let opts = grade::GradeOptions {
+                exercises: grade::Exercise::parse_list(&exercise)?,
+                dir: grade::exercises_dir(exercises)?,
+                solution,
+                timeout: parse_timeout(timeout)?,
+                out,
+            };
+            let report = grade::grade(&opts, grade::fixture::grading_scene()?)?;
+            print!("{}", report.text());
+            if let Some(path) = json {
+                let text = serde_json::to_string_pretty(&report.gradescope())
+                    .map_err(|e| Error::io(&path, std::io::Error::other(e)))?;
+                std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+            }
+            Ok(())
+        }
+        Command::Exercises {
+            command: ExercisesCommand::Export { dir, root },
+        } => {
+            let root = root.unwrap_or_else(|| {
+                if Path::new("exercises/ex1_stereo").is_dir() {
+                    PathBuf::from(".")
+                } else {
+                    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                }
+            });
+            grade::export::export(&root, &dir)?;
+            println!("wrote the student handout to {}", dir.display());
             Ok(())
         }
         Command::Info { scene, sets } => {
