@@ -114,7 +114,11 @@ fn parse_timeout(seconds: f64) -> Result<Duration> {
     if seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0 {
         Ok(Duration::from_secs_f64(seconds))
     } else {
-        Err(Error::invalid("--timeout", seconds, "must be between 0 and 3600 seconds"))
+        Err(Error::invalid(
+            "--timeout",
+            seconds,
+            "must be between 0 and 3600 seconds",
+        ))
     }
 }
 
@@ -146,7 +150,11 @@ fn run(cli: Cli) -> Result<()> {
             }
             if let Some(name) = exercise {
                 let [ex] = grade::Exercise::parse_list(&name)?[..] else {
-                    return Err(Error::invalid("--exercise", name, "name one exercise: ex1, ex2 or ex3"));
+                    return Err(Error::invalid(
+                        "--exercise",
+                        name,
+                        "name one exercise: ex1, ex2 or ex3",
+                    ));
                 };
                 let dir = grade::exercises_dir(exercises)?;
                 let timeout = Duration::from_secs(30);

@@ -5,5 +5,6 @@ mod common;
 mod conformance;
 mod determinism;
 mod golden;
+mod grading;
 mod layout;
 mod rig;

@@ -105,10 +105,13 @@ impl Answer for Mat3 {
     }
 }
 
+/// The flattened answer, or the panic message.
+pub type Reply = Result<Vec<f64>, String>;
+
 /// One task an exercise binary can evaluate.
 pub struct Task {
     name: &'static str,
-    run: Box<dyn Fn(&Value) -> Result<Vec<f64>, String>>,
+    run: Box<dyn Fn(&Value) -> Reply>,
 }
 
 /// A task named `name` evaluating `f` on inputs of type `I` (deserialized from the grader's JSON).

@@ -285,7 +285,13 @@ fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
     let reference: Vec<(String, Framebuffer)> = fixture_eye_inputs(fx)
         .into_iter()
         .map(|(eye, l)| {
-            let m = eyes(&setup, &scene.camera, setup.eye_separation, CameraMode::OffAxis, l);
+            let m = eyes(
+                &setup,
+                &scene.camera,
+                setup.eye_separation,
+                CameraMode::OffAxis,
+                l,
+            );
             let fb = render_view(&scene, &m[eye], Shading::Color)
                 .expect("the fixture renders")
                 .0;
@@ -402,9 +408,7 @@ pub fn reference_anaglyph(kind: AnaglyphKind) -> AnaglyphMatrices {
     let right = match kind {
         AnaglyphKind::True => [ZERO3, ZERO3, LUMA],
         AnaglyphKind::Gray => [ZERO3, LUMA, LUMA],
-        AnaglyphKind::Color | AnaglyphKind::HalfColor => {
-            [ZERO3, [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-        }
+        AnaglyphKind::Color | AnaglyphKind::HalfColor => [ZERO3, [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
     };
     AnaglyphMatrices { left, right }
 }
@@ -589,17 +593,33 @@ struct RemapVariant {
 
 fn remap_reference(l: &Mat4, r: &Mat4, uv: [f32; 2], depth: f32, v: RemapVariant) -> Vec<f64> {
     let (l, r) = (l.as_dmat4(), r.as_dmat4());
-    let m: DMat4 = if v.order_swapped { l * r.inverse() } else { r * l.inverse() };
-    let z = if v.depth_as_ndc { depth as f64 } else { 2.0 * depth as f64 - 1.0 };
+    let m: DMat4 = if v.order_swapped {
+        l * r.inverse()
+    } else {
+        r * l.inverse()
+    };
+    let z = if v.depth_as_ndc {
+        depth as f64
+    } else {
+        2.0 * depth as f64 - 1.0
+    };
     let clip = m * DVec4::new(2.0 * uv[0] as f64 - 1.0, 2.0 * uv[1] as f64 - 1.0, z, 1.0);
     if clip.w <= 0.0 {
         return Vec::new();
     }
-    let ndc = if v.no_divide { clip.truncate() } else { clip.truncate() / clip.w };
+    let ndc = if v.no_divide {
+        clip.truncate()
+    } else {
+        clip.truncate() / clip.w
+    };
     if v.ndc_out {
         return ndc.to_array().to_vec();
     }
-    let depth = if v.depth_as_ndc { ndc.z } else { 0.5 * (ndc.z + 1.0) };
+    let depth = if v.depth_as_ndc {
+        ndc.z
+    } else {
+        0.5 * (ndc.z + 1.0)
+    };
     vec![0.5 * (ndc.x + 1.0), 0.5 * (ndc.y + 1.0), depth]
 }
 
@@ -658,9 +678,10 @@ fn remap_task(fx: &Fixture) -> TaskSpec {
         move |answers: &[Option<Vec<f64>>]| {
             let mut fb = canvas.clone();
             for ((x, y, _, _), a) in samples.iter().zip(answers) {
-                let texel = a.as_ref().filter(|a| a.len() == 3).and_then(|a| {
-                    texel_of(a[0], a[1], w, h)
-                });
+                let texel = a
+                    .as_ref()
+                    .filter(|a| a.len() == 3)
+                    .and_then(|a| texel_of(a[0], a[1], w, h));
                 let i = fb.index(*x, *y);
                 fb.color[i] = match texel {
                     Some((tx, ty)) => right.color[right.index(tx, ty)],
@@ -769,7 +790,12 @@ fn fixture_visible_inputs(fx: &Fixture) -> Vec<(u32, u32, VisibleInput)> {
                 [u, v, z] => {
                     let stored = texel_of(*u, *v, w, h)
                         .map_or(1.0, |(tx, ty)| right.depth[right.index(tx, ty)]);
-                    (Some([*u as f32, *v as f32]), *z as f32, stored, FIXTURE_DEPTH_TOLERANCE)
+                    (
+                        Some([*u as f32, *v as f32]),
+                        *z as f32,
+                        stored,
+                        FIXTURE_DEPTH_TOLERANCE,
+                    )
                 }
                 _ => (None, 1.0, 1.0, FIXTURE_DEPTH_TOLERANCE),
             };
@@ -797,13 +823,28 @@ const HIDDEN_COLOR: [u8; 4] = [230, 40, 40, 255];
 fn visible_task(fx: &Fixture) -> TaskSpec {
     let mut inputs: Vec<(String, VisibleInput)> = vec![
         ("behind the right eye".into(), (None, 0.5, 0.5, 1e-3)),
-        ("right of the image".into(), (Some([1.2, 0.5]), 0.5, 0.5, 1e-3)),
-        ("below the image".into(), (Some([0.5, -0.1]), 0.6, 0.6, 1e-3)),
-        ("within tolerance".into(), (Some([0.5, 0.5]), 0.6, 0.6004, 1e-3)),
+        (
+            "right of the image".into(),
+            (Some([1.2, 0.5]), 0.5, 0.5, 1e-3),
+        ),
+        (
+            "below the image".into(),
+            (Some([0.5, -0.1]), 0.6, 0.6, 1e-3),
+        ),
+        (
+            "within tolerance".into(),
+            (Some([0.5, 0.5]), 0.6, 0.6004, 1e-3),
+        ),
         ("occluded".into(), (Some([0.5, 0.5]), 0.6, 0.55, 1e-3)),
-        ("exact, zero tolerance".into(), (Some([0.3, 0.7]), 0.7, 0.7, 0.0)),
+        (
+            "exact, zero tolerance".into(),
+            (Some([0.3, 0.7]), 0.7, 0.7, 0.0),
+        ),
         ("stored farther".into(), (Some([0.3, 0.7]), 0.7, 0.72, 1e-3)),
-        ("just inside, farther within tolerance".into(), (Some([0.3, 0.7]), 0.7, 0.7008, 1e-3)),
+        (
+            "just inside, farther within tolerance".into(),
+            (Some([0.3, 0.7]), 0.7, 0.7008, 1e-3),
+        ),
     ];
     let fixture_inputs = fixture_visible_inputs(fx);
     inputs.extend(
@@ -946,7 +987,11 @@ fn parallax_task() -> TaskSpec {
 fn color_reference(p: f32, max: f32, swapped: bool) -> [f32; 3] {
     let t = (p / max).clamp(-1.0, 1.0);
     let t = if swapped { -t } else { t };
-    if t >= 0.0 { [t, 0.0, 0.0] } else { [0.0, 0.0, -t] }
+    if t >= 0.0 {
+        [t, 0.0, 0.0]
+    } else {
+        [0.0, 0.0, -t]
+    }
 }
 
 fn parallax_color_task(fx: &Fixture) -> TaskSpec {
@@ -969,7 +1014,10 @@ fn parallax_color_task(fx: &Fixture) -> TaskSpec {
             Some((x, y, d * (1.0 - z0 / -p.z)))
         })
         .collect();
-    let max = samples.iter().map(|s| s.2.abs()).fold(f32::MIN_POSITIVE, f32::max);
+    let max = samples
+        .iter()
+        .map(|s| s.2.abs())
+        .fold(f32::MIN_POSITIVE, f32::max);
     let mut canvas = fx.canvas(fx.scene.background);
     canvas.depth = fx.views[0].depth.clone();
     let picture = {
@@ -1028,7 +1076,11 @@ fn parallax_color_task(fx: &Fixture) -> TaskSpec {
                 hint: "clamp p / max_abs to [−1, 1] before it becomes a color",
                 answers: each(&|[p, m]| {
                     let t = p / m;
-                    if t >= 0.0 { [t, 0.0, 0.0] } else { [0.0, 0.0, -t] }
+                    if t >= 0.0 {
+                        [t, 0.0, 0.0]
+                    } else {
+                        [0.0, 0.0, -t]
+                    }
                 }),
             },
         ],

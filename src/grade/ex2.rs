@@ -8,9 +8,9 @@ use serde_json::json;
 
 use super::ex1::{blank, flat};
 use super::fixture::{Fixture, unproject};
-use crate::math::EyeMatrices;
 use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
 use crate::framebuffer::Framebuffer;
+use crate::math::EyeMatrices;
 use crate::shade::to_rgba8;
 
 /// Every task of exercise 2.
@@ -71,7 +71,12 @@ fn ramp_task() -> TaskSpec {
     let strip_ts: Vec<f32> = (0..RAMP_STRIP_WIDTH)
         .map(|x| (x as f32 + 0.5) / RAMP_STRIP_WIDTH as f32)
         .collect();
-    let expected = strip(&strip_ts.iter().map(|t| Some(reference_ramp(*t))).collect::<Vec<_>>());
+    let expected = strip(
+        &strip_ts
+            .iter()
+            .map(|t| Some(reference_ramp(*t)))
+            .collect::<Vec<_>>(),
+    );
     let build = move |answers: &[Option<Vec<f64>>]| {
         vec![Picture {
             name: "hsv_ramp_strip".into(),
@@ -138,10 +143,15 @@ fn ramp_task() -> TaskSpec {
 /// Seed 000's bounding-sphere range of the fixture's objects, seen from the cyclopean eye.
 fn fixture_range(fx: &Fixture) -> [f32; 2] {
     let view = fx.center_matrices.view;
-    let pts: Vec<Vec3> = fx.scene.world_points().map(|p| view.transform_point3(p)).collect();
-    let (lo, hi) = pts.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(a, b), p| {
-        (a.min(*p), b.max(*p))
-    });
+    let pts: Vec<Vec3> = fx
+        .scene
+        .world_points()
+        .map(|p| view.transform_point3(p))
+        .collect();
+    let (lo, hi) = pts.iter().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(a, b), p| (a.min(*p), b.max(*p)),
+    );
     let c = 0.5 * (lo + hi);
     let r = pts.iter().map(|p| p.distance(c)).fold(0.0, f32::max);
     [(-c.z - r).max(fx.scene.camera.near), -c.z + r]
@@ -173,9 +183,8 @@ fn chromadepth_picture(
 fn texgen_task(fx: &Fixture) -> TaskSpec {
     let range = fixture_range(fx);
     let inputs = [[5.0f32, 15.0], [1.0, 20.0], [0.5, 0.75], range];
-    let each = |f: &dyn Fn(f32, f32) -> [f32; 4]| {
-        inputs.iter().map(|[a, b]| flat(&f(*a, *b))).collect()
-    };
+    let each =
+        |f: &dyn Fn(f32, f32) -> [f32; 4]| inputs.iter().map(|[a, b]| flat(&f(*a, *b))).collect();
     let (center, m, bg) = (fx.center.clone(), fx.center_matrices, fx.scene.background);
     let expected = chromadepth_picture(&center, &m, bg, Some(reference_texgen(range[0], range[1])));
     let pictures = move |answers: &[Option<Vec<f64>>]| {

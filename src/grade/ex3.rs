@@ -45,7 +45,12 @@ fn reference_links(depths: &[f32], g: &SirdsGeometry, how: Linking) -> Vec<usize
     let mut same: Vec<usize> = (0..w).collect();
     for x in 0..w {
         let d = disparity(depths[x], g);
-        let s = if how == Linking::Truncated { d.floor() } else { d.round() }.max(0.0) as usize;
+        let s = if how == Linking::Truncated {
+            d.floor()
+        } else {
+            d.round()
+        }
+        .max(0.0) as usize;
         let (left, width) = if how == Linking::FullDisparity {
             (x.checked_sub(s), 2 * s)
         } else {
@@ -117,7 +122,8 @@ fn depth_rows(fx: &Fixture) -> Vec<Vec<f32>> {
 
 /// A deterministic random color per pixel (the "random dot" pattern).
 fn dot(x: usize, y: usize) -> [u8; 4] {
-    let mut h = (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+    let mut h = (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
     h ^= h >> 29;
     h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
     h ^= h >> 32;
@@ -158,15 +164,26 @@ fn link_task(fx: &Fixture) -> TaskSpec {
         ("flat row at 40 px".into(), vec![40.0; 48]),
         (
             "near box (20 px) on a far plane (60 px)".into(),
-            (0..48).map(|x| if (18..30).contains(&x) { 20.0 } else { 60.0 }).collect(),
+            (0..48)
+                .map(|x| if (18..30).contains(&x) { 20.0 } else { 60.0 })
+                .collect(),
         ),
         (
             "narrow near pillar".into(),
-            (0..48).map(|x| if (22..25).contains(&x) { 10.0 } else { 60.0 }).collect(),
+            (0..48)
+                .map(|x| if (22..25).contains(&x) { 10.0 } else { 60.0 })
+                .collect(),
         ),
-        ("ramp 20 → 60 px".into(), (0..48).map(|x| 20.0 + 40.0 * x as f32 / 47.0).collect()),
+        (
+            "ramp 20 → 60 px".into(),
+            (0..48).map(|x| 20.0 + 40.0 * x as f32 / 47.0).collect(),
+        ),
     ];
-    inputs.extend(rows.iter().enumerate().map(|(y, r)| (format!("fixture row {y}"), r.clone())));
+    inputs.extend(
+        rows.iter()
+            .enumerate()
+            .map(|(y, r)| (format!("fixture row {y}"), r.clone())),
+    );
     let each = |how| {
         inputs
             .iter()
@@ -235,9 +252,8 @@ fn direction_task() -> TaskSpec {
         [30.0, 0.3],
         [2.5, 1.5],
     ];
-    let each = |f: &dyn Fn(f32, f32) -> f32| {
-        inputs.iter().map(|[z, p]| vec![f(*z, *p) as f64]).collect()
-    };
+    let each =
+        |f: &dyn Fn(f32, f32) -> f32| inputs.iter().map(|[z, p]| vec![f(*z, *p) as f64]).collect();
     TaskSpec {
         name: "disparity_constant_direction",
         points: 1.0,

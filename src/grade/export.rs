@@ -54,8 +54,8 @@ fn copy_tree(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()>
 /// a shared target folder reuses compiled dependencies), without the workspace and the
 /// repository's own tests.
 fn library_manifest(text: &str, path: &Path) -> Result<String> {
-    let mut table: toml::Table = toml::from_str(text)
-        .map_err(|e| Error::parse(path, None, e.message().to_string()))?;
+    let mut table: toml::Table =
+        toml::from_str(text).map_err(|e| Error::parse(path, None, e.message().to_string()))?;
     table.remove("workspace");
     table.remove("test");
     table.remove("profile");
@@ -74,8 +74,11 @@ pub fn export(root: &Path, dir: &Path) -> Result<()> {
     let manifest = std::fs::read_to_string(&manifest_path).map_err(io(&manifest_path))?;
     let lib = dir.join("stereolab");
     std::fs::create_dir_all(&lib).map_err(io(&lib))?;
-    std::fs::write(lib.join("Cargo.toml"), library_manifest(&manifest, &manifest_path)?)
-        .map_err(io(&lib))?;
+    std::fs::write(
+        lib.join("Cargo.toml"),
+        library_manifest(&manifest, &manifest_path)?,
+    )
+    .map_err(io(&lib))?;
     copy_tree(&root.join("src"), &lib.join("src"), &|_| false)?;
     for asset in ["scenes", "models"] {
         copy_tree(
@@ -86,14 +89,20 @@ pub fn export(root: &Path, dir: &Path) -> Result<()> {
     }
     for f in ["LICENSE", "Cargo.lock"] {
         let from = root.join(f);
-        let to = if f == "Cargo.lock" { dir.join(f) } else { lib.join(f) };
+        let to = if f == "Cargo.lock" {
+            dir.join(f)
+        } else {
+            lib.join(f)
+        };
         std::fs::copy(&from, &to).map_err(io(&from))?;
     }
     let mut members = Vec::new();
     for ex in super::Exercise::ALL {
         let name = ex.crate_name();
         let (from, to) = (root.join("exercises").join(name), dir.join(name));
-        copy_tree(&from, &to, &|p| p.file_name().is_some_and(|n| n == "solution.rs"))?;
+        copy_tree(&from, &to, &|p| {
+            p.file_name().is_some_and(|n| n == "solution.rs")
+        })?;
         for file in ["Cargo.toml", "src/lib.rs"] {
             let p = to.join(file);
             let text = std::fs::read_to_string(&p).map_err(io(&p))?;

@@ -54,7 +54,12 @@ color = [0.6, 0.6, 0.5]
 /// # Errors
 /// Never in practice (the text is a constant); kept as `Result` like every scene load.
 pub fn grading_scene() -> Result<Scene> {
-    Scene::from_toml(GRADING_SCENE, Path::new("<grading scene>"), Path::new("."), &[])
+    Scene::from_toml(
+        GRADING_SCENE,
+        Path::new("<grading scene>"),
+        Path::new("."),
+        &[],
+    )
 }
 
 /// A scene and what the reference renders of it, shared by the tasks' image checks.
@@ -147,7 +152,10 @@ impl Fixture {
 
 /// Texture coordinate (OpenGL: v = 0 at the bottom row) of pixel (x, y)'s center in a w × h image.
 pub fn pixel_uv(w: u32, h: u32, x: u32, y: u32) -> [f32; 2] {
-    [(x as f32 + 0.5) / w as f32, 1.0 - (y as f32 + 0.5) / h as f32]
+    [
+        (x as f32 + 0.5) / w as f32,
+        1.0 - (y as f32 + 0.5) / h as f32,
+    ]
 }
 
 /// Eye-space position (in `m.view`'s space) of a covered pixel of `fb`, rendered with `m`;

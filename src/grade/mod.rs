@@ -113,7 +113,11 @@ pub fn exercises_dir(given: Option<PathBuf>) -> Result<PathBuf> {
     };
     candidates
         .iter()
-        .find(|d| d.join(Exercise::Ex1.crate_name()).join("Cargo.toml").is_file())
+        .find(|d| {
+            d.join(Exercise::Ex1.crate_name())
+                .join("Cargo.toml")
+                .is_file()
+        })
         .cloned()
         .ok_or_else(|| {
             Error::invalid(
@@ -199,9 +203,8 @@ pub fn render_exercise(
 ) -> Result<Vec<String>> {
     let fx = Fixture::new(scene)?;
     let crate_dir = crate_dir(dir, ex)?;
-    let binary = child::build(&crate_dir, ex.crate_name(), solution).map_err(|log| {
-        Error::invalid(ex.crate_name(), "does not compile", log)
-    })?;
+    let binary = child::build(&crate_dir, ex.crate_name(), solution)
+        .map_err(|log| Error::invalid(ex.crate_name(), "does not compile", log))?;
     let mut lines = Vec::new();
     for spec in ex.tasks(&fx) {
         let Some(img) = &spec.image else { continue };

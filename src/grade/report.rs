@@ -31,7 +31,11 @@ impl ExerciseResult {
 
     /// Points to reach: bonus tasks excluded.
     pub fn max(&self) -> f64 {
-        self.tasks.iter().filter(|t| !t.bonus).map(|t| t.points).sum()
+        self.tasks
+            .iter()
+            .filter(|t| !t.bonus)
+            .map(|t| t.points)
+            .sum()
     }
 }
 
@@ -101,7 +105,11 @@ impl Report {
         }
         format!(
             "{}: {why} [graded: {}; rule: ≥ {:.0}% of all points and ≥ {MIN_POINTS_PER_EXERCISE} points in each exercise]",
-            if self.passed() { "PASSED" } else { "NOT PASSED" },
+            if self.passed() {
+                "PASSED"
+            } else {
+                "NOT PASSED"
+            },
             graded.join(", "),
             100.0 * PASS_FRACTION
         )
@@ -160,7 +168,11 @@ impl Report {
             let _ = writeln!(s, "\nTasks that lost points:");
         }
         for t in failing {
-            let _ = writeln!(s, "{} {} ({:.2} / {}):", t.exercise, t.name, t.score, t.points);
+            let _ = writeln!(
+                s,
+                "{} {} ({:.2} / {}):",
+                t.exercise, t.name, t.score, t.points
+            );
             for d in &t.details {
                 let _ = writeln!(s, "  {d}");
             }

@@ -84,11 +84,7 @@ fn check(expected: &[f64], actual: &[f64], tol: &Tolerance) -> Option<String> {
         return None;
     }
     let diff = if expected.len() != actual.len() {
-        format!(
-            "{} numbers instead of {}",
-            actual.len(),
-            expected.len()
-        )
+        format!("{} numbers instead of {}", actual.len(), expected.len())
     } else {
         let (k, d) = expected
             .iter()
@@ -96,7 +92,11 @@ fn check(expected: &[f64], actual: &[f64], tol: &Tolerance) -> Option<String> {
             .map(|(e, a)| (a - e).abs())
             .enumerate()
             .fold((0, 0.0f64), |best, (k, d)| {
-                if d > best.1 || d.is_nan() { (k, d) } else { best }
+                if d > best.1 || d.is_nan() {
+                    (k, d)
+                } else {
+                    best
+                }
             });
         format!("{d:.3e} at element {k}")
     };
@@ -150,7 +150,10 @@ pub fn evaluate(exercise: &'static str, spec: &TaskSpec, run: &Run, out_dir: &Pa
     }
     let failed = n - passed;
     if failed > SHOWN_FAILURES {
-        details.push(format!("… and {} more failing inputs", failed - SHOWN_FAILURES));
+        details.push(format!(
+            "… and {} more failing inputs",
+            failed - SHOWN_FAILURES
+        ));
     }
     if let Some(f) = &run.failure {
         details.push(f.clone());
@@ -163,7 +166,11 @@ pub fn evaluate(exercise: &'static str, spec: &TaskSpec, run: &Run, out_dir: &Pa
             return false;
         }
         let answers: Vec<Option<Vec<f64>>> = (0..img.inputs.len())
-            .map(|k| run.replies.get(n + k).and_then(|r| r.as_ref().ok().cloned()))
+            .map(|k| {
+                run.replies
+                    .get(n + k)
+                    .and_then(|r| r.as_ref().ok().cloned())
+            })
             .collect();
         let built = catch_unwind(AssertUnwindSafe(|| (img.build)(&answers)));
         match built {
@@ -175,7 +182,11 @@ pub fn evaluate(exercise: &'static str, spec: &TaskSpec, run: &Run, out_dir: &Pa
         }
     });
 
-    let frac = if n == 0 { 1.0 } else { passed as f64 / n as f64 };
+    let frac = if n == 0 {
+        1.0
+    } else {
+        passed as f64 / n as f64
+    };
     let raw = match image_passed {
         Some(ok) => (1.0 - IMAGE_SHARE) * frac + IMAGE_SHARE * f64::from(u8::from(ok)),
         None => frac,
@@ -277,7 +288,12 @@ fn check_pictures(
             m.mean_channel_diff,
             m.max_channel_diff
         );
-        match write_diff_strip(&p.expected, &p.actual, out_dir, &format!("{exercise}_{}", p.name)) {
+        match write_diff_strip(
+            &p.expected,
+            &p.actual,
+            out_dir,
+            &format!("{exercise}_{}", p.name),
+        ) {
             Ok(path) => {
                 let _ = write!(line, "; expected | diff | actual: {}", path.display());
             }

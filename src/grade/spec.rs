@@ -36,9 +36,9 @@ impl Tolerance {
     /// Human-readable: `1e-4·|expected| + 1e-6`.
     pub fn describe(&self) -> String {
         match (self.abs, self.rel) {
-            (a, r) if a == 0.0 && r == 0.0 => "exact".to_string(),
-            (a, r) if r == 0.0 => format!("{a:e}"),
-            (a, r) if a == 0.0 => format!("{r:e}·|expected|"),
+            (0.0, 0.0) => "exact".to_string(),
+            (a, 0.0) => format!("{a:e}"),
+            (0.0, r) => format!("{r:e}·|expected|"),
             (a, r) => format!("{r:e}·|expected| + {a:e}"),
         }
     }

@@ -17,14 +17,23 @@ pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
     Mat4::from_cols(
         Vec4::new(2.0 * n / (r - l), 0.0, 0.0, 0.0),
         Vec4::new(0.0, 2.0 * n / (t - b), 0.0, 0.0),
-        Vec4::new((r + l) / (r - l), (t + b) / (t - b), (n + f) / (n - f), -1.0),
+        Vec4::new(
+            (r + l) / (r - l),
+            (t + b) / (t - b),
+            (n + f) / (n - f),
+            -1.0,
+        ),
         Vec4::new(0.0, 0.0, 2.0 * n * f / (n - f), 0.0),
     )
 }
 
 /// −1 for the left eye (index 0), +1 for the right eye.
 fn side(eye: usize) -> f32 {
-    let eye = if planted("swapped-eyes") { 1 - eye } else { eye };
+    let eye = if planted("swapped-eyes") {
+        1 - eye
+    } else {
+        eye
+    };
     if eye == 0 { -1.0 } else { 1.0 }
 }
 
@@ -50,7 +59,12 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
 }
 
 /// View and projection of one eye (seed 004, per-eye or cyclopic lighting).
-pub fn stereo_matrices(setup: &StereoSetup, modelview: Mat4, eye: usize, lighting: Lighting) -> EyeView {
+pub fn stereo_matrices(
+    setup: &StereoSetup,
+    modelview: Mat4,
+    eye: usize,
+    lighting: Lighting,
+) -> EyeView {
     let [l, r, b, t, n, f] = stereo_frustum(setup, eye);
     let p = frustum(l, r, b, t, n, f);
     let half = half_separation(setup);
@@ -64,7 +78,10 @@ pub fn stereo_matrices(setup: &StereoSetup, modelview: Mat4, eye: usize, lightin
         Mat4::from_translation(Vec3::new(-side(eye) * half, 0.0, 0.0)) * modelview
     };
     match lighting {
-        Lighting::PerEye => EyeView { view: eye_view, projection: p },
+        Lighting::PerEye => EyeView {
+            view: eye_view,
+            projection: p,
+        },
         Lighting::Cyclopic => EyeView {
             view: modelview,
             projection: p * eye_view * modelview.inverse(),
@@ -88,12 +105,13 @@ pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
     let right = match kind {
         AnaglyphKind::True => [ZERO, ZERO, LUMA],
         AnaglyphKind::Gray => [ZERO, LUMA, LUMA],
-        AnaglyphKind::Color | AnaglyphKind::HalfColor => {
-            [ZERO, [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-        }
+        AnaglyphKind::Color | AnaglyphKind::HalfColor => [ZERO, [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
     };
     if planted("transposed-anaglyph") {
-        AnaglyphMatrices { left: transposed(left), right: transposed(right) }
+        AnaglyphMatrices {
+            left: transposed(left),
+            right: transposed(right),
+        }
     } else {
         AnaglyphMatrices { left, right }
     }
@@ -117,19 +135,32 @@ pub fn dubois_matrices() -> AnaglyphMatrices {
 
 /// Seed 004's remapping through `MVP_r · MVP_l⁻¹`.
 pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) -> Option<Vec3> {
-    let z_ndc = if planted("opengl-depth") { depth_left } else { 2.0 * depth_left - 1.0 };
+    let z_ndc = if planted("opengl-depth") {
+        depth_left
+    } else {
+        2.0 * depth_left - 1.0
+    };
     let ndc_left = (2.0 * uv_left - Vec2::ONE).extend(z_ndc).extend(1.0);
     let clip = mvp_right * mvp_left.inverse() * ndc_left;
     if clip.w <= 0.0 {
         return None;
     }
     let ndc = clip.truncate() / clip.w;
-    let depth = if planted("opengl-depth") { ndc.z } else { 0.5 * (ndc.z + 1.0) };
+    let depth = if planted("opengl-depth") {
+        ndc.z
+    } else {
+        0.5 * (ndc.z + 1.0)
+    };
     Some(Vec3::new(0.5 * (ndc.x + 1.0), 0.5 * (ndc.y + 1.0), depth))
 }
 
 /// Seed 004's visibility check.
-pub fn visible(uv_right: Option<Vec2>, remapped_depth: f32, stored_depth: f32, tolerance: f32) -> bool {
+pub fn visible(
+    uv_right: Option<Vec2>,
+    remapped_depth: f32,
+    stored_depth: f32,
+    tolerance: f32,
+) -> bool {
     let Some(uv) = uv_right else { return false };
     let inside = (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y);
     inside && (stored_depth - remapped_depth).abs() <= tolerance
@@ -150,5 +181,9 @@ pub fn parallax(z: f32, zero_parallax: f32, eye_separation: f32) -> f32 {
 /// Red for positive, blue for negative parallax.
 pub fn parallax_color(p: f32, max_abs: f32) -> [f32; 3] {
     let t = (p / max_abs).clamp(-1.0, 1.0);
-    if t >= 0.0 { [t, 0.0, 0.0] } else { [0.0, 0.0, -t] }
+    if t >= 0.0 {
+        [t, 0.0, 0.0]
+    } else {
+        [0.0, 0.0, -t]
+    }
 }

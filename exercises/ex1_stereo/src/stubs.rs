@@ -109,7 +109,9 @@ pub fn visible(
     tolerance: f32,
 ) -> bool {
     // TODO: out of the image → false; then compare the depths.
-    todo!("visible? uv {uv_right:?}, remapped {remapped_depth:?}, stored {stored_depth:?}, tolerance {tolerance:?}")
+    todo!(
+        "visible? uv {uv_right:?}, remapped {remapped_depth:?}, stored {stored_depth:?}, tolerance {tolerance:?}"
+    )
 }
 
 /// Task `parallax` (1 point): the screen parallax of a point at eye distance `z`.

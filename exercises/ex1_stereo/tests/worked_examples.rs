@@ -15,7 +15,10 @@ fn seed003() -> (StereoSetup, Mat4) {
         eye_separation: 1.0,
         zero_parallax: 9.0,
     };
-    (setup, look_at(Vec3::new(0.0, 0.0, 9.0), Vec3::ZERO, Vec3::Y))
+    (
+        setup,
+        look_at(Vec3::new(0.0, 0.0, 9.0), Vec3::ZERO, Vec3::Y),
+    )
 }
 
 #[test]
@@ -47,7 +50,10 @@ fn frustum_maps_near_to_minus_one_and_far_to_plus_one() {
 #[test]
 fn point_on_the_screen_has_zero_parallax() {
     assert!(ex1_stereo::parallax(5.0, 5.0, 0.3).abs() < 1e-6);
-    assert!(ex1_stereo::parallax(2.0, 5.0, 0.3) < 0.0, "in front of the screen is negative");
+    assert!(
+        ex1_stereo::parallax(2.0, 5.0, 0.3) < 0.0,
+        "in front of the screen is negative"
+    );
 }
 
 #[test]

@@ -9,7 +9,9 @@ use stereolab::exercise::{serve, task};
 fn main() -> ExitCode {
     serve(vec![
         task("hsv_ramp", ex2_chromadepth::hsv_ramp),
-        task("texgen", |[d1, d2]: [f32; 2]| ex2_chromadepth::texgen(d1, d2)),
+        task("texgen", |[d1, d2]: [f32; 2]| {
+            ex2_chromadepth::texgen(d1, d2)
+        }),
         task("depth_range", |(c, r): ([f32; 3], f32)| {
             ex2_chromadepth::depth_range(Vec3::from(c), r)
         }),

@@ -5,7 +5,10 @@ fn seed000_texgen_for_d1_5_d2_15() {
     // Seed 000's sample code: D1 = 5, D2 = 15 → { 0, 0, -1/10, -5/10 }.
     let p = ex2_chromadepth::texgen(5.0, 15.0);
     let want = [0.0, 0.0, -0.1, -0.5];
-    assert!(p.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6), "{p:?}");
+    assert!(
+        p.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6),
+        "{p:?}"
+    );
 }
 
 #[test]

@@ -24,7 +24,9 @@ pub fn link_row(depths: &[f32], geometry: &SirdsGeometry) -> Vec<usize> {
     let w = depths.len();
     let mut same: Vec<usize> = (0..w).collect();
     for x in 0..w {
-        let s = disparity_constant_eyes(depths[x], geometry).round().max(0.0) as usize;
+        let s = disparity_constant_eyes(depths[x], geometry)
+            .round()
+            .max(0.0) as usize;
         let (left, width) = if planted("full-disparity") {
             (x.checked_sub(s), 2 * s)
         } else {

@@ -45,5 +45,8 @@ pub fn disparity_constant_eyes(z: f32, geometry: &SirdsGeometry) -> f32 {
 ///    ```
 pub fn link_row(depths: &[f32], geometry: &SirdsGeometry) -> Vec<usize> {
     // TODO: the three steps above.
-    todo!("links of a row of {} depths with {geometry:?}: {depths:?}", depths.len())
+    todo!(
+        "links of a row of {} depths with {geometry:?}: {depths:?}",
+        depths.len()
+    )
 }

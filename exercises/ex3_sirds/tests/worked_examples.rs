@@ -5,11 +5,14 @@ use stereolab::exercise::SirdsGeometry;
 #[test]
 fn flat_row_links_every_pixel_to_the_one_s_to_its_right() {
     // a = 60, f = 240, z = 60 → d = 60·60/300 = 12 pixels.
-    let g = SirdsGeometry { eye_distance: 60.0, focal_length: 240.0 };
+    let g = SirdsGeometry {
+        eye_distance: 60.0,
+        focal_length: 240.0,
+    };
     assert!((ex3_sirds::disparity_constant_eyes(60.0, &g) - 12.0).abs() < 1e-5);
     let same = ex3_sirds::link_row(&[60.0; 40], &g);
-    for x in 0..28 {
-        assert_eq!(same[x], x + 12, "pixel {x}");
+    for (x, partner) in same.iter().enumerate().take(28) {
+        assert_eq!(*partner, x + 12, "pixel {x}");
     }
 }
 
