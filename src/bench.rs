@@ -84,6 +84,10 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     rows.extend(stereo_pair(&scene, opts.iterations)?);
     rows.extend(subpixel_bits(&scene, opts.iterations)?);
     rows.extend(perspective_correction(opts.iterations)?);
+    rows.extend(crate::effects::chromadepth::bench::rows(
+        &scene,
+        opts.iterations,
+    )?);
     Ok(rows)
 }
 

@@ -2,9 +2,12 @@
 
 use crate::error::{Error, Result};
 
-/// Largest image side we accept; refusing earlier than allocation keeps absurd sizes from
-/// asking for gigabytes (16384² RGBA + f32 depth is 2 GiB, the most we allow).
+/// Largest image side we accept.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// Largest pixel count we accept (8192², 512 MiB of color + depth per framebuffer): checked
+/// before anything is allocated, so an absurd size never asks for gigabytes.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 
 /// An RGBA8 color buffer and an f32 depth buffer in [0, 1] (1 = far plane), row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,6 +95,14 @@ pub fn check_size(width: u32, height: u32) -> Result<()> {
                 format!("must be at most {MAX_IMAGE_SIDE} pixels"),
             ));
         }
+    }
+    let pixels = width as u64 * height as u64;
+    if pixels > MAX_IMAGE_PIXELS {
+        return Err(Error::invalid(
+            "image size",
+            format!("{width}x{height}"),
+            format!("{pixels} pixels, more than the {MAX_IMAGE_PIXELS} accepted"),
+        ));
     }
     Ok(())
 }

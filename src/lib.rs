@@ -10,6 +10,7 @@ pub mod compare;
 pub mod effects;
 pub mod error;
 pub mod exercise;
+pub mod figures;
 pub mod framebuffer;
 pub mod grade;
 pub mod info;

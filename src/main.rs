@@ -83,6 +83,14 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
     },
+    /// Draw the slides' figures (rig top views, parallax plot) for a scene.
+    Figures {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Output folder.
+        #[arg(long, default_value = "slides/figures")]
+        out: PathBuf,
+    },
     /// Measure accuracy knobs and speed: error and time side by side.
     Bench {
         /// Also write the rows as CSV.
@@ -229,6 +237,13 @@ fn run(cli: Cli) -> Result<()> {
         Command::Info { scene, sets } => {
             let s = Scene::load(&scene, &sets)?;
             print!("{}", info::describe(&s)?);
+            Ok(())
+        }
+        Command::Figures { scene, out } => {
+            let s = Scene::load(&scene, &[])?;
+            for p in stereolab::figures::write_all(&s, &out)? {
+                println!("wrote {}", p.display());
+            }
             Ok(())
         }
         Command::Bench {

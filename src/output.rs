@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::effects::layout;
+use crate::effects::{chromadepth, layout};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::plan::{Output, View};
@@ -81,6 +81,12 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             eye(View::Right)?,
             |x, y| (x + y) % 2 == 0,
         )?),
+        Output::ChromaDepth
+        | Output::ChromaDepthLeft
+        | Output::ChromaDepthRight
+        | Output::ChromaDepthAnaglyph => {
+            Image::Rgba(chromadepth::produce(output, frame, &scene.chromadepth)?.to_rgba_image())
+        }
     })
 }
 

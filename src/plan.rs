@@ -31,6 +31,14 @@ pub enum Output {
     InterlacedColumns,
     /// Left where x + y is even, right elsewhere (DLP checkerboard).
     Checkerboard,
+    /// Seed 000's ChromaDepth image: depth as a red → green → blue ramp, one center-eye pass.
+    ChromaDepth,
+    /// The left eye's view of the ChromaDepth image through the glasses (simulated).
+    ChromaDepthLeft,
+    /// The right eye's view of the ChromaDepth image through the glasses (simulated).
+    ChromaDepthRight,
+    /// Both simulated views as a red–cyan anaglyph, for viewers without ChromaDepth glasses.
+    ChromaDepthAnaglyph,
 }
 
 /// Which camera a pass renders from.
@@ -51,6 +59,8 @@ pub enum Shading {
     DepthOnly,
     /// Shaded color (and depth).
     Color,
+    /// ChromaDepth: color from the depth ramp (and depth), seed 000.
+    ChromaDepth,
 }
 
 /// One rasterization pass over the whole scene.
@@ -76,6 +86,10 @@ impl Output {
         Output::InterlacedRows,
         Output::InterlacedColumns,
         Output::Checkerboard,
+        Output::ChromaDepth,
+        Output::ChromaDepthLeft,
+        Output::ChromaDepthRight,
+        Output::ChromaDepthAnaglyph,
     ];
 
     /// The name used in scene files and for the PNG written.
@@ -92,6 +106,10 @@ impl Output {
             Output::InterlacedRows => "interlaced_rows",
             Output::InterlacedColumns => "interlaced_columns",
             Output::Checkerboard => "checkerboard",
+            Output::ChromaDepth => "chromadepth",
+            Output::ChromaDepthLeft => "chromadepth_left",
+            Output::ChromaDepthRight => "chromadepth_right",
+            Output::ChromaDepthAnaglyph => "chromadepth_anaglyph",
         }
     }
 
@@ -129,13 +147,22 @@ impl Output {
             Output::Right => vec![color(View::Right)],
             Output::LeftDepth => vec![depth(View::Left)],
             Output::RightDepth => vec![depth(View::Right)],
+            // One center pass, no stereo pair: the glasses make the pair (seed 000).
+            Output::ChromaDepth
+            | Output::ChromaDepthLeft
+            | Output::ChromaDepthRight
+            | Output::ChromaDepthAnaglyph => vec![Pass {
+                view: View::Center,
+                shading: Shading::ChromaDepth,
+            }],
             _ => vec![color(View::Left), color(View::Right)],
         }
     }
 }
 
 /// The passes a set of outputs needs. A color pass also produces depth, so a depth-only pass of
-/// the same view is dropped when a color pass of it runs anyway.
+/// the same view is dropped when a color pass of it runs anyway; two different shadings of one
+/// view (e.g. Blinn-Phong and ChromaDepth) stay separate passes.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Plan {
     /// Requested outputs, deduplicated, in request order.
@@ -156,10 +183,14 @@ impl Plan {
         let mut passes: Vec<Pass> = uniq.iter().flat_map(|o| o.needs()).collect();
         passes.sort();
         passes.dedup();
-        // Keep the strongest shading per view (Color > DepthOnly).
+        // Fold depth-only passes into a shaded pass of the same view.
         let mut merged: Vec<Pass> = Vec::new();
         for p in passes {
-            match merged.iter_mut().find(|m| m.view == p.view) {
+            let absorbs = |m: &Pass| {
+                m.view == p.view
+                    && (m.shading == Shading::DepthOnly || p.shading == Shading::DepthOnly)
+            };
+            match merged.iter_mut().find(|m| absorbs(m)) {
                 Some(m) => m.shading = m.shading.max(p.shading),
                 None => merged.push(p),
             }
@@ -182,7 +213,12 @@ impl Plan {
             let users: Vec<&str> = self
                 .outputs
                 .iter()
-                .filter(|o| o.needs().iter().any(|n| n.view == p.view))
+                .filter(|o| {
+                    o.needs().iter().any(|n| {
+                        n.view == p.view
+                            && (n.shading == p.shading || n.shading == Shading::DepthOnly)
+                    })
+                })
                 .map(|o| o.name())
                 .collect();
             let _ = writeln!(
@@ -207,5 +243,6 @@ fn shading_name(s: Shading) -> &'static str {
     match s {
         Shading::Color => "color + depth (shaded)",
         Shading::DepthOnly => "depth only (no shading)",
+        Shading::ChromaDepth => "ChromaDepth ramp + depth (texgen)",
     }
 }

@@ -92,7 +92,7 @@ pub fn render(scene: &Scene, plan: &Plan) -> Result<Frame> {
     })
 }
 
-/// Renders the whole scene once from `m`: shaded Blinn-Phong, or depth only.
+/// Renders the whole scene once from `m`: shaded Blinn-Phong, ChromaDepth, or depth only.
 ///
 /// # Errors
 /// An image size refused by [`Framebuffer::new`].
@@ -101,6 +101,9 @@ pub fn render_view(
     m: &EyeMatrices,
     shading: Shading,
 ) -> Result<(Framebuffer, RasterStats)> {
+    if shading == Shading::ChromaDepth {
+        return crate::effects::chromadepth::shader::render_center(scene, m);
+    }
     let mut fb = Framebuffer::new(scene.width, scene.height, scene.background)?;
     let mut total = RasterStats::default();
     for o in &scene.objects {
@@ -124,7 +127,7 @@ pub fn render_view(
                     &scene.raster,
                 )
             }
-            Shading::DepthOnly => {
+            Shading::DepthOnly | Shading::ChromaDepth => {
                 let shader = DepthOnly {
                     positions: &mesh.positions,
                     mvp: m.mvp * o.model,

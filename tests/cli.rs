@@ -183,6 +183,10 @@ fn bad_scene_values_name_the_field_and_value() {
             &["image.width = 100000", "at most 16384"],
         ),
         (&["--size", "12by7"], &["--size = 12by7"]),
+        (
+            &["--size", "16000x16000"],
+            &["image size = 16000x16000", "pixels"],
+        ),
         (&["--set", "camera.near=0"], &["camera.near = 0"]),
         (&["--set", "camera.far=0.5"], &["camera.far = 0.5"]),
         (
@@ -250,4 +254,24 @@ fn scene_syntax_errors_and_unknown_fields_give_the_line() {
     );
     let err = fails(&["render", dir.join("nope.toml").to_str().unwrap()]);
     assert!(err.contains("nope.toml"), "{err}");
+}
+
+#[test]
+fn figures_draws_both_eyes_frusta_and_the_plot() {
+    let dir = out_dir("cli_figures");
+    let out = stereolab(&["figures", &wuson(), "--out", dir.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let top = image::open(dir.join("rig_off_axis.png"))
+        .unwrap()
+        .to_rgba8();
+    let has = |rgb: [u8; 3]| top.pixels().any(|p| p.0[..3] == rgb);
+    assert!(
+        has([220, 40, 40]) && has([20, 170, 200]),
+        "left (red) and right (cyan) frusta must both be drawn"
+    );
+    assert!(dir.join("parallax_vs_depth.png").exists() && dir.join("rig_toe_in.png").exists());
 }

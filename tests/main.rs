@@ -1,5 +1,6 @@
 //! One integration-test binary (tiny-skia's layout): `mod` per area.
 
+mod chromadepth;
 mod cli;
 mod common;
 mod conformance;
@@ -8,3 +9,4 @@ mod golden;
 mod grading;
 mod layout;
 mod rig;
+mod stability;

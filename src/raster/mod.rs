@@ -8,7 +8,12 @@ mod clip;
 mod setup;
 
 pub use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
-pub use setup::{WindowVertex, rasterize_window_triangle, snap};
+pub use setup::{
+    Band, Setup, SetupTriangle, WindowVertex, rasterize_window_triangle, setup_triangle, snap,
+    traverse,
+};
+
+use rayon::prelude::*;
 
 use crate::framebuffer::Framebuffer;
 use crate::shade::{Shader, Varyings};
@@ -52,7 +57,15 @@ pub struct RasterStats {
     pub fragments: usize,
 }
 
+/// Rows per band when a pass is split across threads. Each band sees every triangle in
+/// submission order, so the result is the same for any number of threads.
+pub const BAND_ROWS: usize = 32;
+
 /// Rasterizes `triangles` (indices into the shader's vertices) into `fb`.
+///
+/// Vertex stage and setup run once; traversal runs in parallel over bands of [`BAND_ROWS`]
+/// rows, each band applying the triangles in order, so the bytes never depend on the thread
+/// count.
 pub fn rasterize<S: Shader>(
     triangles: &[[u32; 3]],
     vertex_count: usize,
@@ -60,6 +73,44 @@ pub fn rasterize<S: Shader>(
     fb: &mut Framebuffer,
     opts: &RasterOptions,
 ) -> RasterStats {
+    let (setups, mut stats) = setup_all(triangles, vertex_count, shader, fb.width, fb.height, opts);
+    let width = fb.width as usize;
+    stats.fragments = fb
+        .color
+        .par_chunks_mut(width * BAND_ROWS)
+        .zip(fb.depth.par_chunks_mut(width * BAND_ROWS))
+        .enumerate()
+        .map(|(b, (color, depth))| {
+            let y0 = (b * BAND_ROWS) as u32;
+            let y1 = y0 + (depth.len() / width) as u32 - 1;
+            let mut band = Band {
+                width: fb.width,
+                y0,
+                color,
+                depth,
+            };
+            setups
+                .iter()
+                .filter(|t| {
+                    let (r0, r1) = t.rows();
+                    r0 <= y1 && r1 >= y0
+                })
+                .map(|t| traverse(t, shader, &mut band, opts))
+                .sum::<usize>()
+        })
+        .sum();
+    stats
+}
+
+/// Vertex stage, clipping, perspective divide and triangle setup for every triangle, in order.
+fn setup_all<S: Shader>(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    shader: &S,
+    width: u32,
+    height: u32,
+    opts: &RasterOptions,
+) -> (Vec<SetupTriangle>, RasterStats) {
     let nvar = shader.varying_count().min(crate::shade::MAX_VARYINGS);
     // Vertex stage, once per vertex (a post-transform cache, like a GPU's).
     let verts: Vec<ClipVertex> = (0..vertex_count as u32)
@@ -73,6 +124,7 @@ pub fn rasterize<S: Shader>(
         triangles: triangles.len(),
         ..Default::default()
     };
+    let mut setups = Vec::with_capacity(triangles.len());
     let blank = ClipVertex {
         pos: glam::Vec4::ZERO,
         var: [0.0; crate::shade::MAX_VARYINGS],
@@ -105,24 +157,28 @@ pub fn rasterize<S: Shader>(
             clip_triangle(t, nvar, &mut poly)
         };
         for k in 0..n {
-            win[k] = WindowVertex::from_clip(&poly[k], fb.width, fb.height);
+            win[k] = WindowVertex::from_clip(&poly[k], width, height);
         }
         // The clipped polygon is convex: draw it as a fan around its first vertex.
+        let mut culled = false;
         for k in 1..n.saturating_sub(1) {
             let (Some(a), Some(b), Some(c)) = (win[0], win[k], win[k + 1]) else {
                 continue;
             };
-            let r = rasterize_window_triangle(
+            match setup_triangle(
                 [a, b, c],
                 [&poly[0].var, &poly[k].var, &poly[k + 1].var],
                 nvar,
-                shader,
-                fb,
+                width,
+                height,
                 opts,
-            );
-            stats.culled += r.culled;
-            stats.fragments += r.fragments;
+            ) {
+                Setup::Triangle(t) => setups.push(*t),
+                Setup::Culled => culled = true,
+                Setup::Empty => {}
+            }
         }
+        stats.culled += culled as usize;
     }
-    stats
+    (setups, stats)
 }

@@ -29,11 +29,19 @@ impl WindowVertex {
             return None;
         }
         let (hw, hh) = (width as f32 * 0.5, height as f32 * 0.5);
+        let inv_w = 1.0 / p.w;
+        if !inv_w.is_finite() {
+            return None; // w so small its reciprocal overflows: nothing sensible to draw
+        }
+        // After clipping |x|, |y|, |z| ≤ w holds mathematically; with extreme magnitudes the
+        // intersection rounding can leave a vertex far outside. Clamping NDC to [−1, 1] changes
+        // no sample point inside the viewport and keeps the fixed-point math from overflowing.
+        let ndc = |c: f32| (c / p.w).clamp(-1.0, 1.0);
         Some(WindowVertex {
-            x: (p.x / p.w) * hw + hw,
-            y: (p.y / p.w) * -hh + hh,
-            z: (p.z / p.w) * 0.5 + 0.5,
-            inv_w: 1.0 / p.w,
+            x: ndc(p.x) * hw + hw,
+            y: ndc(p.y) * -hh + hh,
+            z: ndc(p.z) * 0.5 + 0.5,
+            inv_w,
         })
     }
 }
@@ -45,34 +53,66 @@ pub fn snap(coord: f32, bits: u32) -> i64 {
     ((coord - 0.5) * (1u32 << bits) as f32).round_ties_even() as i64
 }
 
-/// What one window-space triangle did.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct TriangleStats {
-    /// 1 when back-face culling removed it.
-    pub culled: usize,
-    /// Fragments that passed the depth test.
-    pub fragments: usize,
-}
-
 /// A linear function of window position, `a0 + dadx (x − x0) + dady (y − y0)`.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 struct Plane {
     a0: f32,
     dadx: f32,
     dady: f32,
 }
 
-/// Rasterizes one window-space triangle: coverage from the snapped fixed-point edge functions,
-/// depth and varyings from float plane equations evaluated at pixel centers.
-pub fn rasterize_window_triangle<S: Shader>(
+impl Plane {
+    #[inline]
+    fn at(&self, fx: f32, fy: f32) -> f32 {
+        self.a0 + self.dadx * fx + self.dady * fy
+    }
+}
+
+/// A triangle after setup: fixed-point edge functions, its pixel bounds, and the attribute
+/// planes. Traversal needs nothing else, so one setup serves every band of rows.
+#[derive(Clone, Debug)]
+pub struct SetupTriangle {
+    c: [i64; 3],
+    dcdx: [i64; 3],
+    dcdy: [i64; 3],
+    bits: u32,
+    /// Pixel bounds, inclusive, clamped to the target.
+    px0: i64,
+    px1: i64,
+    py0: i64,
+    py1: i64,
+    front_facing: bool,
+    /// Window position of vertex 0: the planes' origin.
+    x0: f32,
+    y0: f32,
+    z: Plane,
+    inv_w: Plane,
+    var: [Plane; MAX_VARYINGS],
+    nvar: usize,
+}
+
+/// The outcome of [`setup_triangle`].
+#[derive(Clone, Debug)]
+pub enum Setup {
+    /// Covers no sample point (zero area on the grid, outside the target, degenerate).
+    Empty,
+    /// Back-facing and culled.
+    Culled,
+    /// Ready to traverse.
+    Triangle(Box<SetupTriangle>),
+}
+
+/// Triangle setup: snap to the subpixel grid, orient, build the edge functions with the
+/// top-left tie-break, clamp the bounds to a `width`×`height` target, and build the attribute
+/// planes from the float window positions (as llvmpipe's coefficient setup does).
+pub fn setup_triangle(
     v: [WindowVertex; 3],
     var: [&Varyings; 3],
     nvar: usize,
-    shader: &S,
-    fb: &mut Framebuffer,
+    width: u32,
+    height: u32,
     opts: &RasterOptions,
-) -> TriangleStats {
-    let mut stats = TriangleStats::default();
+) -> Setup {
     let bits = opts.subpixel_bits.clamp(1, 16);
     let (mut xs, mut ys) = ([0i64; 3], [0i64; 3]);
     for i in 0..3 {
@@ -81,13 +121,12 @@ pub fn rasterize_window_triangle<S: Shader>(
     }
     let area = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (xs[2] - xs[0]) * (ys[1] - ys[0]);
     if area == 0 {
-        return stats; // zero area on the grid: draws nothing
+        return Setup::Empty; // zero area on the grid: draws nothing
     }
     // Counter-clockwise in NDC (y up) is a negative area in window space (y down).
     let front_facing = area < 0;
     if opts.cull_back && !front_facing {
-        stats.culled = 1;
-        return stats;
+        return Setup::Culled;
     }
     if area > 0 {
         xs.swap(1, 2);
@@ -110,30 +149,26 @@ pub fn rasterize_window_triangle<S: Shader>(
     }
     let s = 1i64 << bits;
     let ceil_div = |a: i64| a.div_euclid(s) + (a.rem_euclid(s) != 0) as i64;
-    let px0 = ceil_div(*xs.iter().min().unwrap_or(&0)).max(0);
-    let py0 = ceil_div(*ys.iter().min().unwrap_or(&0)).max(0);
-    let px1 = xs
-        .iter()
-        .max()
-        .unwrap_or(&0)
+    let px0 = ceil_div(xs[0].min(xs[1]).min(xs[2])).max(0);
+    let py0 = ceil_div(ys[0].min(ys[1]).min(ys[2])).max(0);
+    let px1 = xs[0]
+        .max(xs[1])
+        .max(xs[2])
         .div_euclid(s)
-        .min(fb.width as i64 - 1);
-    let py1 = ys
-        .iter()
-        .max()
-        .unwrap_or(&0)
+        .min(width as i64 - 1);
+    let py1 = ys[0]
+        .max(ys[1])
+        .max(ys[2])
         .div_euclid(s)
-        .min(fb.height as i64 - 1);
+        .min(height as i64 - 1);
     if px0 > px1 || py0 > py1 {
-        return stats;
+        return Setup::Empty;
     }
-
-    // Attribute planes from the float window positions (as llvmpipe's coefficient setup does).
     let (dx1, dy1) = (v[1].x - v[0].x, v[1].y - v[0].y);
     let (dx2, dy2) = (v[2].x - v[0].x, v[2].y - v[0].y);
     let det = dx1 * dy2 - dx2 * dy1;
     if det == 0.0 || !det.is_finite() {
-        return stats;
+        return Setup::Empty;
     }
     let plane = |a: [f32; 3]| {
         let (da1, da2) = (a[1] - a[0], a[2] - a[0]);
@@ -143,9 +178,13 @@ pub fn rasterize_window_triangle<S: Shader>(
             dady: (da2 * dx1 - da1 * dx2) / det,
         }
     };
-    let z_plane = plane([v[0].z, v[1].z, v[2].z]);
-    let w_plane = plane([v[0].inv_w, v[1].inv_w, v[2].inv_w]);
-    let mut var_planes = [z_plane; MAX_VARYINGS];
+    let z = plane([v[0].z, v[1].z, v[2].z]);
+    let inv_w = plane([v[0].inv_w, v[1].inv_w, v[2].inv_w]);
+    let finite = |p: &Plane| p.a0.is_finite() && p.dadx.is_finite() && p.dady.is_finite();
+    if !finite(&z) || !finite(&inv_w) {
+        return Setup::Empty; // a sliver so thin its gradients overflow f32
+    }
+    let mut var_planes = [z; MAX_VARYINGS];
     for (k, p) in var_planes.iter_mut().enumerate().take(nvar) {
         *p = if opts.perspective_correct {
             plane([
@@ -157,19 +196,67 @@ pub fn rasterize_window_triangle<S: Shader>(
             plane([var[0][k], var[1][k], var[2][k]])
         };
     }
+    Setup::Triangle(Box::new(SetupTriangle {
+        c,
+        dcdx,
+        dcdy,
+        bits,
+        px0,
+        px1,
+        py0,
+        py1,
+        front_facing,
+        x0: v[0].x,
+        y0: v[0].y,
+        z,
+        inv_w,
+        var: var_planes,
+        nvar,
+    }))
+}
+
+impl SetupTriangle {
+    /// First and last pixel row the triangle may cover.
+    pub fn rows(&self) -> (u32, u32) {
+        (self.py0 as u32, self.py1 as u32)
+    }
+}
+
+/// A band of rows of a framebuffer: rows `y0 .. y0 + color.len() / width`.
+pub struct Band<'a> {
+    /// Row width in pixels.
+    pub width: u32,
+    /// First row of the band.
+    pub y0: u32,
+    /// The band's colors.
+    pub color: &'a mut [[u8; 4]],
+    /// The band's depths.
+    pub depth: &'a mut [f32],
+}
+
+/// Traverses a set-up triangle over the rows of `band`: coverage from the edge functions, then
+/// depth test LESS, then the fragment stage. Returns the fragments written.
+pub fn traverse<S: Shader>(
+    t: &SetupTriangle,
+    shader: &S,
+    band: &mut Band,
+    opts: &RasterOptions,
+) -> usize {
+    let rows = (band.depth.len() / band.width.max(1) as usize) as i64;
+    let py0 = t.py0.max(band.y0 as i64);
+    let py1 = t.py1.min(band.y0 as i64 + rows - 1);
+    let s = 1i64 << t.bits;
     let writes_color = shader.writes_color();
     let mut frag_var: Varyings = [0.0; MAX_VARYINGS];
-
+    let mut fragments = 0;
+    let step = [t.dcdx[0] * s, t.dcdx[1] * s, t.dcdx[2] * s];
     for py in py0..=py1 {
         let sy = py * s;
-        let mut e = [0i64; 3];
-        for i in 0..3 {
-            e[i] = c[i] + dcdy[i] * sy - dcdx[i] * px0 * s;
-        }
-        let step = [dcdx[0] * s, dcdx[1] * s, dcdx[2] * s];
-        let fy = py as f32 + 0.5 - v[0].y;
-        let row = py as usize * fb.width as usize;
-        for px in px0..=px1 {
+        let mut e: [i64; 3] =
+            std::array::from_fn(|i| t.c[i] + t.dcdy[i] * sy - t.dcdx[i] * t.px0 * s);
+        let fy = py as f32 + 0.5 - t.y0;
+        let row = (py - band.y0 as i64) as usize * band.width as usize;
+        for px in t.px0..=t.px1 {
             let inside = (e[0] | e[1] | e[2]) >= 0;
             for i in 0..3 {
                 e[i] -= step[i];
@@ -177,18 +264,17 @@ pub fn rasterize_window_triangle<S: Shader>(
             if !inside {
                 continue;
             }
-            let fx = px as f32 + 0.5 - v[0].x;
-            let z = (z_plane.a0 + z_plane.dadx * fx + z_plane.dady * fy).clamp(0.0, 1.0);
+            let fx = px as f32 + 0.5 - t.x0;
+            let z = t.z.at(fx, fy).clamp(0.0, 1.0);
             let idx = row + px as usize;
-            if opts.depth_test && z >= fb.depth[idx] {
+            if opts.depth_test && z >= band.depth[idx] {
                 continue;
             }
             if writes_color {
-                let inv_w = w_plane.a0 + w_plane.dadx * fx + w_plane.dady * fy;
-                for k in 0..nvar {
-                    let p = var_planes[k];
-                    let a = p.a0 + p.dadx * fx + p.dady * fy;
-                    frag_var[k] = if opts.perspective_correct {
+                let inv_w = t.inv_w.at(fx, fy);
+                for (out, plane) in frag_var.iter_mut().zip(&t.var[..t.nvar]) {
+                    let a = plane.at(fx, fy);
+                    *out = if opts.perspective_correct {
                         a / inv_w
                     } else {
                         a
@@ -199,18 +285,44 @@ pub fn rasterize_window_triangle<S: Shader>(
                     y: py as u32,
                     depth: z,
                     varyings: &frag_var,
-                    front_facing,
+                    front_facing: t.front_facing,
                 };
+                // A discarded fragment writes neither color nor depth.
                 let Some(col) = shader.fragment(&f) else {
                     continue;
-                }; // discard: no writes
-                fb.color[idx] = col;
+                };
+                band.color[idx] = col;
             }
             if opts.depth_test {
-                fb.depth[idx] = z;
+                band.depth[idx] = z;
             }
-            stats.fragments += 1;
+            fragments += 1;
         }
     }
-    stats
+    fragments
+}
+
+/// Setup + traversal of one window-space triangle over the whole framebuffer.
+/// Returns `(culled, fragments)`.
+pub fn rasterize_window_triangle<S: Shader>(
+    v: [WindowVertex; 3],
+    var: [&Varyings; 3],
+    nvar: usize,
+    shader: &S,
+    fb: &mut Framebuffer,
+    opts: &RasterOptions,
+) -> (bool, usize) {
+    match setup_triangle(v, var, nvar, fb.width, fb.height, opts) {
+        Setup::Empty => (false, 0),
+        Setup::Culled => (true, 0),
+        Setup::Triangle(t) => {
+            let mut band = Band {
+                width: fb.width,
+                y0: 0,
+                color: &mut fb.color,
+                depth: &mut fb.depth,
+            };
+            (false, traverse(&t, shader, &mut band, opts))
+        }
+    }
 }

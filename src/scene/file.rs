@@ -2,6 +2,7 @@
 
 use serde::Deserialize;
 
+use crate::effects::chromadepth::ChromaDepthSettings;
 use crate::math::{Camera, CameraMode, Lighting};
 
 /// A scene file as written.
@@ -24,6 +25,9 @@ pub struct SceneFile {
     /// Rasterizer options.
     #[serde(default)]
     pub raster: RasterSpec,
+    /// ChromaDepth options (seed 000).
+    #[serde(default)]
+    pub chromadepth: ChromaDepthSettings,
     /// Objects, in `[[mesh]]` tables.
     #[serde(default, rename = "mesh")]
     pub meshes: Vec<MeshSpec>,
@@ -163,9 +167,9 @@ pub struct RasterSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
-    /// `obj`, `sphere`, `cube`, `torus`, `plane`, `triangles`.
+    /// `obj`, `sphere`, `cube`, `torus`, `plane`, `triangles`, `terrain`.
     pub kind: String,
-    /// OBJ path, relative to the scene file.
+    /// OBJ path (or terrain CSV path), relative to the scene file.
     #[serde(default)]
     pub path: Option<String>,
     /// Radius (sphere), edge (cube, plane), major radius (torus).

@@ -3,6 +3,8 @@
 mod file;
 mod mesh;
 mod obj;
+pub mod terrain;
+pub mod terrain_data;
 
 pub use file::SceneFile;
 pub use mesh::Mesh;
@@ -12,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{EulerRot, Mat4, Quat, Vec3};
 
+use crate::effects::chromadepth::ChromaDepthSettings;
 use crate::error::{Error, Result};
 use crate::framebuffer::check_size;
 use crate::math::{Camera, Separation, StereoRig, ZeroParallax};
@@ -55,6 +58,8 @@ pub struct Scene {
     pub blank_interval: u32,
     /// Rasterizer options.
     pub raster: RasterOptions,
+    /// ChromaDepth options (seed 000).
+    pub chromadepth: ChromaDepthSettings,
 }
 
 impl Scene {
@@ -158,6 +163,7 @@ impl Scene {
                 "ask for at least one output",
             ));
         }
+        f.chromadepth.validate()?;
         let objects = f
             .meshes
             .iter()
@@ -178,6 +184,7 @@ impl Scene {
                 cull_back: f.raster.cull_back,
                 ..RasterOptions::default()
             },
+            chromadepth: f.chromadepth,
         })
     }
 
@@ -256,6 +263,12 @@ fn load_object(i: usize, m: &file::MeshSpec, base_dir: &Path) -> Result<Object> 
             detail,
             detail / 2,
         ),
+        "terrain" => {
+            let p = m.path.as_ref().ok_or_else(|| {
+                Error::invalid(field("path"), "missing", "a terrain mesh needs a CSV path")
+            })?;
+            terrain::load_terrain_csv(&base_dir.join(p))?.mesh
+        }
         "plane" => Mesh::plane(positive("size", m.size, 1.0)?, detail.min(512)),
         "triangles" => {
             let n = m.count.unwrap_or(1000);
@@ -272,7 +285,7 @@ fn load_object(i: usize, m: &file::MeshSpec, base_dir: &Path) -> Result<Object> 
             return Err(Error::invalid(
                 field("kind"),
                 format!("\"{other}\""),
-                "known kinds: obj, sphere, cube, torus, plane, triangles",
+                "known kinds: obj, sphere, cube, torus, plane, triangles, terrain",
             ));
         }
     };

@@ -1,0 +1,146 @@
+//! ChromaDepth (seed 000): depth coded as a red → green → blue ramp in one center-eye pass, and
+//! the glasses simulation that turns it into a stereo pair for viewers without the glasses.
+//!
+//! - [`ramp`]: the 1D texture (HSV red–green–blue or red–white–blue), clamped at both ends.
+//! - [`texgen`]: the eye-linear plane `s = A x + B y + C z + D`, D1/D2 from the scene or from the
+//!   bounding sphere.
+//! - [`shader`]: the pass itself (per-vertex or per-pixel texgen, optionally lit).
+//! - [`glasses`]: each eye's view through the diffraction-grating lenses, and a color anaglyph.
+//! - [`bench`]: the accuracy/time rows for `stereolab bench`.
+
+pub mod bench;
+pub mod glasses;
+pub mod ramp;
+pub mod shader;
+pub mod texgen;
+
+use serde::Deserialize;
+
+use crate::error::{Error, Result};
+use crate::framebuffer::Framebuffer;
+use crate::plan::Output;
+use crate::render::Frame;
+use ramp::{DEFAULT_TEXELS, RampKind, Sampling};
+
+/// Where `s` is evaluated.
+///
+/// Measured (`stereolab bench`, plane slanted 70°): per-vertex with perspective-correct
+/// interpolation is exact to rounding (`s` is affine in eye space) and a little faster than
+/// per-pixel, whose depth round trip costs a division and a few ulps; only affine interpolation
+/// makes per-vertex visibly wrong. Hence per-vertex is the default, as in OpenGL.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TexgenMode {
+    /// OpenGL's texgen: `s` at the vertices, interpolated across the triangle.
+    #[default]
+    PerVertex,
+    /// `s` from each pixel's own eye depth, whatever the varying interpolation does.
+    PerPixel,
+}
+
+/// The scene's `[chromadepth]` table (all optional), also adjustable with
+/// `--set chromadepth.d1=…`.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ChromaDepthSettings {
+    /// Distance in front of the eye where the ramp starts (red); automatic when absent.
+    pub d1: Option<f32>,
+    /// Distance in front of the eye where the ramp ends (blue); automatic when absent.
+    pub d2: Option<f32>,
+    /// `hsv` (red–green–blue, default) or `red-white-blue`.
+    pub ramp: RampKind,
+    /// Texels in the ramp texture (default 256).
+    pub texels: usize,
+    /// `linear` (default) or `nearest`.
+    pub sampling: Sampling,
+    /// `per-vertex` (default) or `per-pixel`.
+    pub texgen: TexgenMode,
+    /// Modulate the ramp by diffuse lighting, keeping its hue.
+    pub lit: bool,
+    /// How far the glasses move the reddest pixel inward in each eye, as a fraction of the image
+    /// width (default 0.01: red–blue parallax 2% of the width, inside seed 003's ~3% budget).
+    pub glasses_shift: f32,
+}
+
+impl Default for ChromaDepthSettings {
+    fn default() -> Self {
+        ChromaDepthSettings {
+            d1: None,
+            d2: None,
+            ramp: RampKind::Hsv,
+            texels: DEFAULT_TEXELS,
+            sampling: Sampling::Linear,
+            texgen: TexgenMode::PerVertex,
+            lit: false,
+            glasses_shift: 0.01,
+        }
+    }
+}
+
+impl ChromaDepthSettings {
+    /// Checks what can be checked before rendering (automatic D1/D2 are checked when resolved).
+    ///
+    /// # Errors
+    /// `Invalid` naming the field: non-finite D1/D2, D1 == D2, D1 > D2, texels outside
+    /// 2..=65536, glasses shift outside 0..=0.1.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [("chromadepth.d1", self.d1), ("chromadepth.d2", self.d2)] {
+            if let Some(v) = v.filter(|v| !v.is_finite()) {
+                return Err(Error::invalid(name, v, "must be a finite distance"));
+            }
+        }
+        if let (Some(d1), Some(d2)) = (self.d1, self.d2) {
+            texgen::Texgen::from_range(d1, d2)?;
+        }
+        ramp::Ramp::new(self.ramp, self.texels)?;
+        if !(0.0..=0.1).contains(&self.glasses_shift) {
+            return Err(Error::invalid(
+                "chromadepth.glasses_shift",
+                self.glasses_shift,
+                "must lie in 0..=0.1 (fraction of the image width)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The glasses' largest inward shift in pixels for an image `width` pixels wide.
+    pub fn max_shift_px(&self, width: u32) -> f32 {
+        self.glasses_shift * width as f32
+    }
+}
+
+/// Produces a ChromaDepth output from the frame's ChromaDepth pass: the image itself, one eye's
+/// view through the glasses, or both views as a red–cyan color anaglyph.
+///
+/// # Errors
+/// The frame has no ChromaDepth pass (a plan bug), or `output` is not a ChromaDepth output.
+pub fn produce(
+    output: Output,
+    frame: &Frame,
+    settings: &ChromaDepthSettings,
+) -> Result<Framebuffer> {
+    let fb = frame
+        .passes
+        .iter()
+        .find(|p| Output::ChromaDepth.needs().contains(&p.pass))
+        .map(|p| &p.framebuffer)
+        .ok_or_else(|| Error::invalid("plan", output.name(), "the ChromaDepth pass was not run"))?;
+    let shift = settings.max_shift_px(fb.width);
+    let view = |eye| glasses::glasses_view(fb, eye, shift);
+    Ok(match output {
+        Output::ChromaDepth => fb.clone(),
+        Output::ChromaDepthLeft => view(glasses::Eye::Left),
+        Output::ChromaDepthRight => view(glasses::Eye::Right),
+        Output::ChromaDepthAnaglyph => {
+            let [left, right] = glasses::glasses_pair(fb, shift);
+            glasses::color_anaglyph(&left, &right)
+        }
+        other => {
+            return Err(Error::invalid(
+                "output",
+                other.name(),
+                "is not a ChromaDepth output",
+            ));
+        }
+    })
+}
