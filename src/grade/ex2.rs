@@ -1,16 +1,23 @@
 //! Exercise 2 (seed 000, ChromaDepth): the tasks, reference answers, mistakes, image checks.
 //!
-//! The reference ramp and texgen are the grader's own (seed 000's formulas, below) until the
-//! ChromaDepth module lands on main.
+//! The reference is stereolab's ChromaDepth module (`effects::chromadepth`): its exact HSV ramp,
+//! its texgen plane and its bounding-sphere range; the texgen image check renders the real
+//! ChromaDepth pass with the student's plane.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use serde_json::json;
 
-use super::ex1::{blank, flat};
-use super::fixture::{Fixture, unproject};
+use super::ex1::flat;
+use super::fixture::Fixture;
 use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
+use crate::effects::chromadepth::ChromaDepthSettings;
+use crate::effects::chromadepth::ramp::{Ramp, RampKind, exact, hsv_to_rgb};
+use crate::effects::chromadepth::shader::ChromaDepthShader;
+use crate::effects::chromadepth::texgen::{Texgen, auto_range};
 use crate::framebuffer::Framebuffer;
 use crate::math::EyeMatrices;
+use crate::raster::rasterize;
+use crate::scene::Scene;
 use crate::shade::to_rgba8;
 
 /// Every task of exercise 2.
@@ -20,26 +27,21 @@ pub fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
 
 /// HSV (hue in degrees, S = V = 1) to RGB.
 fn hue_to_rgb(hue: f32) -> [f32; 3] {
-    let h = hue.rem_euclid(360.0) / 60.0;
-    let x = 1.0 - (h % 2.0 - 1.0).abs();
-    match h as u32 {
-        0 => [1.0, x, 0.0],
-        1 => [x, 1.0, 0.0],
-        2 => [0.0, 1.0, x],
-        3 => [0.0, x, 1.0],
-        4 => [x, 0.0, 1.0],
-        _ => [1.0, 0.0, x],
-    }
+    hsv_to_rgb(hue, 1.0, 1.0).to_array()
 }
 
-/// Seed 000's ramp: hue 240° · clamp(t), red near, blue far.
+/// Seed 000's ramp as stereolab computes it: hue 240° · clamp(t), red near, blue far.
 pub fn reference_ramp(t: f32) -> [f32; 3] {
-    hue_to_rgb(240.0 * t.clamp(0.0, 1.0))
+    exact(RampKind::Hsv, t).to_array()
 }
 
-/// Seed 000's texgen plane `[A, B, C, D]`.
+/// Seed 000's texgen plane `[A, B, C, D]` as stereolab's `Texgen::from_range` computes it; for
+/// `d1 ≥ d2`, which it refuses, the formula itself.
 pub fn reference_texgen(d1: f32, d2: f32) -> [f32; 4] {
-    [0.0, 0.0, -1.0 / (d2 - d1), -d1 / (d2 - d1)]
+    Texgen::from_range(d1, d2).map_or_else(
+        |_| [0.0, 0.0, -1.0 / (d2 - d1), -d1 / (d2 - d1)],
+        |t| t.plane.to_array(),
+    )
 }
 
 const RAMP_STRIP_WIDTH: u32 = 64;
@@ -140,42 +142,44 @@ fn ramp_task() -> TaskSpec {
     }
 }
 
-/// Seed 000's bounding-sphere range of the fixture's objects, seen from the cyclopean eye.
+/// Seed 000's bounding-sphere range of the fixture's objects, seen from the cyclopean eye
+/// (stereolab's `auto_range`, which keeps it between the clip planes).
 fn fixture_range(fx: &Fixture) -> [f32; 2] {
-    let view = fx.center_matrices.view;
-    let pts: Vec<Vec3> = fx
-        .scene
-        .world_points()
-        .map(|p| view.transform_point3(p))
-        .collect();
-    let (lo, hi) = pts.iter().fold(
-        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-        |(a, b), p| (a.min(*p), b.max(*p)),
-    );
-    let c = 0.5 * (lo + hi);
-    let r = pts.iter().map(|p| p.distance(c)).fold(0.0, f32::max);
-    [(-c.z - r).max(fx.scene.camera.near), -c.z + r]
+    let points: Vec<Vec3> = fx.scene.world_points().collect();
+    let (n, f) = (fx.scene.camera.near, fx.scene.camera.far);
+    auto_range(&points, fx.center_matrices.view, n, f).map_or([n, f], |(a, b)| [a, b])
 }
 
-/// The cyclopean view colored by the reference ramp at `s` from `plane` (eye-space texgen).
-fn chromadepth_picture(
-    center: &Framebuffer,
-    m: &EyeMatrices,
-    background: [u8; 4],
-    plane: Option<[f32; 4]>,
-) -> Framebuffer {
+/// The real ChromaDepth pass (HSV ramp, the scene's other settings) seen with `m`, with the
+/// texgen plane `plane` (blank for a missing or non-finite plane).
+fn chromadepth_render(scene: &Scene, m: &EyeMatrices, plane: Option<[f32; 4]>) -> Framebuffer {
+    let mut fb = Framebuffer::new(scene.width, scene.height, scene.background)
+        .expect("the scene's size was validated");
     let Some(p) = plane.filter(|p| p.iter().all(|x| x.is_finite())) else {
-        return blank(center, background);
+        return fb;
     };
-    let mut fb = center.clone();
-    for y in 0..fb.height {
-        for x in 0..fb.width {
-            if let Some(e) = unproject(m, center, x, y) {
-                let s = p[0] * e.x + p[1] * e.y + p[2] * e.z + p[3];
-                let i = fb.index(x, y);
-                fb.color[i] = to_rgba8(Vec3::from(reference_ramp(s)));
-            }
-        }
+    let settings = ChromaDepthSettings {
+        ramp: RampKind::Hsv,
+        ..scene.chromadepth.clone()
+    };
+    let Ok(ramp) = Ramp::new(settings.ramp, settings.texels) else {
+        return fb;
+    };
+    // d1, d2 only label the plane; the shader evaluates the plane itself.
+    let texgen = Texgen {
+        plane: Vec4::from(p),
+        d1: 0.0,
+        d2: 1.0,
+    };
+    for o in &scene.objects {
+        let shader = ChromaDepthShader::new(o, m, texgen, &ramp, &settings, scene);
+        rasterize(
+            &o.mesh.triangles,
+            o.mesh.positions.len(),
+            &shader,
+            &mut fb,
+            &scene.raster,
+        );
     }
     fb
 }
@@ -185,8 +189,8 @@ fn texgen_task(fx: &Fixture) -> TaskSpec {
     let inputs = [[5.0f32, 15.0], [1.0, 20.0], [0.5, 0.75], range];
     let each =
         |f: &dyn Fn(f32, f32) -> [f32; 4]| inputs.iter().map(|[a, b]| flat(&f(*a, *b))).collect();
-    let (center, m, bg) = (fx.center.clone(), fx.center_matrices, fx.scene.background);
-    let expected = chromadepth_picture(&center, &m, bg, Some(reference_texgen(range[0], range[1])));
+    let (scene, m) = (fx.scene.clone(), fx.center_matrices);
+    let expected = chromadepth_render(&scene, &m, Some(reference_texgen(range[0], range[1])));
     let pictures = move |answers: &[Option<Vec<f64>>]| {
         let plane = match answers.first().and_then(|a| a.as_deref()) {
             Some([a, b, c, d]) => Some([*a as f32, *b as f32, *c as f32, *d as f32]),
@@ -195,7 +199,7 @@ fn texgen_task(fx: &Fixture) -> TaskSpec {
         vec![Picture {
             name: "chromadepth_texgen".into(),
             expected: expected.clone(),
-            actual: chromadepth_picture(&center, &m, bg, plane),
+            actual: chromadepth_render(&scene, &m, plane),
         }]
     };
     TaskSpec {

@@ -13,7 +13,8 @@ use crate::render::render_view;
 use crate::scene::Scene;
 
 /// The built-in grading scene: small (fast, ASCII maps fit a terminal), with depth in front of
-/// and behind the screen (parallax of both signs) and an occluder (remapping and visibility).
+/// and behind the screen (parallax of both signs), occluders in front of a backdrop (remapping,
+/// visibility) and a background plane behind everything (seed 002's SIRDS bound).
 pub const GRADING_SCENE: &str = r#"
 outputs = ["left", "right"]
 [image]
@@ -44,7 +45,7 @@ color = [0.3, 0.7, 0.9]
 [[mesh]]
 kind = "plane"
 size = 8.0
-rotate = [90.0, 0.0, 0.0]
+detail = 4
 translate = [0.0, 0.0, -2.5]
 color = [0.6, 0.6, 0.5]
 "#;
