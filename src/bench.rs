@@ -88,6 +88,10 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         &scene,
         opts.iterations,
     )?);
+    rows.extend(crate::effects::finalize_bench::rows(
+        &scene,
+        opts.iterations,
+    )?);
     Ok(rows)
 }
 

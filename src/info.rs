@@ -93,6 +93,7 @@ pub fn describe(scene: &Scene) -> Result<String> {
             m.eye_world.x, m.eye_world.y, m.eye_world.z, f[0], f[1], f[2], f[3], f[4], f[5]
         );
     }
+    s.push_str(&crate::effects::parallax::scene_budget(scene)?.report());
     let p = parallax_range(scene)?;
     if p.vertices == 0 {
         let _ = writeln!(s, "parallax: no vertex lies inside both frusta");

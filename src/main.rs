@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand};
 
 use stereolab::plan::Plan;
 use stereolab::scene::Scene;
-use stereolab::{Error, Result, bench, grade, info, output, render};
+use stereolab::{Error, Result, bench, effects, grade, info, output, render};
 
 #[derive(Parser)]
 #[command(
@@ -190,6 +190,9 @@ fn run(cli: Cli) -> Result<()> {
                     p.stats.clipped,
                     p.stats.culled
                 );
+            }
+            if let Some(report) = effects::parallax::frame_budget_report(&frame, &s)? {
+                print!("{report}");
             }
             for p in paths {
                 println!("  wrote {}", p.display());

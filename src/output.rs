@@ -2,7 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::effects::{chromadepth, layout};
+use crate::effects::parallax::{ParallaxRig, parallax_image};
+use crate::effects::remap::{Precision, remap_color};
+use crate::effects::{anaglyph, chromadepth, layout, occlusion};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::plan::{Output, View};
@@ -87,6 +89,36 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
         | Output::ChromaDepthAnaglyph => {
             Image::Rgba(chromadepth::produce(output, frame, &scene.chromadepth)?.to_rgba_image())
         }
+        Output::Anaglyph(kind) => Image::Rgba(anaglyph::anaglyph(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            kind,
+            scene.finalize,
+        )?),
+        Output::RemapLeft => Image::Rgba(remap_color(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            &frame.eyes[0].mvp,
+            &frame.eyes[1].mvp,
+            Precision::default(),
+        )?),
+        Output::RemapRight => Image::Rgba(remap_color(
+            eye(View::Right)?,
+            eye(View::Left)?,
+            &frame.eyes[1].mvp,
+            &frame.eyes[0].mvp,
+            Precision::default(),
+        )?),
+        Output::Occlusion => Image::Rgba(occlusion::occlusion_image(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            [&frame.eyes[0].mvp, &frame.eyes[1].mvp],
+            Precision::default(),
+        )?),
+        Output::Parallax => Image::Rgba(parallax_image(
+            eye(View::Left)?,
+            &ParallaxRig::of_scene(scene)?,
+        )?),
     })
 }
 

@@ -3,6 +3,7 @@
 
 use std::fmt::Write as _;
 
+use crate::effects::anaglyph::AnaglyphKind;
 use crate::error::{Error, Result};
 
 /// Everything a scene can ask `stereolab render` to write.
@@ -39,6 +40,16 @@ pub enum Output {
     ChromaDepthRight,
     /// Both simulated views as a red–cyan anaglyph, for viewers without ChromaDepth glasses.
     ChromaDepthAnaglyph,
+    /// `anaglyph_<kind>`: both eyes' colors mixed by the kind's matrices (seed 004).
+    Anaglyph(AnaglyphKind),
+    /// The left eye's view recolored from the right eye by remapping (seed 004).
+    RemapLeft,
+    /// The right eye's view recolored from the left eye.
+    RemapRight,
+    /// Per eye, what it sees that the other eye cannot (remapping + visibility check).
+    Occlusion,
+    /// The left eye's parallax `p(z) = d(1 − z0/z)` as color with a legend (seed 004).
+    Parallax,
 }
 
 /// Which camera a pass renders from.
@@ -90,6 +101,19 @@ impl Output {
         Output::ChromaDepthLeft,
         Output::ChromaDepthRight,
         Output::ChromaDepthAnaglyph,
+        Output::Anaglyph(AnaglyphKind::True),
+        Output::Anaglyph(AnaglyphKind::Gray),
+        Output::Anaglyph(AnaglyphKind::Color),
+        Output::Anaglyph(AnaglyphKind::HalfColor),
+        Output::Anaglyph(AnaglyphKind::Optimized),
+        Output::Anaglyph(AnaglyphKind::DuboisRedCyan),
+        Output::Anaglyph(AnaglyphKind::DuboisRedCyanLcd),
+        Output::Anaglyph(AnaglyphKind::DuboisGreenMagenta),
+        Output::Anaglyph(AnaglyphKind::DuboisAmberBlue),
+        Output::RemapLeft,
+        Output::RemapRight,
+        Output::Occlusion,
+        Output::Parallax,
     ];
 
     /// The name used in scene files and for the PNG written.
@@ -110,6 +134,11 @@ impl Output {
             Output::ChromaDepthLeft => "chromadepth_left",
             Output::ChromaDepthRight => "chromadepth_right",
             Output::ChromaDepthAnaglyph => "chromadepth_anaglyph",
+            Output::Anaglyph(kind) => kind.output_name(),
+            Output::RemapLeft => "remap_left",
+            Output::RemapRight => "remap_right",
+            Output::Occlusion => "occlusion",
+            Output::Parallax => "parallax",
         }
     }
 
@@ -155,6 +184,13 @@ impl Output {
                 view: View::Center,
                 shading: Shading::ChromaDepth,
             }],
+            // Remapping unprojects this eye's depth and fetches the other eye's color.
+            Output::RemapLeft => vec![depth(View::Left), color(View::Right)],
+            Output::RemapRight => vec![color(View::Left), depth(View::Right)],
+            // The visibility check compares depths only.
+            Output::Occlusion => vec![depth(View::Left), depth(View::Right)],
+            // p(z) needs the left eye's depth and the rig, nothing else.
+            Output::Parallax => vec![depth(View::Left)],
             _ => vec![color(View::Left), color(View::Right)],
         }
     }

@@ -448,11 +448,37 @@ fn glasses_disparity_order_matches_depth_order() {
         disparities[0] < disparities[1] && disparities[1] < disparities[2],
         "{disparities:?}"
     );
-    let anaglyph = cd::produce(Output::ChromaDepthAnaglyph, &frame, &s.chromadepth).expect("ok");
+    // The anaglyph of the pair comes from the shared anaglyph module, kind chosen in the scene.
+    let mut color = s.chromadepth.clone();
+    color.anaglyph = "color".into();
+    let anaglyph = cd::produce(Output::ChromaDepthAnaglyph, &frame, &color).expect("ok");
     for (i, p) in anaglyph.color.iter().enumerate() {
         assert_eq!(p[0], left.color[i][0]);
         assert_eq!(p[1..3], right.color[i][1..3]);
     }
+    let gray = cd::produce(Output::ChromaDepthAnaglyph, &frame, &s.chromadepth).expect("ok");
+    let expected = stereolab::effects::anaglyph::anaglyph(
+        &left,
+        &right,
+        stereolab::effects::anaglyph::AnaglyphKind::Gray,
+        Default::default(),
+    )
+    .expect("same size");
+    assert!(
+        gray.color
+            .iter()
+            .zip(expected.pixels())
+            .all(|(a, b)| *a == b.0),
+        "default is the gray anaglyph"
+    );
+    color.anaglyph = "plaid".into();
+    let err = cd::produce(Output::ChromaDepthAnaglyph, &frame, &color)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("chromadepth.anaglyph") && err.contains("plaid"),
+        "{err}"
+    );
 }
 
 #[test]

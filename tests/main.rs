@@ -5,6 +5,7 @@ mod cli;
 mod common;
 mod conformance;
 mod determinism;
+mod finalize;
 mod golden;
 mod grading;
 mod layout;

@@ -28,6 +28,9 @@ pub struct SceneFile {
     /// ChromaDepth options (seed 000).
     #[serde(default)]
     pub chromadepth: ChromaDepthSettings,
+    /// Finalize-pass options (anaglyphs).
+    #[serde(default)]
+    pub finalize: FinalizeSpec,
     /// Objects, in `[[mesh]]` tables.
     #[serde(default, rename = "mesh")]
     pub meshes: Vec<MeshSpec>,
@@ -161,6 +164,18 @@ pub struct RasterSpec {
     /// Back-face culling.
     #[serde(default)]
     pub cull_back: bool,
+}
+
+/// `[finalize]`.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct FinalizeSpec {
+    /// Apply anaglyph matrices to linear-light values (decode sRGB, mix, encode).
+    #[serde(default)]
+    pub linear_light: bool,
+    /// Swap the eyes in anaglyphs (glasses worn the other way round).
+    #[serde(default)]
+    pub swap_eyes: bool,
 }
 
 /// One `[[mesh]]`.

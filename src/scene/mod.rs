@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{EulerRot, Mat4, Quat, Vec3};
 
+use crate::effects::anaglyph::AnaglyphOptions;
 use crate::effects::chromadepth::ChromaDepthSettings;
 use crate::error::{Error, Result};
 use crate::framebuffer::check_size;
@@ -60,6 +61,8 @@ pub struct Scene {
     pub raster: RasterOptions,
     /// ChromaDepth options (seed 000).
     pub chromadepth: ChromaDepthSettings,
+    /// Finalize-pass options from `[finalize]` (anaglyph linear light, swapped eyes).
+    pub finalize: AnaglyphOptions,
 }
 
 impl Scene {
@@ -185,6 +188,10 @@ impl Scene {
                 ..RasterOptions::default()
             },
             chromadepth: f.chromadepth,
+            finalize: AnaglyphOptions {
+                linear_light: f.finalize.linear_light,
+                swap_eyes: f.finalize.swap_eyes,
+            },
         })
     }
 

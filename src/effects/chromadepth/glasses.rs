@@ -123,14 +123,3 @@ fn warp(fb: &Framebuffer, eye: Eye, shifts: &[f32]) -> Framebuffer {
     }
     out
 }
-
-/// Red–cyan color anaglyph (seed 004's "color anaglyph": R from the left view, G and B from the
-/// right view). A minimal local combination until the shared anaglyph module lands. The views
-/// have the same size when both come from one framebuffer through [`glasses_view`].
-pub fn color_anaglyph(left: &Framebuffer, right: &Framebuffer) -> Framebuffer {
-    let mut out = right.clone();
-    for (o, l) in out.color.iter_mut().zip(&left.color) {
-        o[0] = l[0];
-    }
-    out
-}

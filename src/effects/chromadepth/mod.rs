@@ -5,7 +5,7 @@
 //! - [`texgen`]: the eye-linear plane `s = A x + B y + C z + D`, D1/D2 from the scene or from the
 //!   bounding sphere.
 //! - [`shader`]: the pass itself (per-vertex or per-pixel texgen, optionally lit).
-//! - [`glasses`]: each eye's view through the diffraction-grating lenses, and a color anaglyph.
+//! - [`glasses`]: each eye's view through the diffraction-grating lenses.
 //! - [`bench`]: the accuracy/time rows for `stereolab bench`.
 
 pub mod bench;
@@ -16,6 +16,7 @@ pub mod texgen;
 
 use serde::Deserialize;
 
+use crate::effects::anaglyph::{self, AnaglyphKind, AnaglyphOptions};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::plan::Output;
@@ -60,6 +61,10 @@ pub struct ChromaDepthSettings {
     /// How far the glasses move the reddest pixel inward in each eye, as a fraction of the image
     /// width (default 0.01: red–blue parallax 2% of the width, inside seed 003's ~3% budget).
     pub glasses_shift: f32,
+    /// The anaglyph that shows the simulated glasses pair, by kind name (`gray` default: every
+    /// ChromaDepth hue reaches both eyes, where a color anaglyph shows pure red to the left eye
+    /// only and pure blue to the right eye only, so those regions cannot fuse).
+    pub anaglyph: String,
 }
 
 impl Default for ChromaDepthSettings {
@@ -73,6 +78,7 @@ impl Default for ChromaDepthSettings {
             texgen: TexgenMode::PerVertex,
             lit: false,
             glasses_shift: 0.01,
+            anaglyph: "gray".into(),
         }
     }
 }
@@ -93,6 +99,7 @@ impl ChromaDepthSettings {
             texgen::Texgen::from_range(d1, d2)?;
         }
         ramp::Ramp::new(self.ramp, self.texels)?;
+        self.anaglyph_kind()?;
         if !(0.0..=0.1).contains(&self.glasses_shift) {
             return Err(Error::invalid(
                 "chromadepth.glasses_shift",
@@ -103,6 +110,27 @@ impl ChromaDepthSettings {
         Ok(())
     }
 
+    /// The anaglyph kind named by `anaglyph`.
+    ///
+    /// # Errors
+    /// An unknown kind name.
+    pub fn anaglyph_kind(&self) -> Result<AnaglyphKind> {
+        AnaglyphKind::ALL
+            .into_iter()
+            .find(|k| k.output_name().strip_prefix("anaglyph_") == Some(self.anaglyph.as_str()))
+            .ok_or_else(|| {
+                let known: Vec<&str> = AnaglyphKind::ALL
+                    .iter()
+                    .filter_map(|k| k.output_name().strip_prefix("anaglyph_"))
+                    .collect();
+                Error::invalid(
+                    "chromadepth.anaglyph",
+                    format!("\"{}\"", self.anaglyph),
+                    format!("known kinds: {}", known.join(", ")),
+                )
+            })
+    }
+
     /// The glasses' largest inward shift in pixels for an image `width` pixels wide.
     pub fn max_shift_px(&self, width: u32) -> f32 {
         self.glasses_shift * width as f32
@@ -110,7 +138,7 @@ impl ChromaDepthSettings {
 }
 
 /// Produces a ChromaDepth output from the frame's ChromaDepth pass: the image itself, one eye's
-/// view through the glasses, or both views as a red–cyan color anaglyph.
+/// view through the glasses, or both views as an anaglyph (`chromadepth.anaglyph`, default gray).
 ///
 /// # Errors
 /// The frame has no ChromaDepth pass (a plan bug), or `output` is not a ChromaDepth output.
@@ -133,7 +161,17 @@ pub fn produce(
         Output::ChromaDepthRight => view(glasses::Eye::Right),
         Output::ChromaDepthAnaglyph => {
             let [left, right] = glasses::glasses_pair(fb, shift);
-            glasses::color_anaglyph(&left, &right)
+            let image = anaglyph::anaglyph(
+                &left,
+                &right,
+                settings.anaglyph_kind()?,
+                AnaglyphOptions::default(),
+            )?;
+            let mut out = right;
+            for (o, p) in out.color.iter_mut().zip(image.pixels()) {
+                *o = p.0;
+            }
+            out
         }
         other => {
             return Err(Error::invalid(

@@ -1,0 +1,240 @@
+//! Benchmark rows of the finalize pass: every mode's time on the real model, linear light vs
+//! stored values, remap f32 vs f64, and throughput as a fraction of a plain memory copy.
+
+use glam::Mat4;
+
+use super::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
+use super::occlusion::occlusion_image;
+use super::parallax::{ParallaxRig, parallax_image};
+use super::remap::{
+    Precision, Remapper, Visibility, remap_color, remap_coordinates, visibility_map,
+};
+use crate::bench::{Row, median_ms};
+use crate::error::Result;
+use crate::framebuffer::Framebuffer;
+use crate::plan::{Output, Plan, Shading, View};
+use crate::render::{render, render_view};
+use crate::scene::Scene;
+
+fn row(knob: &str, setting: impl Into<String>, error: Option<f64>, unit: &str, ms: f64) -> Row {
+    Row {
+        area: "finalize".into(),
+        knob: knob.into(),
+        setting: setting.into(),
+        error,
+        error_unit: unit.into(),
+        ms,
+        note: String::new(),
+    }
+}
+
+/// Median ms of copying `bytes` bytes (`copy_from_slice`, one thread), the yardstick.
+fn memcpy_ms(bytes: usize, iters: usize) -> f64 {
+    let src = vec![7u8; bytes];
+    let mut dst = vec![0u8; bytes];
+    median_ms(iters, || {
+        dst.copy_from_slice(std::hint::black_box(&src));
+        dst[bytes / 2]
+    })
+}
+
+/// Fills in the throughput note: the mode reads `bytes` of framebuffers; a plain copy of the
+/// same bytes takes `copy_ms`.
+fn with_throughput(mut r: Row, bytes: usize, copy_ms: f64) -> Row {
+    let t = format!(
+        "{:.3} of memcpy ({:.1} MB read; copy {:.3} ms)",
+        copy_ms / r.ms,
+        bytes as f64 / 1e6,
+        copy_ms
+    );
+    r.note = if r.note.is_empty() {
+        t
+    } else {
+        format!("{}; {t}", r.note)
+    };
+    r
+}
+
+/// Every finalize row on `scene` (its size; `stereolab bench` uses 1024×768). Single-threaded.
+///
+/// # Errors
+/// The scene cannot be rendered, or a mode fails.
+pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
+    let frame = render(scene, &Plan::new(&[Output::Left, Output::Right]))?;
+    let (Some(left), Some(right)) = (frame.view(View::Left), frame.view(View::Right)) else {
+        return Ok(Vec::new());
+    };
+    let mvp = [frame.eyes[0].mvp, frame.eyes[1].mvp];
+    let px = left.color.len();
+    let mut rows = anaglyph_rows(left, right, iters)?;
+    let copy_color_depth = memcpy_ms(px * 8, iters);
+    let mut err = None;
+    let mut time = |f: &mut dyn FnMut() -> Result<()>| {
+        median_ms(iters, || {
+            if let Err(e) = f() {
+                err = Some(e);
+            }
+        })
+    };
+    let remap_ms =
+        time(&mut || remap_color(left, right, &mvp[0], &mvp[1], Precision::F64).map(drop));
+    let remap_right_ms =
+        time(&mut || remap_color(right, left, &mvp[1], &mvp[0], Precision::F64).map(drop));
+    let occlusion_ms =
+        time(&mut || occlusion_image(left, right, [&mvp[0], &mvp[1]], Precision::F64).map(drop));
+    let rig = ParallaxRig::of_scene(scene)?;
+    let parallax_ms = time(&mut || parallax_image(left, &rig).map(drop));
+    if let Some(e) = err {
+        return Err(e);
+    }
+    for (name, ms) in [("remap_left", remap_ms), ("remap_right", remap_right_ms)] {
+        rows.push(with_throughput(
+            row("mode", name, None, "", ms),
+            px * 8,
+            copy_color_depth,
+        ));
+    }
+    let map = visibility_map(left, right, &mvp[0], &mvp[1], Precision::F64)?;
+    let n = |v: Visibility| map.iter().filter(|m| **m == v).count();
+    let mut occlusion = row("mode", "occlusion", None, "", occlusion_ms);
+    occlusion.note = format!(
+        "left eye: {} visible, {} occluded, {} out of view, {} farther (silhouette sampling)",
+        n(Visibility::Visible),
+        n(Visibility::Occluded),
+        n(Visibility::OutOfView),
+        n(Visibility::Farther)
+    );
+    rows.push(with_throughput(occlusion, px * 8, copy_color_depth));
+    rows.push(with_throughput(
+        row("mode", "parallax + legend", None, "", parallax_ms),
+        px * 4,
+        memcpy_ms(px * 4, iters),
+    ));
+    rows.extend(remap_precision_rows(left, &mvp, "near/far 1/20", iters)?);
+    // The same model with near = far / 1e5: where f32 unprojection struggles.
+    let mut deep = scene.clone();
+    deep.camera.near = deep.camera.far * 1e-5;
+    let eyes = deep.rig.eyes(&deep.camera, deep.aspect())?;
+    let (deep_left, _) = render_view(&deep, &eyes[0], Shading::DepthOnly)?;
+    rows.extend(remap_precision_rows(
+        &deep_left,
+        &[eyes[0].mvp, eyes[1].mvp],
+        "near/far 1e-5",
+        iters,
+    )?);
+    Ok(rows)
+}
+
+/// Each anaglyph kind on stored values and in linear light: time, and the largest and mean
+/// channel difference (8-bit levels) of linear light against stored values.
+fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Result<Vec<Row>> {
+    let px = left.color.len();
+    let copy = memcpy_ms(px * 8, iters);
+    let mut rows = Vec::new();
+    for kind in AnaglyphKind::ALL {
+        let run = |linear_light| {
+            anaglyph(
+                left,
+                right,
+                kind,
+                AnaglyphOptions {
+                    linear_light,
+                    swap_eyes: false,
+                },
+            )
+        };
+        let stored = run(false)?;
+        let linear = run(true)?;
+        let diffs: Vec<u8> = stored
+            .as_raw()
+            .iter()
+            .zip(linear.as_raw())
+            .map(|(a, b)| a.abs_diff(*b))
+            .collect();
+        let max = diffs.iter().copied().max().unwrap_or(0) as f64;
+        let mean = diffs.iter().map(|d| *d as f64).sum::<f64>() / (px * 3) as f64;
+        let stored_ms = median_ms(iters, || run(false).is_ok());
+        let linear_ms = median_ms(iters, || run(true).is_ok());
+        rows.push(with_throughput(
+            row(
+                "anaglyph",
+                format!("{} stored", kind.output_name()),
+                Some(0.0),
+                "max levels vs stored",
+                stored_ms,
+            ),
+            px * 8,
+            copy,
+        ));
+        let mut r = row(
+            "anaglyph",
+            format!("{} linear", kind.output_name()),
+            Some(max),
+            "max levels vs stored",
+            linear_ms,
+        );
+        r.note = format!("mean {mean:.2} levels");
+        rows.push(with_throughput(r, px * 8, copy));
+    }
+    Ok(rows)
+}
+
+/// Remap coordinates in f32 (seed 004's shader), f32 with the composed matrix, and f64: time,
+/// and the largest texture-coordinate difference to f64 over drawn pixels (and over all pixels,
+/// including the far plane).
+fn remap_precision_rows(
+    left: &Framebuffer,
+    mvp: &[Mat4; 2],
+    label: &str,
+    iters: usize,
+) -> Result<Vec<Row>> {
+    let exact = remap_coordinates(left, &mvp[0], &mvp[1], Precision::F64)?;
+    let mut rows = Vec::new();
+    for (p, name) in [
+        (Precision::F64, "f64"),
+        (Precision::F32Composed, "f32 composed"),
+        (Precision::F32, "f32 seed 004"),
+    ] {
+        let coords = remap_coordinates(left, &mvp[0], &mvp[1], p)?;
+        let (mut drawn, mut all) = (0.0f64, 0.0f64);
+        for ((a, b), d) in exact.iter().zip(&coords).zip(&left.depth) {
+            let e = match (a, b) {
+                (Some(a), Some(b)) => (a.tex[0] - b.tex[0]).abs().max((a.tex[1] - b.tex[1]).abs()),
+                (None, None) => 0.0,
+                _ => f64::INFINITY,
+            };
+            all = all.max(e);
+            if *d < 1.0 {
+                drawn = drawn.max(e);
+            }
+        }
+        // Time the per-pixel program alone (no coordinate buffer to allocate).
+        let remapper = Remapper::new(&mvp[0], &mvp[1], left.width, left.height, p)?;
+        let ms = median_ms(iters, || {
+            let mut sum = 0.0;
+            for y in 0..left.height {
+                for x in 0..left.width {
+                    if let Some(m) = remapper.remap(x, y, left.depth[left.index(x, y)]) {
+                        sum += m.tex[0] + m.tex[1] + m.depth;
+                    }
+                }
+            }
+            sum
+        });
+        let mut r = row(
+            "remap unproject",
+            format!("{name}, {label}"),
+            Some(drawn),
+            "max |tex| error",
+            ms,
+        );
+        r.note = format!(
+            "= {:.4} px at width {}; all pixels incl. far plane {:.2e}",
+            drawn * left.width as f64,
+            left.width,
+            all
+        );
+        rows.push(r);
+    }
+    Ok(rows)
+}

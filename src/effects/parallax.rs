@@ -1,0 +1,286 @@
+//! Screen parallax per pixel, `p(z) = d·(1 − z0/z)` (seed 004), drawn as color (blue negative,
+//! red positive, as seed 004's last slide), and seed 003's parallax budget.
+//!
+//! Per pixel, as a shader: the window depth back to the eye distance z ([`ParallaxRig::
+//! eye_distance`]), then `p(z)` in world units at the zero-parallax plane, then in pixels
+//! (`× W / Xrange`, Xrange the view width at z0). Positive parallax lies behind the screen (the
+//! right eye's image of a point is right of the left eye's), as seed 003 defines it.
+
+use image::RgbaImage;
+
+use super::eye_input::check_depth;
+use super::legend::draw_legend;
+use crate::error::{Error, Result};
+use crate::framebuffer::Framebuffer;
+use crate::info::PARALLAX_BUDGET_PERCENT;
+use crate::math::{Camera, CameraMode, StereoRig};
+use crate::scene::Scene;
+
+/// The rig's numbers the parallax formula needs, resolved for one image size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParallaxRig {
+    /// Eye separation d (world units, `user_offset` applied).
+    pub eye_separation: f64,
+    /// Zero-parallax distance z0.
+    pub zero_parallax_distance: f64,
+    /// Seed 003's `UserBalanceAdjustment` b (off-axis), 1 for toe-in, 0 for parallel axes.
+    pub balance: f64,
+    /// Near plane distance n.
+    pub near: f64,
+    /// Far plane distance f.
+    pub far: f64,
+    /// Pixels per world unit at the zero-parallax plane: `W / Xrange`.
+    pub pixels_per_unit: f64,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+}
+
+impl ParallaxRig {
+    /// Resolves `rig` against `camera` for a `width`×`height` image.
+    ///
+    /// # Errors
+    /// As [`StereoRig::resolve`] and [`Camera::validate`].
+    pub fn new(rig: &StereoRig, camera: &Camera, width: u32, height: u32) -> Result<Self> {
+        camera.validate()?;
+        let r = rig.resolve(camera, width as f32 / height as f32)?;
+        Ok(ParallaxRig {
+            eye_separation: r.eye_separation as f64,
+            zero_parallax_distance: r.zero_parallax_distance as f64,
+            balance: match rig.mode {
+                CameraMode::OffAxis => rig.user_balance as f64,
+                CameraMode::ToeIn => 1.0,
+                CameraMode::Parallel => 0.0,
+            },
+            near: camera.near as f64,
+            far: camera.far as f64,
+            pixels_per_unit: width as f64 / r.xrange as f64,
+            width,
+            height,
+        })
+    }
+
+    /// The rig of a scene at its image size.
+    ///
+    /// # Errors
+    /// As [`ParallaxRig::new`].
+    pub fn of_scene(scene: &Scene) -> Result<Self> {
+        ParallaxRig::new(&scene.rig, &scene.camera, scene.width, scene.height)
+    }
+
+    /// Eye distance z of a window depth `d_w` (inverting `d_w = f/(f−n)·(1 − n/z)`, the
+    /// depth `P_frustum` and `glDepthRange(0, 1)` produce): `z = n f / (f − d_w (f − n))`.
+    #[inline]
+    pub fn eye_distance(&self, window_depth: f32) -> f64 {
+        let (n, f) = (self.near, self.far);
+        n * f / (f - window_depth as f64 * (f - n))
+    }
+
+    /// Screen parallax of a point at eye distance z, world units at the zero-parallax plane:
+    /// `p(z) = d·(b − z0/z)`. With seed 003's balance b = 1 this is seed 004's
+    /// `p(z) = d·(1 − z0/z)`; b scales the frustum shift (`n·d/(2 z0)·b`), b = 0 is parallel
+    /// axes. Exact for off-axis and parallel rigs; for toe-in only on the center line.
+    #[inline]
+    pub fn parallax(&self, z: f64) -> f64 {
+        self.eye_separation * (self.balance - self.zero_parallax_distance / z)
+    }
+
+    /// Parallax in pixels of the point a pixel with window depth `d_w` shows; `None` for the
+    /// background (depth 1).
+    #[inline]
+    pub fn parallax_pixels(&self, window_depth: f32) -> Option<f64> {
+        (window_depth < 1.0)
+            .then(|| self.parallax(self.eye_distance(window_depth)) * self.pixels_per_unit)
+    }
+
+    fn check(&self, fb: &Framebuffer) -> Result<()> {
+        if (fb.width, fb.height) != (self.width, self.height) {
+            return Err(Error::invalid(
+                "parallax framebuffer",
+                format!("{}x{}", fb.width, fb.height),
+                format!("the rig was resolved for {}x{}", self.width, self.height),
+            ));
+        }
+        check_depth("parallax", fb)
+    }
+}
+
+/// Parallax in pixels of every pixel of `fb` (row-major), `None` on the background.
+///
+/// # Errors
+/// A size other than the rig's, or a missing or NaN depth buffer.
+pub fn parallax_map(fb: &Framebuffer, rig: &ParallaxRig) -> Result<Vec<Option<f64>>> {
+    rig.check(fb)?;
+    Ok(fb.depth.iter().map(|d| rig.parallax_pixels(*d)).collect())
+}
+
+/// Seed 003's parallax budget over one eye's pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParallaxBudget {
+    /// Image width (parallax percentages are of this).
+    pub width: u32,
+    /// Pixels showing geometry (depth < 1).
+    pub drawn: usize,
+    /// Most negative parallax, pixels (in front of the screen).
+    pub min_pixels: f64,
+    /// Most positive parallax, pixels (behind the screen).
+    pub max_pixels: f64,
+    /// Drawn pixels whose |parallax| exceeds [`PARALLAX_BUDGET_PERCENT`] of the width.
+    pub beyond_budget: usize,
+    /// Border pixels with negative parallax (seed 003's window violation), per side:
+    /// left, right, top, bottom.
+    pub window_violations: [usize; 4],
+}
+
+impl ParallaxBudget {
+    /// `pixels` as percent of the image width.
+    pub fn percent(&self, pixels: f64) -> f64 {
+        pixels / self.width as f64 * 100.0
+    }
+
+    /// Share (0..1) of drawn pixels beyond the budget.
+    pub fn share_beyond(&self) -> f64 {
+        self.beyond_budget as f64 / self.drawn.max(1) as f64
+    }
+
+    /// The lines `stereolab info` and the render report print.
+    pub fn report(&self) -> String {
+        if self.drawn == 0 {
+            return "parallax budget: no geometry drawn\n".into();
+        }
+        let sides = ["left", "right", "top", "bottom"];
+        let violations: Vec<String> = sides
+            .iter()
+            .zip(self.window_violations)
+            .filter(|(_, n)| *n > 0)
+            .map(|(s, n)| format!("{s} {n} px"))
+            .collect();
+        format!(
+            "parallax budget (per pixel, {} drawn): min {:+.2} px ({:+.3}%), max {:+.2} px ({:+.3}%)\n  \
+             beyond ±{}% of width: {:.2}% of drawn pixels ({})\n  window violations (negative parallax at the border): {}\n",
+            self.drawn,
+            self.min_pixels,
+            self.percent(self.min_pixels),
+            self.max_pixels,
+            self.percent(self.max_pixels),
+            PARALLAX_BUDGET_PERCENT,
+            self.share_beyond() * 100.0,
+            self.beyond_budget,
+            if violations.is_empty() {
+                "none".to_string()
+            } else {
+                violations.join(", ")
+            }
+        )
+    }
+}
+
+/// The budget of a parallax map of a `width`×`height` image.
+pub fn budget(map: &[Option<f64>], width: u32, height: u32) -> ParallaxBudget {
+    let limit = PARALLAX_BUDGET_PERCENT as f64 / 100.0 * width as f64;
+    let mut b = ParallaxBudget {
+        width,
+        drawn: 0,
+        min_pixels: f64::INFINITY,
+        max_pixels: f64::NEG_INFINITY,
+        beyond_budget: 0,
+        window_violations: [0; 4],
+    };
+    for (i, p) in map.iter().enumerate() {
+        let Some(p) = *p else { continue };
+        let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
+        b.drawn += 1;
+        b.min_pixels = b.min_pixels.min(p);
+        b.max_pixels = b.max_pixels.max(p);
+        b.beyond_budget += (p.abs() > limit) as usize;
+        if p < 0.0 {
+            let on = [x == 0, x + 1 == width, y == 0, y + 1 == height];
+            for (v, on) in b.window_violations.iter_mut().zip(on) {
+                *v += on as usize;
+            }
+        }
+    }
+    b
+}
+
+/// The budget of one eye's depth buffer.
+///
+/// # Errors
+/// As [`parallax_map`].
+pub fn budget_of(fb: &Framebuffer, rig: &ParallaxRig) -> Result<ParallaxBudget> {
+    Ok(budget(&parallax_map(fb, rig)?, fb.width, fb.height))
+}
+
+/// Color of background pixels in the parallax image.
+pub const PARALLAX_BACKGROUND: [u8; 4] = [24, 24, 24, 255];
+
+/// Seed 004's parallax color: white at zero, towards blue (0, 64, 255) for negative and red
+/// (255, 32, 0) for positive parallax, saturating at ±`scale` pixels.
+#[inline]
+pub fn parallax_color(pixels: f64, scale: f64) -> [u8; 4] {
+    let t = (pixels / scale).clamp(-1.0, 1.0);
+    let (end, s) = if t < 0.0 {
+        ([0.0, 64.0, 255.0], -t)
+    } else {
+        ([255.0, 32.0, 0.0], t)
+    };
+    let c = |k: usize| (255.0 + (end[k] - 255.0) * s).round() as u8;
+    [c(0), c(1), c(2), 255]
+}
+
+/// The symmetric color scale of a budget: the largest |parallax|, at least half a pixel.
+pub fn color_scale(b: &ParallaxBudget) -> f64 {
+    if b.drawn == 0 {
+        return 0.5;
+    }
+    b.min_pixels.abs().max(b.max_pixels.abs()).max(0.5)
+}
+
+/// The parallax of one eye's depth buffer as color, with a legend bar (drawn with tiny-skia)
+/// appended below the image: the color scale from −S to +S pixels, ticks at 0 and at seed
+/// 003's ±3% budget, labels in pixels and percent of the width.
+///
+/// # Errors
+/// As [`parallax_map`].
+pub fn parallax_image(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> {
+    let map = parallax_map(fb, rig)?;
+    let b = budget(&map, fb.width, fb.height);
+    let scale = color_scale(&b);
+    let legend = draw_legend(fb.width, scale, &|p| parallax_color(p, scale))?;
+    let mut bytes: Vec<u8> = map
+        .iter()
+        .flat_map(|p| p.map_or(PARALLAX_BACKGROUND, |p| parallax_color(p, scale)))
+        .collect();
+    bytes.extend_from_slice(legend.data());
+    let h = fb.height + legend.height();
+    Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))
+}
+
+/// The budget of a scene: renders the left eye depth-only (all `p(z)` needs) and measures it.
+/// What `stereolab info` prints.
+///
+/// # Errors
+/// Invalid camera or rig, or an image size refused by [`Framebuffer::new`].
+pub fn scene_budget(scene: &Scene) -> Result<ParallaxBudget> {
+    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let (fb, _) = crate::render::render_view(scene, &eyes[0], crate::plan::Shading::DepthOnly)?;
+    budget_of(&fb, &ParallaxRig::of_scene(scene)?)
+}
+
+/// The budget lines of the render report, from the frame's left eye depth (or the right eye's
+/// when only that one was rendered); `None` when no eye pass ran.
+///
+/// # Errors
+/// As [`parallax_map`].
+pub fn frame_budget_report(frame: &crate::render::Frame, scene: &Scene) -> Result<Option<String>> {
+    use crate::plan::View;
+    let rig = ParallaxRig::of_scene(scene)?;
+    for (view, name) in [(View::Left, "left"), (View::Right, "right")] {
+        if let Some(fb) = frame.view(view) {
+            let b = budget_of(fb, &rig)?;
+            return Ok(Some(format!("  {name} eye {}", b.report())));
+        }
+    }
+    Ok(None)
+}

@@ -1,0 +1,330 @@
+//! Remapping one eye's pixels into the other eye (seed 004, "Remapping"), and the visibility
+//! check built on it (seed 004, "Visibility Check").
+//!
+//! For a pixel of eye `this` (window coordinates from `gl_FragCoord.xy`, depth from its depth
+//! texture):
+//!
+//! ```text
+//! ndc_this = (2 x_win / W − 1, 1 − 2 y_win / H, 2 d − 1)        (row 0 at the top)
+//! clip_other = MVP_other · MVP_this⁻¹ · (ndc_this, 1)
+//! ndc_other  = clip_other.xyz / clip_other.w                    (the w-divide)
+//! τ = ½ (ndc_other.xy + 1)                                      (texture coordinates, v up)
+//! ```
+//!
+//! and the other eye's color and depth are fetched at τ with nearest filtering (seed 004 sets
+//! `TF_NEAREST` on all four textures). [`Remapper::remap`] is the shader for one pixel; the
+//! functions below it only loop.
+
+use glam::{DMat4, DVec4, Mat4, Vec4};
+use image::RgbaImage;
+
+use super::eye_input::{check_depth, check_same_size};
+use crate::error::{Error, Result};
+use crate::framebuffer::Framebuffer;
+
+/// In which precision the unproject/project chain runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Precision {
+    /// As seed 004's shader: `iMVP_this` (inverted in f32) and `MVP_other` as f32 uniforms, two
+    /// f32 products per pixel through world space. Loses accuracy as far/near grows: the
+    /// inverse projection's entries grow like 1/near and cancel. On the real model at 1024 px
+    /// width the texture coordinates are off by 2.3e-4 px at near/far = 1/20 but by 1.5 px at
+    /// 1e-5 (tested).
+    F32,
+    /// `MVP_other · MVP_this⁻¹` composed once in f64 (on the host, as a uniform), rounded to
+    /// f32, and applied per pixel in f32: one product, no trip through world space. What a
+    /// WGSL mirror should do: 0.07 px at near/far = 1e-5 in the same test.
+    F32Composed,
+    /// `MVP_other · MVP_this⁻¹` composed and applied in f64 (the reference).
+    #[default]
+    F64,
+}
+
+/// Where a pixel of one eye lands in the other eye.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Remapped {
+    /// Texture coordinates τ = ½(ndc_other.xy + 1) in the other eye: u right, v up.
+    pub tex: [f64; 2],
+    /// The point's window depth in the other eye, `½ ndc_other.z + ½`.
+    pub depth: f64,
+}
+
+impl Remapped {
+    /// The other eye's window position (pixels, y down, pixel centers at +0.5).
+    pub fn window(&self, width: u32, height: u32) -> [f64; 2] {
+        [
+            self.tex[0] * width as f64,
+            (1.0 - self.tex[1]) * height as f64,
+        ]
+    }
+
+    /// The texel nearest filtering fetches, or `None` outside the other eye's image.
+    pub fn texel(&self, width: u32, height: u32) -> Option<(u32, u32)> {
+        let [x, y] = self.window(width, height);
+        let (x, y) = (x.floor(), y.floor());
+        (x >= 0.0 && y >= 0.0 && x < width as f64 && y < height as f64)
+            .then_some((x as u32, y as u32))
+    }
+}
+
+/// The per-pixel remapping program of one eye into the other, with its uniforms.
+#[derive(Clone, Copy, Debug)]
+pub struct Remapper {
+    precision: Precision,
+    width: u32,
+    height: u32,
+    inverse_this: Mat4,
+    other: Mat4,
+    this_to_other: DMat4,
+    this_to_other_f32: Mat4,
+}
+
+impl Remapper {
+    /// The uniforms for remapping from the eye with `this_mvp` into the eye with `other_mvp`,
+    /// both rendering `width`×`height` images.
+    ///
+    /// # Errors
+    /// `this_mvp` is not invertible (or not finite).
+    pub fn new(
+        this_mvp: &Mat4,
+        other_mvp: &Mat4,
+        width: u32,
+        height: u32,
+        precision: Precision,
+    ) -> Result<Remapper> {
+        let this64 = this_mvp.as_dmat4();
+        let det = this64.determinant();
+        if !(det.is_finite() && det != 0.0 && other_mvp.is_finite()) {
+            return Err(Error::invalid(
+                "eye matrices",
+                format!("det(MVP) = {det}"),
+                "the eye's MVP must be finite and invertible to unproject its pixels",
+            ));
+        }
+        let this_to_other = other_mvp.as_dmat4() * this64.inverse();
+        Ok(Remapper {
+            precision,
+            width,
+            height,
+            inverse_this: this_mvp.inverse(),
+            other: *other_mvp,
+            this_to_other,
+            this_to_other_f32: this_to_other.as_mat4(),
+        })
+    }
+
+    /// The shader for pixel (x, y) of this eye with window depth `depth`: where its surface point
+    /// lands in the other eye. `None` when the point is behind the other eye (w ≤ 0).
+    #[inline]
+    pub fn remap(&self, x: u32, y: u32, depth: f32) -> Option<Remapped> {
+        match self.precision {
+            Precision::F32 | Precision::F32Composed => {
+                let ndc = Vec4::new(
+                    2.0 * (x as f32 + 0.5) / self.width as f32 - 1.0,
+                    1.0 - 2.0 * (y as f32 + 0.5) / self.height as f32,
+                    2.0 * depth - 1.0,
+                    1.0,
+                );
+                let clip = if self.precision == Precision::F32 {
+                    self.other * (self.inverse_this * ndc)
+                } else {
+                    self.this_to_other_f32 * ndc
+                };
+                (clip.w > 0.0).then(|| {
+                    let n = clip.truncate() / clip.w;
+                    Remapped {
+                        tex: [0.5 * (n.x as f64 + 1.0), 0.5 * (n.y as f64 + 1.0)],
+                        depth: 0.5 * n.z as f64 + 0.5,
+                    }
+                })
+            }
+            Precision::F64 => {
+                let ndc = DVec4::new(
+                    2.0 * (x as f64 + 0.5) / self.width as f64 - 1.0,
+                    1.0 - 2.0 * (y as f64 + 0.5) / self.height as f64,
+                    2.0 * depth as f64 - 1.0,
+                    1.0,
+                );
+                let clip = self.this_to_other * ndc;
+                (clip.w > 0.0).then(|| {
+                    let n = clip.truncate() / clip.w;
+                    Remapped {
+                        tex: [0.5 * (n.x + 1.0), 0.5 * (n.y + 1.0)],
+                        depth: 0.5 * n.z + 0.5,
+                    }
+                })
+            }
+        }
+    }
+}
+
+/// Where every pixel of `this` lands in the other eye (row-major; `None` behind the other eye).
+///
+/// # Errors
+/// A missing or non-finite depth buffer, or a singular MVP.
+pub fn remap_coordinates(
+    this: &Framebuffer,
+    this_mvp: &Mat4,
+    other_mvp: &Mat4,
+    precision: Precision,
+) -> Result<Vec<Option<Remapped>>> {
+    check_depth("this", this)?;
+    let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
+    Ok((0..this.height)
+        .flat_map(|y| (0..this.width).map(move |x| (x, y)))
+        .map(|(x, y)| r.remap(x, y, this.depth[this.index(x, y)]))
+        .collect())
+}
+
+/// `this` eye's view recolored from the `other` eye: each pixel takes the other eye's color at
+/// its remapped position. Reads this eye's depth and the other eye's color only; regions the
+/// other eye cannot see show whatever the other eye sees there instead, which is what makes
+/// occlusions visible (seed 004). Pixels where this eye drew nothing (depth 1) have no surface
+/// point to remap and stay black; points outside the other image get
+/// [`OUT_OF_VIEW_COLOR`](super::occlusion::OUT_OF_VIEW_COLOR).
+///
+/// # Errors
+/// Different sizes, a missing or NaN depth buffer in `this`, or a singular MVP.
+pub fn remap_color(
+    this: &Framebuffer,
+    other: &Framebuffer,
+    this_mvp: &Mat4,
+    other_mvp: &Mat4,
+    precision: Precision,
+) -> Result<RgbaImage> {
+    check_same_size(this, other)?;
+    check_depth("this", this)?;
+    let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
+    let (w, h) = (this.width, this.height);
+    let mut bytes = vec![0u8; this.depth.len() * 4];
+    for (i, out) in bytes.chunks_exact_mut(4).enumerate() {
+        let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
+        out.copy_from_slice(&remap_color_pixel(&r, other, x, y, this.depth[i]));
+    }
+    Ok(RgbaImage::from_raw(w, h, bytes).expect("4 bytes per pixel"))
+}
+
+/// One pixel of [`remap_color`]: the other eye's color at the remapped texel.
+#[inline]
+pub fn remap_color_pixel(r: &Remapper, other: &Framebuffer, x: u32, y: u32, depth: f32) -> [u8; 4] {
+    if depth >= 1.0 {
+        return super::occlusion::BACKGROUND_COLOR;
+    }
+    r.remap(x, y, depth)
+        .and_then(|m| m.texel(other.width, other.height))
+        .map_or(super::occlusion::OUT_OF_VIEW_COLOR, |(tx, ty)| {
+            other.pixel(tx, ty)
+        })
+}
+
+/// What the other eye sees of a surface point this eye sees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Visibility {
+    /// This eye sees nothing here (depth 1: the cleared far plane).
+    Background,
+    /// The other eye sees the same surface point.
+    Visible,
+    /// Something nearer hides the point from the other eye.
+    Occluded,
+    /// The point lies outside the other eye's image (or behind it).
+    OutOfView,
+    /// The other eye's depth there is *farther* than the point. Impossible for exact geometry
+    /// (seed 004: "if violated, only d₁ < d₀ possible"); it happens only where nearest
+    /// sampling at a silhouette fetches the background next to the surface.
+    Farther,
+}
+
+/// Depth-precision part of the visibility tolerance, in window-depth units: 8·2⁻²⁴.
+///
+/// A window depth is an f32 in [0, 1]; near 1 (where every depth of a scene with a large
+/// far/near ratio crowds) one unit in the last place is 2⁻²⁴. Each eye's depth comes from the
+/// rasterizer's plane equation `z0 + dz/dx·Δx + dz/dy·Δy` (terms up to ~1, three roundings)
+/// and one store, so each is within ~4 ulps of the exact window depth; the two eyes together
+/// give 8. The remapped depth itself (computed in f64 by default) adds nothing measurable.
+pub const DEPTH_PRECISION: f64 = 8.0 / 16_777_216.0;
+
+/// The local depth slope of `fb` at (x, y), in window depth per pixel: for each axis the
+/// smaller of the two one-sided differences (so a silhouette on one side does not widen the
+/// tolerance), summed over x and y. A shader reads the same four neighbours with `texelFetch`.
+#[inline]
+pub fn depth_slope(fb: &Framebuffer, x: u32, y: u32) -> f64 {
+    let d = |x: u32, y: u32| fb.depth[fb.index(x, y)] as f64;
+    let c = d(x, y);
+    let one_sided = |a: Option<f64>, b: Option<f64>| match (a, b) {
+        (Some(a), Some(b)) => (a - c).abs().min((b - c).abs()),
+        (Some(v), None) | (None, Some(v)) => (v - c).abs(),
+        (None, None) => 0.0,
+    };
+    let gx = one_sided(
+        x.checked_sub(1).map(|x| d(x, y)),
+        (x + 1 < fb.width).then(|| d(x + 1, y)),
+    );
+    let gy = one_sided(
+        y.checked_sub(1).map(|y| d(x, y)),
+        (y + 1 < fb.height).then(|| d(x, y + 1)),
+    );
+    gx + gy
+}
+
+/// The visibility tolerance at a pixel: `DEPTH_PRECISION + slope_x + slope_y`.
+///
+/// Why the slope: nearest filtering fetches the other eye's texel center, up to half a pixel
+/// from the remapped point in x and in y, so on a sloped surface the fetched depth differs
+/// from the remapped one by up to ½·(|∂d/∂x| + |∂d/∂y|). The slope is measured in this eye;
+/// the other eye sees the surface stretched or squeezed horizontally by the parallax gradient,
+/// so a full pixel's worth (a factor 2) is allowed.
+#[inline]
+pub fn tolerance(slope: f64) -> f64 {
+    DEPTH_PRECISION + slope
+}
+
+/// The visibility check for one pixel (seed 004): the other eye's depth `other_depth` at the
+/// remapped texel against the remapped depth, within `tolerance`. `target` is `None` when the
+/// point falls outside the other image.
+#[inline]
+pub fn classify(this_depth: f32, target: Option<(Remapped, f32)>, tolerance: f64) -> Visibility {
+    if this_depth >= 1.0 {
+        return Visibility::Background;
+    }
+    let Some((r, other_depth)) = target else {
+        return Visibility::OutOfView;
+    };
+    let diff = other_depth as f64 - r.depth;
+    if diff.abs() <= tolerance {
+        Visibility::Visible
+    } else if diff < 0.0 {
+        Visibility::Occluded
+    } else {
+        Visibility::Farther
+    }
+}
+
+/// The visibility of every pixel of `this` in `other` (row-major). Reads both depth buffers only.
+///
+/// # Errors
+/// Different sizes, a missing or NaN depth buffer, or a singular MVP.
+pub fn visibility_map(
+    this: &Framebuffer,
+    other: &Framebuffer,
+    this_mvp: &Mat4,
+    other_mvp: &Mat4,
+    precision: Precision,
+) -> Result<Vec<Visibility>> {
+    check_same_size(this, other)?;
+    check_depth("this", this)?;
+    check_depth("other", other)?;
+    let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
+    let (w, h) = (this.width, this.height);
+    let mut out = Vec::with_capacity(this.depth.len());
+    for y in 0..h {
+        for x in 0..w {
+            let d = this.depth[this.index(x, y)];
+            let target = r.remap(x, y, d).and_then(|m| {
+                m.texel(w, h)
+                    .map(|(tx, ty)| (m, other.depth[other.index(tx, ty)]))
+            });
+            out.push(classify(d, target, tolerance(depth_slope(this, x, y))));
+        }
+    }
+    Ok(out)
+}
