@@ -4,6 +4,8 @@ use glam::Mat4;
 use serde::{Deserialize, Serialize};
 
 use super::protocol::Answer;
+use crate::effects::anaglyph;
+pub use crate::effects::anaglyph::{AnaglyphMatrices, ColorMatrix};
 
 /// A mono camera's symmetric frustum plus the stereo rig (seed 004's parameters).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -61,22 +63,20 @@ impl AnaglyphKind {
         AnaglyphKind::Color,
         AnaglyphKind::HalfColor,
     ];
+
+    /// The same kind in stereolab's anaglyph module (the reference).
+    pub fn reference(self) -> anaglyph::AnaglyphKind {
+        match self {
+            AnaglyphKind::True => anaglyph::AnaglyphKind::True,
+            AnaglyphKind::Gray => anaglyph::AnaglyphKind::Gray,
+            AnaglyphKind::Color => anaglyph::AnaglyphKind::Color,
+            AnaglyphKind::HalfColor => anaglyph::AnaglyphKind::HalfColor,
+        }
+    }
 }
 
-/// A 3×3 color matrix written as on the slides: `m[row][column]`, rows are the output R, G, B,
-/// columns the input R, G, B.
-pub type ColorMatrix = [[f32; 3]; 3];
-
-/// `out = clamp(left · left_rgb + right · right_rgb)`, each `ColorMatrix` row-major.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AnaglyphMatrices {
-    /// Applied to the left eye's (index 0) color.
-    pub left: ColorMatrix,
-    /// Applied to the right eye's (index 1) color.
-    pub right: ColorMatrix,
-}
-
-/// Flattens as `left` then `right`, each row by row.
+/// Flattens as `left` then `right`, each row by row (`m[row][column]`, rows are the output
+/// R, G, B, as on the slides).
 impl Answer for AnaglyphMatrices {
     fn flatten(&self, out: &mut Vec<f64>) {
         self.left.flatten(out);
