@@ -92,6 +92,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         &scene,
         opts.iterations,
     )?);
+    rows.extend(crate::effects::sirds::bench::rows(opts.iterations)?);
     Ok(rows)
 }
 
@@ -296,22 +297,58 @@ impl Shader for RecordUv<'_> {
     }
 }
 
-/// The rows as an aligned table.
+/// The rows as an aligned table (column widths fitted to the content).
 pub fn table(rows: &[Row]) -> String {
-    let mut s = format!(
-        "{:<14} {:<16} {:<22} {:>14} {:<22} {:>10}  {}\n",
-        "area", "knob", "setting", "error", "error unit", "ms", "note"
-    );
-    for r in rows {
-        let e = r
-            .error
-            .map(|e| format!("{e:.6}"))
-            .unwrap_or_else(|| "-".into());
-        let _ = writeln!(
-            s,
-            "{:<14} {:<16} {:<22} {:>14} {:<22} {:>10.3}  {}",
-            r.area, r.knob, r.setting, e, r.error_unit, r.ms, r.note
-        );
+    let cells: Vec<[String; 7]> = rows
+        .iter()
+        .map(|r| {
+            let e = r
+                .error
+                .map(|e| format!("{e:.6}"))
+                .unwrap_or_else(|| "-".into());
+            [
+                r.area.clone(),
+                r.knob.clone(),
+                r.setting.clone(),
+                e,
+                r.error_unit.clone(),
+                format!("{:.3}", r.ms),
+                r.note.clone(),
+            ]
+        })
+        .collect();
+    let header = [
+        "area",
+        "knob",
+        "setting",
+        "error",
+        "error unit",
+        "ms",
+        "note",
+    ]
+    .map(String::from);
+    let mut width = [0usize; 7];
+    for row in cells.iter().chain(std::iter::once(&header)) {
+        for (w, c) in width.iter_mut().zip(row) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let mut s = String::new();
+    for row in std::iter::once(&header).chain(&cells) {
+        let line: Vec<String> = row
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                if i == 3 || i == 5 {
+                    format!("{c:>w$}", w = width[i])
+                } else if i == 6 {
+                    c.clone()
+                } else {
+                    format!("{c:<w$}", w = width[i])
+                }
+            })
+            .collect();
+        let _ = writeln!(s, "{}", line.join("  ").trim_end());
     }
     s
 }

@@ -103,6 +103,9 @@ enum Command {
         #[arg(long, default_value_t = 15)]
         iterations: usize,
     },
+    /// Autostereograms (SIRDS): from a scene, from a depth map (--depth), animated (--frames),
+    /// or decoded back to depth (--decode).
+    Sirds(stereolab::effects::sirds::cli::SirdsArgs),
 }
 
 #[derive(Subcommand)]
@@ -266,6 +269,10 @@ fn run(cli: Cli) -> Result<()> {
             if let Some(path) = csv {
                 bench::write_csv(&rows, &path)?;
             }
+            Ok(())
+        }
+        Command::Sirds(args) => {
+            print!("{}", stereolab::effects::sirds::cli::run(&args)?);
             Ok(())
         }
     }

@@ -119,6 +119,14 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             eye(View::Left)?,
             &ParallaxRig::of_scene(scene)?,
         )?),
+        Output::Sirds => {
+            Image::Rgba(crate::effects::sirds::from_frame(frame, scene)?.to_rgba_image())
+        }
+        Output::SirdsDepth => Image::Gray16(
+            crate::effects::sirds::scene_depth(frame, scene)?
+                .0
+                .to_image(),
+        ),
     })
 }
 

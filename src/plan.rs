@@ -50,6 +50,10 @@ pub enum Output {
     Occlusion,
     /// The left eye's parallax `p(z) = d(1 − z0/z)` as color with a legend (seed 004).
     Parallax,
+    /// Single-image random-dot stereogram of the cyclopean view (seed 002).
+    Sirds,
+    /// The depth map the SIRDS encodes (16-bit, white = near).
+    SirdsDepth,
 }
 
 /// Which camera a pass renders from.
@@ -114,6 +118,8 @@ impl Output {
         Output::RemapRight,
         Output::Occlusion,
         Output::Parallax,
+        Output::Sirds,
+        Output::SirdsDepth,
     ];
 
     /// The name used in scene files and for the PNG written.
@@ -139,6 +145,8 @@ impl Output {
             Output::RemapRight => "remap_right",
             Output::Occlusion => "occlusion",
             Output::Parallax => "parallax",
+            Output::Sirds => "sirds",
+            Output::SirdsDepth => "sirds_depth",
         }
     }
 
@@ -191,6 +199,8 @@ impl Output {
             Output::Occlusion => vec![depth(View::Left), depth(View::Right)],
             // p(z) needs the left eye's depth and the rig, nothing else.
             Output::Parallax => vec![depth(View::Left)],
+            // One depth pass of the cyclopean view; no color shading at all (seed 002).
+            Output::Sirds | Output::SirdsDepth => vec![depth(View::Center)],
             _ => vec![color(View::Left), color(View::Right)],
         }
     }

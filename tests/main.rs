@@ -10,4 +10,5 @@ mod golden;
 mod grading;
 mod layout;
 mod rig;
+mod sirds;
 mod stability;

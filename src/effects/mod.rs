@@ -10,3 +10,4 @@ pub mod legend;
 pub mod occlusion;
 pub mod parallax;
 pub mod remap;
+pub mod sirds;

@@ -249,21 +249,30 @@ pub fn traverse<S: Shader>(
     let writes_color = shader.writes_color();
     let mut frag_var: Varyings = [0.0; MAX_VARYINGS];
     let mut fragments = 0;
-    let step = [t.dcdx[0] * s, t.dcdx[1] * s, t.dcdx[2] * s];
+    let span = t.px1 - t.px0;
     for py in py0..=py1 {
         let sy = py * s;
-        let mut e: [i64; 3] =
-            std::array::from_fn(|i| t.c[i] + t.dcdy[i] * sy - t.dcdx[i] * t.px0 * s);
+        // Edge i at pixel px0 + k is e_i − step_i·k; solve e_i − step_i·k ≥ 0 for k exactly in
+        // integers, so only covered pixels are visited (same coverage as testing each pixel).
+        let (mut k0, mut k1) = (0i64, span);
+        for i in 0..3 {
+            let e = t.c[i] + t.dcdy[i] * sy - t.dcdx[i] * t.px0 * s;
+            let step = t.dcdx[i] * s;
+            match step.cmp(&0) {
+                std::cmp::Ordering::Greater => k1 = k1.min(e.div_euclid(step)),
+                std::cmp::Ordering::Less => {
+                    k0 = k0.max((-e).div_euclid(-step) + ((-e).rem_euclid(-step) != 0) as i64)
+                }
+                std::cmp::Ordering::Equal if e < 0 => k1 = -1,
+                std::cmp::Ordering::Equal => {}
+            }
+        }
+        if k0 > k1 {
+            continue;
+        }
         let fy = py as f32 + 0.5 - t.y0;
         let row = (py - band.y0 as i64) as usize * band.width as usize;
-        for px in t.px0..=t.px1 {
-            let inside = (e[0] | e[1] | e[2]) >= 0;
-            for i in 0..3 {
-                e[i] -= step[i];
-            }
-            if !inside {
-                continue;
-            }
+        for px in t.px0 + k0..=t.px0 + k1 {
             let fx = px as f32 + 0.5 - t.x0;
             let z = t.z.at(fx, fy).clamp(0.0, 1.0);
             let idx = row + px as usize;
@@ -271,14 +280,15 @@ pub fn traverse<S: Shader>(
                 continue;
             }
             if writes_color {
-                let inv_w = t.inv_w.at(fx, fy);
+                // Perspective correction: divide the interpolated a/w by the interpolated 1/w
+                // (one reciprocal per fragment, one multiply per varying).
+                let w = if opts.perspective_correct {
+                    1.0 / t.inv_w.at(fx, fy)
+                } else {
+                    1.0
+                };
                 for (out, plane) in frag_var.iter_mut().zip(&t.var[..t.nvar]) {
-                    let a = plane.at(fx, fy);
-                    *out = if opts.perspective_correct {
-                        a / inv_w
-                    } else {
-                        a
-                    };
+                    *out = plane.at(fx, fy) * w;
                 }
                 let f = Fragment {
                     x: px as u32,

@@ -31,6 +31,9 @@ pub struct SceneFile {
     /// Finalize-pass options (anaglyphs).
     #[serde(default)]
     pub finalize: FinalizeSpec,
+    /// Autostereogram options.
+    #[serde(default)]
+    pub sirds: crate::effects::sirds::SirdsSpec,
     /// Objects, in `[[mesh]]` tables.
     #[serde(default, rename = "mesh")]
     pub meshes: Vec<MeshSpec>,

@@ -63,6 +63,8 @@ pub struct Scene {
     pub chromadepth: ChromaDepthSettings,
     /// Finalize-pass options from `[finalize]` (anaglyph linear light, swapped eyes).
     pub finalize: AnaglyphOptions,
+    /// Autostereogram options (`[sirds]`).
+    pub sirds: crate::effects::sirds::Settings,
 }
 
 impl Scene {
@@ -192,6 +194,7 @@ impl Scene {
                 linear_light: f.finalize.linear_light,
                 swap_eyes: f.finalize.swap_eyes,
             },
+            sirds: crate::effects::sirds::Settings::from_spec(&f.sirds, base_dir)?,
         })
     }
 

@@ -1,0 +1,228 @@
+//! SIRDS benchmark rows: seed 002 Table 1 (depth pass + strip algorithm) beside the paper's
+//! frame rates, every accuracy knob with its decode error, and TIW on a 4096×3072 depth map.
+
+use std::path::Path;
+
+use super::decode::{DecodeOptions, decode, round_trip};
+use super::per_pixel::{PerPixelOptions, per_pixel};
+use super::per_vertex::{Filter, PerVertexOptions, Start, StripGeometry, per_vertex};
+use super::{Algorithm, DepthMap, Pattern, depth_range, from_frame, scene_depth};
+use crate::bench::{Row, median_ms};
+use crate::error::Result;
+use crate::math::StereoRig;
+use crate::plan::{Output, Plan, Shading};
+use crate::render::{render, render_view};
+use crate::scene::Scene;
+
+/// Seed 002 Table 1: (width, height, triangles, k, frame rate in Hz on a GeForce4 Ti 4600).
+pub const TABLE_1: [(u32, u32, u32, u32, f64); 6] = [
+    (512, 512, 2_500, 10, 60.1),
+    (512, 512, 5_000, 10, 40.2),
+    (512, 512, 10_000, 10, 25.6),
+    (1024, 512, 1_000, 20, 26.2),
+    (1024, 512, 2_500, 20, 17.3),
+    (1024, 512, 5_000, 20, 12.4),
+];
+
+/// A sphere over a ramp as a depth map: the ramp falls from `z = 0.5` at the left edge to 0 at
+/// the right, the sphere (radius 0.35 of the shorter side, centered) rises to `z = 1`.
+pub fn sphere_over_ramp(width: u32, height: u32) -> DepthMap {
+    let (w, h) = (width as f32, height as f32);
+    let radius = 0.35 * w.min(h);
+    let z = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let ramp = 0.5 * (1.0 - (x as f32 + 0.5) / w);
+            let (dx, dy) = (x as f32 + 0.5 - w * 0.5, y as f32 + 0.5 - h * 0.5);
+            let r2 = (dx * dx + dy * dy) / (radius * radius);
+            if r2 < 1.0 {
+                ramp.max(0.5 + 0.5 * (1.0 - r2).sqrt())
+            } else {
+                ramp
+            }
+        })
+        .collect();
+    DepthMap { width, height, z }
+}
+
+fn scene(text: &str) -> Result<Scene> {
+    Scene::from_toml(text, Path::new("bench"), Path::new("."), &[])
+}
+
+/// The Table 1 scene: a height-field grid of exactly `triangles` triangles facing the camera.
+fn table_scene(width: u32, height: u32, triangles: u32, k: u32) -> Result<Scene> {
+    scene(&format!(
+        r#"outputs = ["sirds"]
+[image]
+width = {width}
+height = {height}
+[camera]
+eye = [0.0, 0.0, 2.8]
+target = [0.0, 0.0, 0.0]
+fov_y = 45.0
+near = 1.0
+far = 10.0
+[sirds]
+start = "left"
+filter = "bilinear"
+iterations = {k}
+[[mesh]]
+kind = "triangles"
+count = {triangles}
+"#
+    ))
+}
+
+/// Seed 002 Table 1: depth pass + SIRDS (strip algorithm, left start, bilinear, k as in the
+/// paper) per frame, and the rate as a multiple of the paper's.
+fn table_1(iters: usize) -> Result<Vec<Row>> {
+    let mut rows = Vec::new();
+    for (w, h, tris, k, paper_hz) in TABLE_1 {
+        let s = table_scene(w, h, tris, k)?;
+        let center = StereoRig::center(&s.camera, s.aspect())?;
+        let d = s.sirds.geometry.to_pixels()?;
+        let frame = || -> Result<Vec<[u8; 4]>> {
+            let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
+            let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
+            let g = StripGeometry::new(&s, &center, &range, &d, false);
+            Ok(per_vertex(&g, w, h, &d, &s.sirds.pattern, &s.sirds.per_vertex, false)?.pixels)
+        };
+        frame()?;
+        let ms = median_ms(iters, || frame().is_ok());
+        let hz = 1e3 / ms;
+        rows.push(Row {
+            area: "sirds".into(),
+            knob: "seed 002 Table 1".into(),
+            setting: format!("{w}x{h} {tris} tris k={k}"),
+            error: None,
+            error_unit: String::new(),
+            ms,
+            note: format!(
+                "{hz:.0} Hz vs paper {paper_hz} Hz (GeForce4): {:.1}x, depth pass + strips",
+                hz / paper_hz
+            ),
+        });
+    }
+    Ok(rows)
+}
+
+/// Every accuracy knob on the Fig. 5 ramp at 512×256: time to make the SIRDS from the depth
+/// pass, and the decoded separation's RMS error (share within ±1 px in the note).
+fn knobs(iters: usize) -> Result<Vec<Row>> {
+    let mut base = scene(
+        r#"outputs = ["sirds"]
+[image]
+width = 512
+height = 256
+[camera]
+eye = [0.0, 0.0, 5.0]
+target = [0.0, 0.0, 0.0]
+fov_y = 40.0
+near = 1.0
+far = 20.0
+[[mesh]]
+kind = "plane"
+size = 20.0
+detail = 16
+rotate = [0.0, 35.0, 0.0]
+"#,
+    )?;
+    base.sirds.pattern = Pattern::BlackWhite { seed: 5 };
+    let frame = render(&base, &Plan::new(&[Output::Sirds]))?;
+    let (depth, _) = scene_depth(&frame, &base)?;
+    let mut variants: Vec<(&str, String, Scene)> = Vec::new();
+    for (start, filter) in [
+        (Start::Left, Filter::Nearest),
+        (Start::Left, Filter::Bilinear),
+        (Start::Center, Filter::Nearest),
+        (Start::Center, Filter::Bilinear),
+    ] {
+        let mut s = base.clone();
+        s.sirds.per_vertex = PerVertexOptions {
+            start,
+            filter,
+            iterations: None,
+        };
+        variants.push(("strip start/filter", format!("{start:?} {filter:?}"), s));
+    }
+    for (hidden_surface, oversample) in [(false, 1), (true, 1), (true, 2), (true, 4)] {
+        let mut s = base.clone();
+        s.sirds.algorithm = Algorithm::PerPixel;
+        s.sirds.per_pixel = PerPixelOptions {
+            hidden_surface,
+            oversample,
+        };
+        variants.push((
+            "TIW hsr/oversample",
+            format!("hsr={hidden_surface} x{oversample}"),
+            s,
+        ));
+    }
+    let mut rows = Vec::new();
+    for (knob, setting, s) in variants {
+        let sirds = from_frame(&frame, &s)?;
+        let d = sirds.disparity;
+        let opts = DecodeOptions::for_disparity(&d);
+        let decoded = decode(&sirds.pixels, sirds.width, sirds.height, &opts)?;
+        let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
+        let rt = round_trip(&decoded, &intended, &opts);
+        let ms = median_ms(iters, || from_frame(&frame, &s).is_ok());
+        rows.push(Row {
+            area: "sirds".into(),
+            knob: knob.into(),
+            setting,
+            error: Some(rt.rms),
+            error_unit: "rms decoded sep, px".into(),
+            ms,
+            note: format!(
+                "ramp 512x256: {:.1}% within ±1 px, {:.1}% matched",
+                rt.within_one * 100.0,
+                rt.matched * 100.0
+            ),
+        });
+    }
+    Ok(rows)
+}
+
+/// TIW on a 4096×3072 sphere over a ramp, in memory (the whole-process comparison with netpbm's
+/// `pamstereogram` is done with hyperfine, see the issue note).
+fn large_depth_map(iters: usize) -> Result<Vec<Row>> {
+    let depth = sphere_over_ramp(4096, 3072);
+    let d = super::Geometry::default().to_pixels()?;
+    let pattern = Pattern::BlackWhite { seed: 1 };
+    let mut rows = Vec::new();
+    for hidden_surface in [false, true] {
+        let opts = PerPixelOptions {
+            hidden_surface,
+            oversample: 1,
+        };
+        per_pixel(&depth, &d, &pattern, &opts)?;
+        let ms = median_ms(iters.min(3), || {
+            per_pixel(&depth, &d, &pattern, &opts).is_ok()
+        });
+        rows.push(Row {
+            area: "sirds".into(),
+            knob: "TIW 4096x3072".into(),
+            setting: format!("hsr={hidden_surface}"),
+            error: None,
+            error_unit: String::new(),
+            ms,
+            note: format!(
+                "{:.0} Mpixel/s, in memory (no I/O)",
+                4096.0 * 3072.0 / ms / 1e3
+            ),
+        });
+    }
+    Ok(rows)
+}
+
+/// All SIRDS rows.
+///
+/// # Errors
+/// A scene or SIRDS error.
+pub fn rows(iters: usize) -> Result<Vec<Row>> {
+    let mut rows = table_1(iters)?;
+    rows.extend(knobs(iters.min(5))?);
+    rows.extend(large_depth_map(iters)?);
+    Ok(rows)
+}

@@ -1,0 +1,241 @@
+//! `stereolab sirds`: autostereograms from a scene or a depth-map image, animations, decoding.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::animate::{AnimationOptions, animate};
+use super::decode::{DecodeOptions, decode, depth_from_separation};
+use super::{DepthMap, Settings, SirdsSpec, from_depth_map, from_frame};
+use crate::error::{Error, Result};
+use crate::plan::{Output, Plan};
+use crate::render::render;
+use crate::scene::Scene;
+
+/// Arguments of `stereolab sirds`.
+#[derive(clap::Args, Debug)]
+pub struct SirdsArgs {
+    /// Scene file (TOML): its geometry and `[sirds]` table.
+    pub scene: Option<PathBuf>,
+    /// Make a SIRDS of this depth-map image instead (white = near; PNG, PGM, ...) with the
+    /// per-pixel algorithm.
+    #[arg(long, conflicts_with = "scene")]
+    pub depth: Option<PathBuf>,
+    /// Decode this autostereogram: write the depth it encodes to --out and say whether it is
+    /// one at all.
+    #[arg(long, conflicts_with_all = ["scene", "depth"])]
+    pub decode: Option<PathBuf>,
+    /// Output file: .png, or .ppm (uncompressed); .gif with --frames.
+    #[arg(long, short, default_value = "sirds.png")]
+    pub out: PathBuf,
+    /// Override a `[sirds]` field, e.g. --set sirds.dpi=100 (repeatable; with a scene any
+    /// scene field).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Animate: this many frames of the model turning once, written as a GIF.
+    #[arg(long, requires = "scene")]
+    pub frames: Option<u32>,
+    /// Animation: keep one random-dot seed in every frame (default: a new pattern per frame).
+    #[arg(long, requires = "frames")]
+    pub fixed_seed: bool,
+}
+
+/// Settings from `--set sirds.key=value` alone (no scene file).
+fn settings_from_sets(sets: &[String]) -> Result<Settings> {
+    let mut text = String::new();
+    for s in sets {
+        let (k, v) = s
+            .split_once('=')
+            .ok_or_else(|| Error::invalid("--set", s, "expected key=value"))?;
+        let k = k.trim().trim_start_matches("sirds.");
+        let v = v.trim();
+        // Bare words (nearest, color) become TOML strings.
+        let value = if toml::from_str::<toml::Table>(&format!("v = {v}")).is_ok() {
+            v.to_string()
+        } else {
+            format!("\"{v}\"")
+        };
+        text.push_str(&format!("{k} = {value}\n"));
+    }
+    let spec: SirdsSpec = toml::from_str(&text)
+        .map_err(|e| Error::invalid("--set", sets.join(" "), e.message().to_string()))?;
+    Settings::from_spec(&spec, Path::new("."))
+}
+
+/// Writes RGBA pixels as PNG, or as binary PPM (P6, no compression) for `.ppm`/`.pnm`.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext == "ppm" || ext == "pnm" {
+        let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+        let mut write = || -> std::io::Result<()> {
+            write!(w, "P6\n{width} {height}\n255\n")?;
+            let mut row = Vec::with_capacity(width as usize * 3);
+            for line in pixels.chunks_exact(width.max(1) as usize) {
+                row.clear();
+                row.extend(line.iter().flat_map(|p| [p[0], p[1], p[2]]));
+                w.write_all(&row)?;
+            }
+            w.flush()
+        };
+        write().map_err(|e| Error::io(path, e))
+    } else {
+        let bytes = pixels.iter().flatten().copied().collect();
+        let img = image::RgbaImage::from_raw(width, height, bytes).expect("buffer size matches");
+        img.save(path)
+            .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
+    }
+}
+
+/// TIW from a depth-map file straight into a PPM, a chunk of rows at a time: the depth map is
+/// never held as floats, nor the image as RGBA (a 4096×3072 map would need 100 MB for both).
+fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u32, u32)> {
+    let img = image::open(depth)
+        .map_err(|e| Error::parse(depth, None, format!("cannot read depth map: {e}")))?;
+    let (width, height) = (img.width(), img.height());
+    crate::framebuffer::check_size(width, height).map_err(|e| e.in_file(depth))?;
+    let (samples, max): (Vec<u16>, f32) = match img {
+        image::DynamicImage::ImageLuma8(g) => {
+            (g.into_raw().into_iter().map(u16::from).collect(), 255.0)
+        }
+        other => (other.to_luma16().into_raw(), 65535.0),
+    };
+    let invert = settings.cross_eyed;
+    let w = width as usize;
+    let depth_row = |y: u32, row: &mut Vec<f32>| {
+        let line = &samples[y as usize * w..(y as usize + 1) * w];
+        row.extend(line.iter().map(|&v| {
+            let z = v as f32 / max;
+            if invert { 1.0 - z } else { z }
+        }));
+    };
+    let file = std::fs::File::create(out).map_err(|e| Error::io(out, e))?;
+    let mut writer = std::io::BufWriter::with_capacity(1 << 20, file);
+    write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| Error::io(out, e))?;
+    let mut bytes = Vec::new();
+    super::per_pixel::per_pixel_streamed(
+        width,
+        height,
+        depth_row,
+        &settings.geometry.to_pixels()?,
+        &settings.pattern,
+        &settings.per_pixel,
+        |rows| {
+            bytes.clear();
+            bytes.extend(rows.iter().flat_map(|p| [p[0], p[1], p[2]]));
+            writer.write_all(&bytes).map_err(|e| Error::io(out, e))
+        },
+    )?;
+    writer.flush().map_err(|e| Error::io(out, e))?;
+    Ok((width, height))
+}
+
+/// Runs `stereolab sirds`; returns what to print.
+///
+/// # Errors
+/// Any input, render or write error.
+pub fn run(args: &SirdsArgs) -> Result<String> {
+    if let Some(path) = &args.decode {
+        let settings = settings_from_sets(&args.sets)?;
+        let img = image::open(path)
+            .map_err(|e| Error::parse(path, None, format!("cannot read image: {e}")))?
+            .to_rgba8();
+        let (w, h) = img.dimensions();
+        let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+        let d = settings.geometry.to_pixels()?;
+        let decoded = decode(&pixels, w, h, &DecodeOptions::for_disparity(&d))
+            .map_err(|e| e.in_file(path))?;
+        let z: Vec<f32> = depth_from_separation(&decoded, &d)
+            .into_iter()
+            .map(|z| {
+                if z.is_finite() {
+                    z.clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        DepthMap {
+            width: w,
+            height: h,
+            z,
+        }
+        .to_image()
+        .save(&args.out)
+        .map_err(|e| Error::io(&args.out, std::io::Error::other(e.to_string())))?;
+        return Ok(format!(
+            "{}: {:.1}% of pixels matched a separation in {}..={} px: {}\n  wrote {}\n",
+            path.display(),
+            decoded.matched_share * 100.0,
+            (d.min_separation().floor() as u32).saturating_sub(2),
+            d.max_separation().ceil() as u32 + 2,
+            if decoded.is_autostereogram() {
+                "an autostereogram"
+            } else {
+                "not an autostereogram (no consistent repetition)"
+            },
+            args.out.display()
+        ));
+    }
+    if let Some(path) = &args.depth {
+        let settings = settings_from_sets(&args.sets)?;
+        let d = settings.geometry.to_pixels()?;
+        let is_ppm = matches!(
+            args.out.extension().and_then(|e| e.to_str()),
+            Some("ppm" | "pnm")
+        );
+        let (w, h) = if is_ppm && !settings.guide_dots {
+            stream_depth_map(path, &settings, &args.out)?
+        } else {
+            let sirds = from_depth_map(DepthMap::load(path)?, &settings)?;
+            save(&sirds.pixels, sirds.width, sirds.height, &args.out)?;
+            (sirds.width, sirds.height)
+        };
+        return Ok(format!(
+            "per-pixel SIRDS of {} ({w}x{h}), separations {:.1}..{:.1} px\n  wrote {}\n",
+            path.display(),
+            d.min_separation(),
+            d.max_separation(),
+            args.out.display()
+        ));
+    }
+    let scene_path = args
+        .scene
+        .as_ref()
+        .ok_or_else(|| Error::invalid("sirds", "no input", "give a scene, --depth or --decode"))?;
+    let scene = Scene::load(scene_path, &args.sets)?;
+    if let Some(frames) = args.frames {
+        let opts = AnimationOptions {
+            frames,
+            fixed_seed: args.fixed_seed,
+            ..AnimationOptions::default()
+        };
+        animate(&scene, &opts, &args.out)?;
+        return Ok(format!(
+            "animated {frames} frames of {}\n  wrote {}\n",
+            scene_path.display(),
+            args.out.display()
+        ));
+    }
+    let frame = render(&scene, &Plan::new(&[Output::Sirds]))?;
+    let sirds = from_frame(&frame, &scene)?;
+    save(&sirds.pixels, sirds.width, sirds.height, &args.out)?;
+    Ok(format!(
+        "{:?} SIRDS of {} ({}x{}){}\n  wrote {}\n",
+        scene.sirds.algorithm,
+        scene_path.display(),
+        sirds.width,
+        sirds.height,
+        sirds
+            .iterations
+            .map(|k| format!(", k = {k} strip iterations"))
+            .unwrap_or_default(),
+        args.out.display()
+    ))
+}

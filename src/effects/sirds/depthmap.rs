@@ -1,0 +1,193 @@
+//! The depth map a SIRDS encodes: normalized nearness per pixel, from a rendered depth buffer
+//! or from an image file.
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::framebuffer::{Framebuffer, check_size};
+
+/// Normalized nearness per pixel, row 0 at the top: 0 = background plane (far), 1 = front of
+/// the depth range (TIW's `Z`; in image files white is near, as for netpbm's `pamstereogram`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DepthMap {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major nearness in [0, 1].
+    pub z: Vec<f32>,
+}
+
+/// Which eye-space distances (along the view axis) map to the front (`z = 1`) and to the
+/// background plane (`z = 0`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthRange {
+    /// Distance mapped to `z = 1`.
+    pub front: f32,
+    /// Distance of the background plane, mapped to `z = 0`.
+    pub back: f32,
+}
+
+impl DepthRange {
+    /// Checks `0 < front < back`, both finite.
+    ///
+    /// # Errors
+    /// `Invalid` naming `sirds.front` / `sirds.back`.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.front.is_finite() && self.front > 0.0) {
+            return Err(Error::invalid("sirds.front", self.front, "must be > 0"));
+        }
+        if !(self.back.is_finite() && self.back > self.front) {
+            return Err(Error::invalid(
+                "sirds.back",
+                self.back,
+                format!("must be > sirds.front ({})", self.front),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Nearness of eye-space distance `distance`: `(back − distance) / (back − front)`, clamped.
+    #[inline]
+    pub fn nearness(&self, distance: f32) -> f32 {
+        ((self.back - distance) / (self.back - self.front)).clamp(0.0, 1.0)
+    }
+}
+
+/// Eye-space distance of window depth `depth` ∈ [0, 1] under an OpenGL perspective projection
+/// with clip planes `near`, `far`: `2 n f / ((f + n) − z_ndc (f − n))`, `z_ndc = 2 depth − 1`.
+#[inline]
+pub fn linearize(depth: f32, near: f32, far: f32) -> f32 {
+    let z_ndc = 2.0 * depth - 1.0;
+    2.0 * near * far / ((far + near) - z_ndc * (far - near))
+}
+
+impl DepthMap {
+    /// A depth map from raw nearness values.
+    ///
+    /// # Errors
+    /// `Invalid` for a zero or oversized side, a length that does not match, or a value that is
+    /// NaN or outside [0, 1] (naming the pixel).
+    pub fn new(width: u32, height: u32, z: Vec<f32>) -> Result<DepthMap> {
+        check_size(width, height).map_err(|e| match e {
+            Error::Invalid {
+                field,
+                value,
+                reason,
+            } => Error::Invalid {
+                field: field.replace("image.", "depth map "),
+                value,
+                reason,
+            },
+            other => other,
+        })?;
+        if z.len() != width as usize * height as usize {
+            return Err(Error::invalid(
+                "depth map",
+                z.len(),
+                format!("needs {width}×{height} values"),
+            ));
+        }
+        if let Some(i) = z.iter().position(|v| !(0.0..=1.0).contains(v)) {
+            let (x, y) = (i % width as usize, i / width as usize);
+            return Err(Error::invalid(
+                format!("depth map pixel ({x}, {y})"),
+                z[i],
+                "must be a number in [0, 1] (NaN found or out of range)",
+            ));
+        }
+        Ok(DepthMap { width, height, z })
+    }
+
+    /// Reads a grayscale (or color: its luma) image, white = near: `z = value / max`.
+    ///
+    /// # Errors
+    /// The file cannot be read or decoded, or has a zero side.
+    pub fn load(path: &Path) -> Result<DepthMap> {
+        let img = image::open(path)
+            .map_err(|e| Error::parse(path, None, format!("cannot read depth map: {e}")))?;
+        let gray = img.to_luma16();
+        let (w, h) = gray.dimensions();
+        let z = gray
+            .into_raw()
+            .iter()
+            .map(|&v| v as f32 / 65535.0)
+            .collect();
+        DepthMap::new(w, h, z).map_err(|e| e.in_file(path))
+    }
+
+    /// The nearness of a rendered depth buffer: covered pixels by their eye-space distance,
+    /// uncovered pixels (depth 1.0, the clear value) on the background plane (`z = 0`).
+    pub fn from_framebuffer(fb: &Framebuffer, near: f32, far: f32, range: &DepthRange) -> Self {
+        let z = fb
+            .depth
+            .iter()
+            .map(|&d| {
+                if d >= 1.0 {
+                    0.0
+                } else {
+                    range.nearness(linearize(d, near, far))
+                }
+            })
+            .collect();
+        DepthMap {
+            width: fb.width,
+            height: fb.height,
+            z,
+        }
+    }
+
+    /// The range a depth buffer spans: `front` at the nearest covered pixel, the background
+    /// plane 10% of the covered span behind the farthest one (seed 002 §3: "a certain distance
+    /// behind the geometry"), kept inside the far clip plane. `None` when nothing is covered.
+    pub fn auto_range(fb: &Framebuffer, near: f32, far: f32) -> Option<DepthRange> {
+        let (lo, hi) = fb
+            .depth
+            .iter()
+            .filter(|&&d| d < 1.0)
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &d| {
+                (lo.min(d), hi.max(d))
+            });
+        if lo > hi {
+            return None;
+        }
+        let (front, last) = (linearize(lo, near, far), linearize(hi, near, far));
+        let span = (last - front).max(front * 0.05);
+        Some(DepthRange {
+            front,
+            back: (last + 0.1 * span).min(far * 0.999),
+        })
+    }
+
+    /// Nearness at pixel (x, y).
+    #[inline]
+    pub fn at(&self, x: u32, y: u32) -> f32 {
+        self.z[y as usize * self.width as usize + x as usize]
+    }
+
+    /// One row.
+    #[inline]
+    pub fn row(&self, y: u32) -> &[f32] {
+        let w = self.width as usize;
+        &self.z[y as usize * w..(y as usize + 1) * w]
+    }
+
+    /// Near and far swapped (`z → 1 − z`): what a cross-eyed viewer needs.
+    pub fn inverted(&self) -> DepthMap {
+        DepthMap {
+            width: self.width,
+            height: self.height,
+            z: self.z.iter().map(|z| 1.0 - z).collect(),
+        }
+    }
+
+    /// As a 16-bit grayscale image, white = near (the format [`DepthMap::load`] reads).
+    pub fn to_image(&self) -> image::ImageBuffer<image::Luma<u16>, Vec<u16>> {
+        let data = self
+            .z
+            .iter()
+            .map(|z| (z.clamp(0.0, 1.0) * 65535.0).round() as u16)
+            .collect();
+        image::ImageBuffer::from_raw(self.width, self.height, data).expect("buffer size matches")
+    }
+}

@@ -1,0 +1,156 @@
+//! What fills the free pixels: seeded random dots or a tiled pattern image, plus guide dots.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::error::{Error, Result};
+
+/// The source of colors for pixels no constraint fixes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Pattern {
+    /// Random black or white dots.
+    BlackWhite {
+        /// Seed (the scene file's `sirds.seed`).
+        seed: u64,
+    },
+    /// Random gray levels.
+    Gray {
+        /// Seed.
+        seed: u64,
+    },
+    /// Random RGB colors.
+    Color {
+        /// Seed.
+        seed: u64,
+    },
+    /// A pattern image tiled over the plane; at least as wide as the largest separation.
+    Image(Arc<image::RgbaImage>),
+}
+
+/// SplitMix64's finalizer: a well-mixed 64-bit hash, so every pixel's dot is a pure function of
+/// (seed, x, y) — the same bytes for any thread count.
+#[inline]
+fn mix(mut v: u64) -> u64 {
+    v = (v ^ (v >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    v = (v ^ (v >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    v ^ (v >> 31)
+}
+
+#[inline]
+fn random(seed: u64, x: u32, y: u32) -> u64 {
+    mix(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (((y as u64) << 32) | x as u64))
+}
+
+impl Pattern {
+    /// Loads a pattern image.
+    ///
+    /// # Errors
+    /// The file cannot be read or decoded.
+    pub fn load_image(path: &Path) -> Result<Pattern> {
+        let img = image::open(path)
+            .map_err(|e| Error::parse(path, None, format!("cannot read pattern image: {e}")))?;
+        Ok(Pattern::Image(Arc::new(img.to_rgba8())))
+    }
+
+    /// The same kind of pattern with another seed (animation: a new pattern per frame).
+    pub fn reseeded(&self, seed: u64) -> Pattern {
+        match self {
+            Pattern::BlackWhite { .. } => Pattern::BlackWhite { seed },
+            Pattern::Gray { .. } => Pattern::Gray { seed },
+            Pattern::Color { .. } => Pattern::Color { seed },
+            Pattern::Image(i) => Pattern::Image(i.clone()),
+        }
+    }
+
+    /// Checks that the pattern suits separations up to `max_separation` pixels: a pattern image
+    /// narrower than that would repeat inside one link and show a false depth plane.
+    ///
+    /// # Errors
+    /// `Invalid` naming `sirds.pattern` for an empty or too narrow image.
+    pub fn check(&self, max_separation: f32) -> Result<()> {
+        if let Pattern::Image(img) = self {
+            let (w, h) = img.dimensions();
+            if w == 0 || h == 0 || (w as f32) < max_separation {
+                return Err(Error::invalid(
+                    "sirds.pattern",
+                    format!("{w}×{h} image"),
+                    format!(
+                        "must be at least the largest separation ({max_separation:.1} px) wide"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Color of pattern pixel (x, y).
+    #[inline]
+    pub fn color(&self, x: u32, y: u32) -> [u8; 4] {
+        match self {
+            Pattern::BlackWhite { seed } => {
+                let v = if random(*seed, x, y) & 1 == 0 { 0 } else { 255 };
+                [v, v, v, 255]
+            }
+            Pattern::Gray { seed } => {
+                let v = (random(*seed, x, y) >> 24) as u8;
+                [v, v, v, 255]
+            }
+            Pattern::Color { seed } => {
+                let r = random(*seed, x, y);
+                [(r >> 8) as u8, (r >> 24) as u8, (r >> 40) as u8, 255]
+            }
+            Pattern::Image(img) => {
+                let (w, h) = img.dimensions();
+                img.get_pixel(x % w, y % h).0
+            }
+        }
+    }
+
+    /// A whole `width × height` image of the pattern (the strip algorithm's starting image).
+    pub fn fill(&self, width: u32, height: u32) -> Vec<[u8; 4]> {
+        (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| self.color(x, y))
+            .collect()
+    }
+}
+
+/// Draws the two guide dots (tiny-skia): black discs with a white rim, centered horizontally,
+/// `separation` pixels apart (the background plane's), near the top. Fusing them into three
+/// dots puts the eyes at the right convergence.
+pub fn draw_guide_dots(pixels: &mut [[u8; 4]], width: u32, height: u32, separation: f32) {
+    let Some(mut pixmap) = tiny_skia::Pixmap::new(width, height) else {
+        return;
+    };
+    // Opaque pixels: premultiplied and straight RGBA are the same bytes.
+    for (dst, src) in pixmap.data_mut().chunks_exact_mut(4).zip(pixels.iter()) {
+        dst.copy_from_slice(src);
+    }
+    let radius = (width.min(height) as f32 * 0.015).clamp(2.0, 12.0);
+    let cy = (height as f32 * 0.05).max(radius + 2.0);
+    let cx = width as f32 * 0.5;
+    let mut paint = tiny_skia::Paint {
+        anti_alias: true,
+        ..Default::default()
+    };
+    for (r, color) in [
+        (radius + 1.5, tiny_skia::Color::WHITE),
+        (radius, tiny_skia::Color::BLACK),
+    ] {
+        paint.set_color(color);
+        for x in [cx - separation * 0.5, cx + separation * 0.5] {
+            if let Some(circle) = tiny_skia::PathBuilder::from_circle(x, cy, r) {
+                pixmap.fill_path(
+                    &circle,
+                    &paint,
+                    tiny_skia::FillRule::Winding,
+                    tiny_skia::Transform::identity(),
+                    None,
+                );
+            }
+        }
+    }
+    for (dst, src) in pixels.iter_mut().zip(pixmap.data().chunks_exact(4)) {
+        dst.copy_from_slice(src);
+    }
+}

@@ -1,0 +1,204 @@
+//! The scene file's optional `[sirds]` table, and its validated form.
+
+use std::path::Path;
+
+use serde::Deserialize;
+
+use super::depthmap::DepthRange;
+use super::disparity::{DisparityModel, Geometry};
+use super::pattern::Pattern;
+use super::per_pixel::{MAX_OVERSAMPLE, PerPixelOptions};
+use super::per_vertex::{Filter, PerVertexOptions, Start};
+use crate::error::{Error, Result};
+
+/// Which algorithm turns depth into an autostereogram.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Algorithm {
+    /// Seed 002's strip algorithm: the scene rendered k times with shifted vertices.
+    #[default]
+    PerVertex,
+    /// Thimbleby–Inglis–Witten on the depth pass's depth map.
+    PerPixel,
+}
+
+/// Random-dot kinds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DotKind {
+    /// Black and white dots.
+    #[default]
+    BlackWhite,
+    /// Gray levels.
+    Gray,
+    /// RGB colors.
+    Color,
+}
+
+/// `[sirds]` as written. Every field is optional; the defaults are TIW's set-up.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SirdsSpec {
+    /// `per-vertex` (default) or `per-pixel`.
+    #[serde(default)]
+    pub algorithm: Algorithm,
+    /// `eye-distance` (eq. 3, default) or `view-angle` (eq. 1).
+    #[serde(default, deserialize_with = "model_names::deserialize")]
+    pub model: DisparityModel,
+    /// Eye separation in inches (2.5).
+    pub eye_separation_in: Option<f32>,
+    /// Output resolution (72 DPI).
+    pub dpi: Option<f32>,
+    /// Eye to image plane, inches (12).
+    pub viewing_distance_in: Option<f32>,
+    /// Depth behind the image plane of the nearest scene point, inches (8).
+    pub depth_near_in: Option<f32>,
+    /// Depth behind the image plane of the background plane, inches (12).
+    pub depth_far_in: Option<f32>,
+    /// Eq. 1's angle φ, degrees (default: eq. 2 at the background plane).
+    pub view_angle_deg: Option<f32>,
+    /// Eye-space distance shown at the front of the depth range (default: nearest visible).
+    pub front: Option<f32>,
+    /// Eye-space distance of the background plane (default: 10% behind the farthest visible).
+    pub back: Option<f32>,
+    /// `left` or `center` (default).
+    #[serde(default, deserialize_with = "start_names::deserialize")]
+    pub start: Start,
+    /// `nearest` or `bilinear` (default).
+    #[serde(default, deserialize_with = "filter_names::deserialize")]
+    pub filter: Filter,
+    /// Strip iterations k (default: the fewest the front separation allows).
+    pub iterations: Option<u32>,
+    /// TIW hidden-surface removal (default true).
+    pub hidden_surface: Option<bool>,
+    /// TIW horizontal oversampling (default 1).
+    pub oversample: Option<u32>,
+    /// `black-white` (default), `gray` or `color` random dots.
+    #[serde(default)]
+    pub dots: DotKind,
+    /// A pattern image to tile instead of random dots (relative to the scene file).
+    pub pattern_image: Option<String>,
+    /// Random-dot seed (default 1).
+    pub seed: Option<u64>,
+    /// Draw two guide dots near the top.
+    #[serde(default)]
+    pub guide_dots: bool,
+    /// View cross-eyed (inverts depth) instead of wall-eyed.
+    #[serde(default)]
+    pub cross_eyed: bool,
+}
+
+macro_rules! names {
+    ($module:ident, $ty:ty, $($name:literal => $value:expr),+) => {
+        mod $module {
+            use super::*;
+            pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<$ty, D::Error> {
+                let s = String::deserialize(d)?;
+                match s.as_str() {
+                    $($name => Ok($value),)+
+                    other => Err(serde::de::Error::custom(format!(
+                        "unknown value \"{other}\"; known: {}", [$($name),+].join(", ")
+                    ))),
+                }
+            }
+        }
+    };
+}
+names!(model_names, DisparityModel, "eye-distance" => DisparityModel::EyeDistance, "view-angle" => DisparityModel::ViewAngle);
+names!(start_names, Start, "left" => Start::Left, "center" => Start::Center);
+names!(filter_names, Filter, "nearest" => Filter::Nearest, "bilinear" => Filter::Bilinear);
+
+/// `[sirds]` validated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Algorithm.
+    pub algorithm: Algorithm,
+    /// Physical set-up.
+    pub geometry: Geometry,
+    /// Fixed front distance, if given.
+    pub front: Option<f32>,
+    /// Fixed background-plane distance, if given.
+    pub back: Option<f32>,
+    /// Strip algorithm options.
+    pub per_vertex: PerVertexOptions,
+    /// TIW options.
+    pub per_pixel: PerPixelOptions,
+    /// Free-pixel pattern.
+    pub pattern: Pattern,
+    /// Guide dots.
+    pub guide_dots: bool,
+    /// Cross-eyed viewing.
+    pub cross_eyed: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings::from_spec(&SirdsSpec::default(), Path::new("")).expect("defaults are valid")
+    }
+}
+
+impl Settings {
+    /// Validates `spec`; a pattern image path is relative to `base_dir`.
+    ///
+    /// # Errors
+    /// The first invalid `sirds.*` field, or an unreadable pattern image.
+    pub fn from_spec(spec: &SirdsSpec, base_dir: &Path) -> Result<Settings> {
+        let g = Geometry::default();
+        let geometry = Geometry {
+            model: spec.model,
+            eye_separation_in: spec.eye_separation_in.unwrap_or(g.eye_separation_in),
+            dpi: spec.dpi.unwrap_or(g.dpi),
+            viewing_distance_in: spec.viewing_distance_in.unwrap_or(g.viewing_distance_in),
+            depth_near_in: spec.depth_near_in.unwrap_or(g.depth_near_in),
+            depth_far_in: spec.depth_far_in.unwrap_or(g.depth_far_in),
+            view_angle_deg: spec.view_angle_deg,
+        };
+        geometry.to_pixels()?;
+        if let (Some(front), Some(back)) = (spec.front, spec.back) {
+            DepthRange { front, back }.validate()?;
+        }
+        for (name, v) in [("sirds.front", spec.front), ("sirds.back", spec.back)] {
+            if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
+                return Err(Error::invalid(name, v, "must be a finite distance > 0"));
+            }
+        }
+        let oversample = spec.oversample.unwrap_or(1);
+        if !(1..=MAX_OVERSAMPLE).contains(&oversample) {
+            return Err(Error::invalid(
+                "sirds.oversample",
+                oversample,
+                format!("must lie in 1..={MAX_OVERSAMPLE}"),
+            ));
+        }
+        if spec.iterations == Some(0) {
+            return Err(Error::invalid("sirds.iterations", 0, "must be at least 1"));
+        }
+        let seed = spec.seed.unwrap_or(1);
+        let pattern = match &spec.pattern_image {
+            Some(p) => Pattern::load_image(&base_dir.join(p))?,
+            None => match spec.dots {
+                DotKind::BlackWhite => Pattern::BlackWhite { seed },
+                DotKind::Gray => Pattern::Gray { seed },
+                DotKind::Color => Pattern::Color { seed },
+            },
+        };
+        Ok(Settings {
+            algorithm: spec.algorithm,
+            geometry,
+            front: spec.front,
+            back: spec.back,
+            per_vertex: PerVertexOptions {
+                start: spec.start,
+                filter: spec.filter,
+                iterations: spec.iterations,
+            },
+            per_pixel: PerPixelOptions {
+                hidden_surface: spec.hidden_surface.unwrap_or(true),
+                oversample,
+            },
+            pattern,
+            guide_dots: spec.guide_dots,
+            cross_eyed: spec.cross_eyed,
+        })
+    }
+}
