@@ -12,4 +12,6 @@ pub mod protocol;
 pub mod types;
 
 pub use protocol::{Answer, Task, serve, task};
-pub use types::{AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, SirdsGeometry, StereoSetup};
+pub use types::{
+    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, SirdsGeometry, SirdsSetup, StereoSetup,
+};

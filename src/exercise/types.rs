@@ -92,3 +92,17 @@ pub struct SirdsGeometry {
     /// Distance f from the eyes to the image plane.
     pub focal_length: f32,
 }
+
+/// What one SIRDS scan line needs: seed 002's eye geometry and the depth range the nearness
+/// values span, all in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SirdsSetup {
+    /// Distance a between the eyes.
+    pub eye_distance: f32,
+    /// Distance f from the eyes to the image plane.
+    pub focal_length: f32,
+    /// Depth behind the image plane of nearness 1 (the front of the range).
+    pub depth_near: f32,
+    /// Depth behind the image plane of nearness 0 (the background plane).
+    pub depth_far: f32,
+}

@@ -1,15 +1,19 @@
 //! Exercise 3 (seed 002, SIRDS): the tasks, reference answers, mistakes, image checks.
 //!
-//! The reference linking is the grader's own (seed 002's disparity, Eq. (3), with the linking
-//! and hidden-surface removal of Thimbleby, Inglis and Witten, 1994) until the SIRDS module lands
-//! on main.
+//! The reference is stereolab's SIRDS module: its Eq. (3) separation and its per-pixel linking
+//! (`effects::sirds::per_pixel::RowLinker`, Thimbleby, Inglis and Witten's algorithm). The known
+//! mistakes are modelled by [`variant_links`], which a unit test holds equal to the module when
+//! no mistake is switched on.
 
 use serde_json::json;
 
 use super::ex1::flat;
 use super::fixture::{Fixture, unproject};
 use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
-use crate::exercise::SirdsGeometry;
+use crate::effects::sirds::disparity::{separation_eye_distance, separation_view_angle};
+use crate::effects::sirds::per_pixel::RowLinker;
+use crate::effects::sirds::{Disparity, DisparityModel};
+use crate::exercise::{SirdsGeometry, SirdsSetup};
 use crate::framebuffer::Framebuffer;
 
 /// Every task of exercise 3.
@@ -17,48 +21,75 @@ pub fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
     vec![direction_task(), eyes_task(), link_task(fx)]
 }
 
-/// The viewing geometry of the image check: eyes 64 px apart, 240 px in front of the image.
-pub const GEOMETRY: SirdsGeometry = SirdsGeometry {
+/// The viewing set-up of the link checks: eyes 64 px apart, 240 px in front of the image,
+/// nearness spanning 20 … 60 px behind it (separations 4.9 … 12.8 px).
+pub const SETUP: SirdsSetup = SirdsSetup {
     eye_distance: 64.0,
     focal_length: 240.0,
+    depth_near: 20.0,
+    depth_far: 60.0,
 };
-/// Depth (px behind the image plane) of the nearest surface of the depth map.
-const NEAREST_PX: f32 = 20.0;
-/// Depth of the background plane (seed 002 bounds the scene by one).
-const BACKGROUND_PX: f32 = 60.0;
 
 fn disparity(z: f32, g: &SirdsGeometry) -> f32 {
-    g.eye_distance * z / (z + g.focal_length)
+    separation_eye_distance(z, g.eye_distance, g.focal_length).unwrap_or(f32::NAN)
 }
 
-/// How the reference links a row; `Normal` is the specification.
-#[derive(Clone, Copy, PartialEq)]
+/// stereolab's pixel set-up for `s` (Eq. (3)).
+fn module_disparity(s: &SirdsSetup) -> Disparity {
+    Disparity {
+        model: DisparityModel::EyeDistance,
+        eye_separation: s.eye_distance,
+        viewing_distance: s.focal_length,
+        t_near: s.depth_near,
+        t_far: s.depth_far,
+        tan_phi: 0.0,
+    }
+}
+
+/// stereolab's links of one row (hidden-surface removal on or off).
+fn module_links(nearness: &[f32], row: u32, s: &SirdsSetup, hidden: bool) -> Vec<usize> {
+    let mut linker = RowLinker::default();
+    linker.link_row(nearness, row, &module_disparity(s), 1, hidden);
+    linker.same.iter().map(|&v| v as usize).collect()
+}
+
+/// Known linking mistakes.
+#[derive(Clone, Copy, PartialEq, Debug)]
 enum Linking {
-    Normal,
     FullDisparity,
-    NoHiddenSurfaces,
     Truncated,
+    NoRowAlternation,
 }
 
-fn reference_links(depths: &[f32], g: &SirdsGeometry, how: Linking) -> Vec<usize> {
-    let w = depths.len();
-    let mut same: Vec<usize> = (0..w).collect();
-    for x in 0..w {
-        let d = disparity(depths[x], g);
-        let s = if how == Linking::Truncated {
-            d.floor()
+/// The stub's algorithm (see its doc comment), with one mistake switched on or none.
+fn variant_links(nearness: &[f32], row: u32, s: &SirdsSetup, how: Option<Linking>) -> Vec<usize> {
+    let n = nearness.len();
+    let span = s.depth_far - s.depth_near;
+    let mut same: Vec<usize> = (0..n).collect();
+    for (x, &z) in nearness.iter().enumerate() {
+        let t = s.depth_far - z * span;
+        let d = s.eye_distance * t / (t + s.focal_length);
+        let sep = if how == Some(Linking::Truncated) {
+            d
         } else {
-            d.round()
+            d + 0.5
         }
         .max(0.0) as usize;
-        let (left, width) = if how == Linking::FullDisparity {
-            (x.checked_sub(s), 2 * s)
-        } else {
-            (x.checked_sub(s / 2), s)
+        let shift = match how {
+            Some(Linking::FullDisparity) => Some(sep),
+            Some(Linking::NoRowAlternation) => Some(sep / 2),
+            _ => Some((sep + (sep & row as usize & 1)) / 2),
         };
-        let Some(left) = left else { continue };
-        let right = left + width;
-        if right >= w || (how != Linking::NoHiddenSurfaces && hidden(depths, x, g)) {
+        let Some(left) = shift.and_then(|h| x.checked_sub(h)) else {
+            continue;
+        };
+        let right = if how == Some(Linking::FullDisparity) {
+            x + sep
+        } else {
+            left + sep
+        };
+        let rise = 2.0 * (t + s.focal_length) / s.eye_distance / span;
+        if right >= n || hidden(nearness, x, rise) {
             continue;
         }
         link(&mut same, left, right);
@@ -66,31 +97,30 @@ fn reference_links(depths: &[f32], g: &SirdsGeometry, how: Linking) -> Vec<usize
     same
 }
 
-/// Something nearer than the ray from (x, depth) to either eye blocks it.
-fn hidden(depths: &[f32], x: usize, g: &SirdsGeometry) -> bool {
-    let z = depths[x];
-    let slope = (z + g.focal_length) / (0.5 * g.eye_distance);
-    let mut t = 1;
+/// Something at least as near blocks a ray from the point at `x` to either eye.
+fn hidden(nearness: &[f32], x: usize, rise: f32) -> bool {
+    let z = nearness[x];
+    let mut k = 1;
     loop {
-        let ray = z - t as f32 * slope;
-        if ray <= 0.0 || t > x || x + t >= depths.len() {
-            return false;
-        }
-        if depths[x - t] < ray || depths[x + t] < ray {
+        let zk = z + k as f32 * rise;
+        let at_least = |i: Option<usize>| i.and_then(|i| nearness.get(i)).is_some_and(|&v| v >= zk);
+        if at_least(x.checked_sub(k)) || at_least(Some(x + k)) {
             return true;
         }
-        t += 1;
+        if zk >= 1.0 {
+            return false;
+        }
+        k += 1;
     }
 }
 
-/// Thimbleby's union keeping `same[i] ≥ i`.
+/// Thimbleby, Inglis and Witten's union, keeping `same[i] ≥ i`.
 fn link(same: &mut [usize], mut left: usize, mut right: usize) {
     let mut k = same[left];
     while k != left && k != right {
         if k < right {
             left = k;
         } else {
-            same[left] = right;
             left = right;
             right = k;
         }
@@ -99,8 +129,9 @@ fn link(same: &mut [usize], mut left: usize, mut right: usize) {
     same[left] = right;
 }
 
-/// The fixture's cyclopean depth as a SIRDS depth map: rows of pixels behind the image plane.
-fn depth_rows(fx: &Fixture) -> Vec<Vec<f32>> {
+/// The fixture's cyclopean depth as SIRDS nearness rows: 1 at the nearest surface, 0 at the
+/// farthest (the backdrop) and for background pixels.
+fn nearness_rows(fx: &Fixture) -> Vec<Vec<f32>> {
     let (w, h) = fx.size();
     let dist = |x, y| unproject(&fx.center_matrices, &fx.center, x, y).map(|p| -p.z);
     let all: Vec<f32> = (0..h)
@@ -111,10 +142,7 @@ fn depth_rows(fx: &Fixture) -> Vec<Vec<f32>> {
     (0..h)
         .map(|y| {
             (0..w)
-                .map(|x| {
-                    let t = dist(x, y).map_or(1.0, |d| ((d - lo) / (hi - lo)).clamp(0.0, 1.0));
-                    NEAREST_PX + (BACKGROUND_PX - NEAREST_PX) * t
-                })
+                .map(|x| dist(x, y).map_or(0.0, |d| (1.0 - (d - lo) / (hi - lo)).clamp(0.0, 1.0)))
                 .collect()
         })
         .collect()
@@ -159,35 +187,38 @@ fn links_of(a: &Option<Vec<f64>>) -> Option<Vec<usize>> {
 }
 
 fn link_task(fx: &Fixture) -> TaskSpec {
-    let rows = depth_rows(fx);
-    let mut inputs: Vec<(String, Vec<f32>)> = vec![
-        ("flat row at 40 px".into(), vec![40.0; 48]),
+    let rows = nearness_rows(fx);
+    let mut inputs: Vec<(String, Vec<f32>, u32)> = vec![
+        ("flat row, nearness 0.5".into(), vec![0.5; 48], 0),
         (
-            "near box (20 px) on a far plane (60 px)".into(),
+            "near box on the background".into(),
             (0..48)
-                .map(|x| if (18..30).contains(&x) { 20.0 } else { 60.0 })
+                .map(|x| if (18..30).contains(&x) { 1.0 } else { 0.0 })
                 .collect(),
+            0,
         ),
         (
-            "narrow near pillar".into(),
+            "narrow near pillar, odd row".into(),
             (0..48)
-                .map(|x| if (22..25).contains(&x) { 10.0 } else { 60.0 })
+                .map(|x| if (22..25).contains(&x) { 1.0 } else { 0.1 })
                 .collect(),
+            1,
         ),
         (
-            "ramp 20 → 60 px".into(),
-            (0..48).map(|x| 20.0 + 40.0 * x as f32 / 47.0).collect(),
+            "ramp 1 → 0, odd row".into(),
+            (0..48).map(|x| 1.0 - x as f32 / 47.0).collect(),
+            3,
         ),
     ];
     inputs.extend(
         rows.iter()
             .enumerate()
-            .map(|(y, r)| (format!("fixture row {y}"), r.clone())),
+            .map(|(y, r)| (format!("fixture row {y}"), r.clone(), y as u32)),
     );
     let each = |how| {
         inputs
             .iter()
-            .map(|(_, r)| flat(&reference_links(r, &GEOMETRY, how)))
+            .map(|(_, r, y)| flat(&variant_links(r, *y, &SETUP, Some(how))))
             .collect()
     };
     let w = fx.size().0;
@@ -195,7 +226,8 @@ fn link_task(fx: &Fixture) -> TaskSpec {
         w,
         &rows
             .iter()
-            .map(|r| Some(reference_links(r, &GEOMETRY, Linking::Normal)))
+            .enumerate()
+            .map(|(y, r)| Some(module_links(r, y as u32, &SETUP, true)))
             .collect::<Vec<_>>(),
     );
     let build = move |answers: &[Option<Vec<f64>>]| {
@@ -212,10 +244,10 @@ fn link_task(fx: &Fixture) -> TaskSpec {
         tolerance: Tolerance::EXACT,
         cases: inputs
             .iter()
-            .map(|(label, r)| Case {
+            .map(|(label, r, y)| Case {
                 label: label.clone(),
-                input: json!([r, GEOMETRY]),
-                expected: flat(&reference_links(r, &GEOMETRY, Linking::Normal)),
+                input: json!([r, y, SETUP]),
+                expected: flat(&module_links(r, *y, &SETUP, true)),
             })
             .collect(),
         mistakes: vec![
@@ -229,16 +261,29 @@ fn link_task(fx: &Fixture) -> TaskSpec {
                 id: "no-hidden-surfaces",
                 hint: "hidden-surface removal missing: a point one eye cannot see must not be \
                        linked (check the rays to both eyes, step 2)",
-                answers: each(Linking::NoHiddenSurfaces),
+                answers: inputs
+                    .iter()
+                    .map(|(_, r, y)| flat(&module_links(r, *y, &SETUP, false)))
+                    .collect(),
             },
             Mistake {
                 id: "truncated-separation",
-                hint: "round the separation to the nearest pixel, do not truncate it",
+                hint: "round the separation half up, ⌊d + ½⌋, do not truncate it",
                 answers: each(Linking::Truncated),
+            },
+            Mistake {
+                id: "no-row-alternation",
+                hint: "for odd separations the extra pixel alternates with the row: \
+                       left = x − (s + (s & row & 1)) / 2",
+                answers: each(Linking::NoRowAlternation),
             },
         ],
         image: Some(ImageCheck {
-            inputs: rows.iter().map(|r| json!([r, GEOMETRY])).collect(),
+            inputs: rows
+                .iter()
+                .enumerate()
+                .map(|(y, r)| json!([r, y, SETUP]))
+                .collect(),
             build: Box::new(build),
         }),
     }
@@ -268,7 +313,7 @@ fn direction_task() -> TaskSpec {
             .map(|[z, p]| Case {
                 label: format!("z = {z}, phi = {p} rad"),
                 input: json!([z, p]),
-                expected: vec![(2.0 * z / p.tan()) as f64],
+                expected: vec![separation_view_angle(*z, p.tan()) as f64],
             })
             .collect(),
         mistakes: vec![
@@ -342,5 +387,25 @@ fn eyes_task() -> TaskSpec {
             },
         ],
         image: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grade::fixture::grading_scene;
+
+    #[test]
+    fn the_mistake_model_without_a_mistake_is_stereolabs_linking() {
+        let fx = Fixture::new(grading_scene().unwrap()).unwrap();
+        for (y, row) in nearness_rows(&fx).iter().enumerate() {
+            for y in [y as u32, y as u32 + 1] {
+                assert_eq!(
+                    variant_links(row, y, &SETUP, None),
+                    module_links(row, y, &SETUP, true),
+                    "row {y}"
+                );
+            }
+        }
     }
 }

@@ -3,7 +3,7 @@
 
 use std::process::ExitCode;
 
-use stereolab::exercise::{SirdsGeometry, serve, task};
+use stereolab::exercise::{SirdsGeometry, SirdsSetup, serve, task};
 
 fn main() -> ExitCode {
     serve(vec![
@@ -13,8 +13,11 @@ fn main() -> ExitCode {
         task("disparity_constant_eyes", |(z, g): (f32, SirdsGeometry)| {
             ex3_sirds::disparity_constant_eyes(z, &g)
         }),
-        task("link_row", |(depths, g): (Vec<f32>, SirdsGeometry)| {
-            ex3_sirds::link_row(&depths, &g)
-        }),
+        task(
+            "link_row",
+            |(nearness, row, setup): (Vec<f32>, u32, SirdsSetup)| {
+                ex3_sirds::link_row(&nearness, row, &setup)
+            },
+        ),
     ])
 }

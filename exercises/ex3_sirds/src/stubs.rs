@@ -1,7 +1,7 @@
 //! Your code: complete every `todo!`. Each doc comment states the task, where its formula comes
 //! from, and the conventions; `stereolab grade ex3` scores each function on its own.
 
-use stereolab::exercise::SirdsGeometry;
+use stereolab::exercise::{SirdsGeometry, SirdsSetup};
 
 /// Task `disparity_constant_direction` (1 point): the distance between the two projections of a
 /// point at depth `z` behind the image plane, assuming every eye ray meets the image plane at
@@ -23,30 +23,35 @@ pub fn disparity_constant_eyes(z: f32, geometry: &SirdsGeometry) -> f32 {
 }
 
 /// Task `link_row` (3 points, image check): the per-scan-line constraints of a SIRDS with
-/// hidden-surface removal (seed 002 §2–3; the linking of Thimbleby, Inglis and Witten, 1994).
+/// hidden-surface removal (seed 002 §2–3, after its reference 5: Thimbleby, Inglis and Witten,
+/// "Displaying 3D images", IEEE Computer 27(10), 1994).
 ///
-/// `depths[x]` is the depth (pixels, ≥ 0) behind the image plane of the surface seen through
-/// pixel `x`. Return `same` with `same[x] ≥ x`: pixel `x` must have the color of pixel
-/// `same[x]` (`same[x] == x`: free). For each `x`:
-/// 1. `s = round(d)` with `d` from [`disparity_constant_eyes`]; the pair is
-///    `left = x − s/2` (integer division), `right = left + s`; skip it unless both lie in the row.
-/// 2. Hidden-surface removal: the point (x, z) must see both eyes. The ray to an eye at offset
-///    `t = 1, 2, …` pixels has depth `z − t (z + f) / (a/2)`; stop when it reaches the image
-///    plane (depth ≤ 0) or leaves the row; if `depths[x − t]` or `depths[x + t]` is nearer
-///    (smaller) than the ray, the point is hidden: skip it.
+/// `nearness[x]` in [0, 1] is the surface seen through pixel `x` of image row `row`: 1 is the
+/// front of the depth range (`setup.depth_near` pixels behind the image plane), 0 the background
+/// plane (`setup.depth_far`). Return `same` with `same[x] ≥ x`: pixel `x` must have the color of
+/// pixel `same[x]` (`same[x] == x`: free). For each `x` from left to right:
+/// 1. depth `t = depth_far − z (depth_far − depth_near)`, separation `s = ⌊d + ½⌋` with `d` from
+///    [`disparity_constant_eyes`]; the pair is `left = x − (s + (s & row & 1)) / 2` (integer
+///    division: for odd `s` the extra pixel alternates between rows), `right = left + s`;
+///    skip `x` unless `0 ≤ left` and `right < nearness.len()`.
+/// 2. Hidden-surface removal: the rays from the point to the eyes rise by
+///    `rise = (2 (t + f) / a) / (depth_far − depth_near)` nearness per pixel (seed 002 Eq. (2));
+///    for `k = 1, 2, …`: `zk = z + k · rise`; the point is hidden (skip `x`) when
+///    `nearness[x − k] ≥ zk` or `nearness[x + k] ≥ zk` (indices inside the row); it is visible
+///    once `zk ≥ 1` (checked after the test).
 /// 3. Link `left` and `right` keeping `same` a chain towards the right:
 ///    ```text
 ///    k = same[left]
 ///    while k ≠ left and k ≠ right:
 ///        if k < right: left = k
-///        else: same[left] = right; left = right; right = k
+///        else: left = right; right = k
 ///        k = same[left]
 ///    same[left] = right
 ///    ```
-pub fn link_row(depths: &[f32], geometry: &SirdsGeometry) -> Vec<usize> {
+pub fn link_row(nearness: &[f32], row: u32, setup: &SirdsSetup) -> Vec<usize> {
     // TODO: the three steps above.
     todo!(
-        "links of a row of {} depths with {geometry:?}: {depths:?}",
-        depths.len()
+        "links of row {row:?} ({} pixels) with {setup:?}: {nearness:?}",
+        nearness.len()
     )
 }
