@@ -384,3 +384,31 @@ fn students_worked_examples_pass_with_the_solution() {
     );
     assert_eq!(stdout.matches("test result: ok").count(), 3, "{stdout}");
 }
+
+#[test]
+fn bad_grade_arguments_get_clear_errors() {
+    for (args, says) in [
+        (vec!["grade", "ex9"], "expected ex1, ex2, ex3 or all"),
+        (vec!["grade", "ex1", "--timeout", "0"], "--timeout"),
+        (
+            vec!["grade", "ex1", "--exercises", "/nonexistent"],
+            "no exercise crates there",
+        ),
+        (
+            vec!["render", "assets/scenes/wuson.toml", "--exercise", "all"],
+            "name one exercise",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .current_dir(root())
+            .args(&args)
+            .output()
+            .expect("run stereolab");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(says),
+            "{args:?}: {err}"
+        );
+    }
+}

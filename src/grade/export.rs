@@ -145,3 +145,14 @@ cargo run -p stereolab -- render --exercise ex1 stereolab/assets/scenes/wuson.to
 
 Passing: at least 50% of all points and at least 2 points in each exercise.
 ";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strip_solution_drops_marked_blocks_with_their_markers() {
+        let text = "a\n# solution-begin\n[features]\nsolution = []\n# solution-end\nb\n";
+        assert_eq!(strip_solution(text), "a\nb\n");
+    }
+}

@@ -118,3 +118,23 @@ pub struct TaskSpec {
 
 /// Share of a task's points the image check carries when the task has one.
 pub const IMAGE_SHARE: f64 = 0.3;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tolerance_is_absolute_plus_relative_and_refuses_nan_and_length_mismatch() {
+        let t = Tolerance {
+            abs: 1e-3,
+            rel: 1e-2,
+            why: "test",
+        };
+        assert!(t.accepts(&[100.0], &[100.9]));
+        assert!(!t.accepts(&[100.0], &[101.1]));
+        assert!(!t.accepts(&[1.0], &[f64::NAN]));
+        assert!(!t.accepts(&[1.0, 2.0], &[1.0]));
+        assert!(Tolerance::EXACT.accepts(&[3.0], &[3.0]));
+        assert_eq!(t.describe(), "1e-2·|expected| + 1e-3");
+    }
+}
