@@ -42,7 +42,7 @@ fn grade(
         .arg("--exercises")
         .arg(exercises)
         .args(extra)
-        .env("CARGO_TARGET_DIR", root().join("target"))
+        .env("CARGO_TARGET_DIR", target_dir())
         .env_remove("STEREOLAB_MUTANT");
     if let Some(m) = mutant {
         cmd.env("STEREOLAB_MUTANT", m);
@@ -59,6 +59,16 @@ fn grade(
         out,
         serde_json::from_str(&text).expect("results.json is JSON"),
     )
+}
+
+/// The target folder this test binary was built in (`<target>/debug/stereolab`): nested builds
+/// use it too, so the compiled dependencies are shared whatever `CARGO_TARGET_DIR` CI sets.
+fn target_dir() -> PathBuf {
+    let exe = Path::new(env!("CARGO_BIN_EXE_stereolab"));
+    exe.parent()
+        .and_then(Path::parent)
+        .expect("the binary lies in <target>/<profile>/")
+        .to_path_buf()
 }
 
 fn repo_exercises() -> PathBuf {
@@ -325,7 +335,7 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
             "-p",
             "ex3_sirds",
         ])
-        .env("CARGO_TARGET_DIR", root().join("target"))
+        .env("CARGO_TARGET_DIR", target_dir())
         .output()
         .expect("run cargo");
     assert!(
@@ -372,7 +382,7 @@ fn students_worked_examples_pass_with_the_solution() {
             "-p",
             "ex3_sirds",
         ])
-        .env("CARGO_TARGET_DIR", root().join("target"))
+        .env("CARGO_TARGET_DIR", target_dir())
         .env_remove("STEREOLAB_MUTANT")
         .output()
         .expect("run cargo test");
