@@ -422,3 +422,34 @@ fn bad_grade_arguments_get_clear_errors() {
         );
     }
 }
+
+#[test]
+fn render_exercise_writes_the_solution_next_to_the_reference_on_any_scene() {
+    let _turn = take_turn();
+    let dir = out_dir("render_exercise");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .current_dir(root())
+        .args(["render", "assets/scenes/wuson.toml", "--size", "96x72"])
+        .args(["--exercise", "ex1", "--solution", "--out"])
+        .arg(&dir)
+        .env("CARGO_TARGET_DIR", target_dir())
+        .env_remove("STEREOLAB_MUTANT")
+        .output()
+        .expect("run stereolab render --exercise");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Four eye renders, four anaglyphs, remap, visibility, parallax colors.
+    assert_eq!(stdout.lines().count(), 11, "{stdout}");
+    for line in stdout.lines() {
+        assert!(
+            line.contains("mismatch   0.00%, mean channel difference   0.00"),
+            "{line}"
+        );
+    }
+    let strip = image::open(dir.join("anaglyph_true.png")).expect("strip written");
+    assert_eq!((strip.width(), strip.height()), (3 * 96, 72));
+}

@@ -226,6 +226,20 @@ pub fn render_exercise(
         if run.timed_out {
             lines.push(format!("{}: timed out after {timeout:?}", spec.name));
         }
+        let panics: Vec<&String> = run
+            .replies
+            .iter()
+            .filter_map(|r| r.as_ref().err())
+            .collect();
+        if let Some(first) = panics.first() {
+            lines.push(format!(
+                "{}: {} of {} inputs panicked, e.g. {}",
+                spec.name,
+                panics.len(),
+                img.inputs.len(),
+                first.chars().take(120).collect::<String>()
+            ));
+        }
     }
     Ok(lines)
 }
