@@ -93,6 +93,8 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         opts.iterations,
     )?);
     rows.extend(crate::effects::sirds::bench::rows(opts.iterations)?);
+    #[cfg(feature = "gpu")]
+    rows.extend(crate::gpu::parity::bench_rows(&scene, opts.iterations)?);
     Ok(rows)
 }
 

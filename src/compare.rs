@@ -1,5 +1,6 @@
 //! Image metrics and diff images: coverage mismatch, channel differences, PSNR, depth error;
-//! the ASCII coverage map and the `expected | diff | actual` PNG strip.
+//! the ASCII coverage map and the `expected | diff | actual` PNG strip; thresholds for
+//! `stereolab compare`, and comparing two image files.
 
 use std::path::{Path, PathBuf};
 
@@ -144,4 +145,329 @@ pub fn write_diff_strip(
         .save(&path)
         .map_err(|e| Error::io(&path, std::io::Error::other(e.to_string())))?;
     Ok(path)
+}
+
+/// One compared image pair: what it is, how it differs, where its diff strip went.
+#[derive(Clone, Debug)]
+pub struct Comparison {
+    /// What was compared, e.g. `left pass` or `side_by_side`.
+    pub name: String,
+    /// The metrics.
+    pub metrics: Metrics,
+    /// False when the images carry no depth (PNG files, layouts): depth is not reported.
+    pub has_depth: bool,
+    /// The `expected | diff | actual` strip, when one was written.
+    pub strip: Option<PathBuf>,
+}
+
+/// The comparisons as an aligned table, one row each.
+pub fn table(rows: &[Comparison]) -> String {
+    use std::fmt::Write as _;
+    let mut s = format!(
+        "{:<24} {:>12} {:>9} {:>9} {:>9} {:>11}\n",
+        "image", "coverage %", "max diff", "mean diff", "PSNR dB", "max depth"
+    );
+    for r in rows {
+        let m = &r.metrics;
+        let depth = if r.has_depth {
+            format!("{:.3e}", m.max_depth_diff)
+        } else {
+            "-".into()
+        };
+        let _ = writeln!(
+            s,
+            "{:<24} {:>12.5} {:>9} {:>9.4} {:>9.2} {:>11}",
+            r.name,
+            m.coverage_mismatch_percent(),
+            m.max_channel_diff,
+            m.mean_channel_diff,
+            m.psnr,
+            depth
+        );
+    }
+    s
+}
+
+/// Limits past which `stereolab compare` exits non-zero. The defaults are the GPU parity
+/// targets (the README's "CPU vs GPU" section has the measured figures they leave room for).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Thresholds {
+    /// Largest coverage mismatch, % of pixels (`coverage=`). Target: 0.1 (≥ 99.9% identical).
+    pub coverage_percent: f64,
+    /// Largest channel difference, 0..255 (`max=`).
+    pub max_channel: u8,
+    /// Largest mean channel difference (`mean=`).
+    pub mean_channel: f64,
+    /// Smallest PSNR in dB (`psnr=`).
+    pub min_psnr: f64,
+    /// Largest depth difference where both cover (`depth=`). Target: 1e-5.
+    pub max_depth: f32,
+}
+
+impl Default for Thresholds {
+    fn default() -> Self {
+        Thresholds {
+            coverage_percent: 0.1,
+            max_channel: 255,
+            mean_channel: 1.0,
+            min_psnr: 30.0,
+            max_depth: 1e-5,
+        }
+    }
+}
+
+impl Thresholds {
+    /// Applies one `KEY=VALUE` setting (`coverage`, `max`, `mean`, `psnr`, `depth`).
+    ///
+    /// # Errors
+    /// An unknown key or a value that is not a number in range.
+    pub fn set(&mut self, spec: &str) -> Result<()> {
+        let bad = |why: &str| Error::invalid("--threshold", spec, why.to_string());
+        let (key, value) = spec
+            .split_once('=')
+            .ok_or_else(|| bad("expected KEY=VALUE, e.g. coverage=0.1"))?;
+        let v: f64 = value
+            .trim()
+            .parse()
+            .map_err(|_| bad("the value must be a number"))?;
+        if !v.is_finite() || v < 0.0 {
+            return Err(bad("the value must be a finite number ≥ 0"));
+        }
+        match key.trim() {
+            "coverage" => self.coverage_percent = v,
+            "max" if v <= 255.0 => self.max_channel = v as u8,
+            "max" => return Err(bad("max is a channel difference in 0..=255")),
+            "mean" => self.mean_channel = v,
+            "psnr" => self.min_psnr = v,
+            "depth" => self.max_depth = v as f32,
+            _ => return Err(bad("known keys: coverage, max, mean, psnr, depth")),
+        }
+        Ok(())
+    }
+
+    /// Every limit a comparison exceeds, as `name: what = value > limit`.
+    pub fn violations(&self, rows: &[Comparison]) -> Vec<String> {
+        let mut v = Vec::new();
+        for r in rows {
+            let m = &r.metrics;
+            let mut fail = |what: &str, value: String, limit: String| {
+                v.push(format!("{}: {what} = {value}, limit {limit}", r.name));
+            };
+            if m.coverage_mismatch_percent() > self.coverage_percent {
+                fail(
+                    "coverage mismatch %",
+                    format!("{:.5}", m.coverage_mismatch_percent()),
+                    format!("{}", self.coverage_percent),
+                );
+            }
+            if m.max_channel_diff > self.max_channel {
+                fail(
+                    "max channel difference",
+                    m.max_channel_diff.to_string(),
+                    self.max_channel.to_string(),
+                );
+            }
+            if m.mean_channel_diff > self.mean_channel {
+                fail(
+                    "mean channel difference",
+                    format!("{:.4}", m.mean_channel_diff),
+                    self.mean_channel.to_string(),
+                );
+            }
+            if m.psnr < self.min_psnr {
+                fail(
+                    "PSNR dB",
+                    format!("{:.2}", m.psnr),
+                    format!("at least {}", self.min_psnr),
+                );
+            }
+            if r.has_depth && m.max_depth_diff > self.max_depth {
+                fail(
+                    "max depth difference",
+                    format!("{:.3e}", m.max_depth_diff),
+                    format!("{:e}", self.max_depth),
+                );
+            }
+        }
+        v
+    }
+}
+
+/// A framebuffer from an image without depth: a pixel counts as covered (depth 0) when it
+/// differs from `background` in RGB, uncovered (depth 1) otherwise, so that coverage mismatch
+/// means "drawn in one image, background in the other".
+pub fn framebuffer_from_image(img: &RgbaImage, background: [u8; 4]) -> Framebuffer {
+    let color: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    let depth = color
+        .iter()
+        .map(|c| if c[..3] == background[..3] { 1.0 } else { 0.0 })
+        .collect();
+    Framebuffer {
+        width: img.width(),
+        height: img.height(),
+        color,
+        depth,
+    }
+}
+
+/// Loads any image the `image` crate reads (PNG, PPM, GIF) as RGBA8.
+///
+/// # Errors
+/// The file cannot be read or decoded.
+pub fn load_image(path: &Path) -> Result<RgbaImage> {
+    image::open(path)
+        .map(|i| i.to_rgba8())
+        .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
+}
+
+/// Compares two image files (a student's screenshot against the reference render, say). Each
+/// image's background is `background` when given, else its own top-left pixel. Writes the
+/// `expected | diff | actual` strip into `out` when given.
+///
+/// # Errors
+/// Unreadable files, or images of different sizes.
+pub fn compare_images(
+    expected: &Path,
+    actual: &Path,
+    background: Option<[u8; 4]>,
+    out: Option<&Path>,
+) -> Result<Comparison> {
+    let load = |p: &Path| -> Result<Framebuffer> {
+        let img = load_image(p)?;
+        let bg = background.unwrap_or_else(|| img.get_pixel(0, 0).0);
+        Ok(framebuffer_from_image(&img, bg))
+    };
+    let (e, a) = (load(expected)?, load(actual)?);
+    let metrics = compare(&e, &a).map_err(|err| match err {
+        Error::Invalid { value, .. } => Error::invalid(
+            format!("{} vs {}", expected.display(), actual.display()),
+            value,
+            "images must have the same size",
+        ),
+        other => other,
+    })?;
+    let name = actual
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "image".into());
+    let strip = out
+        .map(|dir| write_diff_strip(&e, &a, dir, &format!("{name}-diff")))
+        .transpose()?;
+    Ok(Comparison {
+        name,
+        metrics,
+        has_depth: false,
+        strip,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn metrics(coverage_mismatch: usize, max: u8, mean: f64, psnr: f64, depth: f32) -> Metrics {
+        Metrics {
+            pixels: 1000,
+            coverage_mismatch,
+            max_channel_diff: max,
+            mean_channel_diff: mean,
+            psnr,
+            max_depth_diff: depth,
+        }
+    }
+
+    fn row(m: Metrics, has_depth: bool) -> Comparison {
+        Comparison {
+            name: "left pass".into(),
+            metrics: m,
+            has_depth,
+            strip: None,
+        }
+    }
+
+    #[test]
+    fn thresholds_pass_identical_images_and_name_every_exceeded_limit() {
+        let t = Thresholds::default();
+        assert!(
+            t.violations(&[row(metrics(0, 0, 0.0, f64::INFINITY, 0.0), true)])
+                .is_empty()
+        );
+        let bad = t.violations(&[row(metrics(2, 9, 2.0, 20.0, 1e-3), true)]);
+        assert_eq!(bad.len(), 4, "coverage 0.2%, mean, PSNR, depth: {bad:?}");
+        assert!(
+            bad[0].contains("coverage mismatch % = 0.20000"),
+            "{}",
+            bad[0]
+        );
+        // Without depth (PNG files), depth is not judged.
+        let no_depth = t.violations(&[row(metrics(0, 0, 0.0, 90.0, 1.0), false)]);
+        assert!(no_depth.is_empty(), "{no_depth:?}");
+    }
+
+    #[test]
+    fn threshold_settings_parse_and_bad_ones_are_named() {
+        let mut t = Thresholds::default();
+        t.set("coverage=0.5").expect("valid");
+        t.set("max=3").expect("valid");
+        t.set("depth=1e-4").expect("valid");
+        assert_eq!(
+            (t.coverage_percent, t.max_channel, t.max_depth),
+            (0.5, 3, 1e-4)
+        );
+        for bad in [
+            "coverage",
+            "colour=1",
+            "max=256",
+            "psnr=-1",
+            "mean=abc",
+            "depth=inf",
+        ] {
+            let e = t.set(bad).expect_err(bad).to_string();
+            assert!(e.contains(bad), "the message names the setting: {e}");
+        }
+    }
+
+    #[test]
+    fn image_coverage_is_whatever_differs_from_the_background() {
+        let bg = [10, 20, 30, 255];
+        let img = RgbaImage::from_fn(3, 1, |x, _| match x {
+            0 => Rgba(bg),
+            1 => Rgba([10, 20, 31, 255]),
+            _ => Rgba([10, 20, 30, 0]), // alpha is ignored
+        });
+        let fb = framebuffer_from_image(&img, bg);
+        assert_eq!(coverage(&fb), vec![false, true, false]);
+    }
+
+    #[test]
+    fn comparing_two_image_files_reports_differences_and_writes_the_strip() {
+        let dir = std::env::temp_dir().join(format!("stereolab-compare-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let bg = Rgba([0, 0, 0, 255]);
+        let a = RgbaImage::from_fn(8, 8, |x, y| {
+            if (2..5).contains(&x) && (2..5).contains(&y) {
+                Rgba([200, 100, 50, 255])
+            } else {
+                bg
+            }
+        });
+        let mut b = a.clone();
+        b.put_pixel(6, 6, Rgba([200, 100, 50, 255])); // one extra covered pixel
+        b.put_pixel(3, 3, Rgba([204, 100, 50, 255])); // one color off by 4
+        let (pa, pb) = (dir.join("expected.png"), dir.join("actual.png"));
+        a.save(&pa).expect("write");
+        b.save(&pb).expect("write");
+        let c = compare_images(&pa, &pb, None, Some(&dir)).expect("compare");
+        assert_eq!(c.metrics.coverage_mismatch, 1);
+        assert_eq!(c.metrics.max_channel_diff, 200);
+        assert!(c.strip.as_ref().is_some_and(|p| p.exists()));
+        let small = RgbaImage::new(4, 4);
+        let pc = dir.join("small.png");
+        small.save(&pc).expect("write");
+        let e = compare_images(&pa, &pc, None, None)
+            .expect_err("sizes differ")
+            .to_string();
+        assert!(e.contains("8x8 vs 4x4"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -12,6 +12,8 @@ pub mod error;
 pub mod exercise;
 pub mod figures;
 pub mod framebuffer;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod grade;
 pub mod info;
 pub mod math;

@@ -4,11 +4,22 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
-use clap::{Parser, Subcommand};
+use clap::{Parser, Subcommand, ValueEnum};
 
+use stereolab::compare::{self, Comparison, Thresholds};
 use stereolab::plan::Plan;
+use stereolab::render::Frame;
 use stereolab::scene::Scene;
 use stereolab::{Error, Result, bench, effects, grade, info, output, render};
+
+/// Which path renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Backend {
+    /// The CPU rasterizer (the reference).
+    Cpu,
+    /// wgpu on Vulkan (lavapipe without a GPU); needs the `gpu` cargo feature.
+    Gpu,
+}
 
 #[derive(Parser)]
 #[command(
@@ -39,6 +50,9 @@ enum Command {
         /// Print the plan (which passes run for which outputs) and render nothing.
         #[arg(long)]
         explain: bool,
+        /// Which path renders.
+        #[arg(long, value_enum, default_value = "cpu")]
+        backend: Backend,
         /// Instead of the scene's outputs: the student's exercise (ex1, ex2, ex3) next to the
         /// reference, as `reference | diff | yours` images.
         #[arg(long, value_name = "EXERCISE")]
@@ -49,6 +63,30 @@ enum Command {
         /// With --exercise: the folder holding the exercise crates (default: ./exercises or .).
         #[arg(long, requires = "exercise")]
         exercises: Option<PathBuf>,
+    },
+    /// Compare the CPU and GPU renders of a scene (`compare SCENE`), or any two images
+    /// (`compare EXPECTED.png ACTUAL.png`); exits non-zero past a threshold.
+    Compare {
+        /// A scene file (TOML), or the expected image when ACTUAL is given.
+        first: PathBuf,
+        /// The actual image (compares two image files).
+        second: Option<PathBuf>,
+        /// Folder for the `expected | diff | actual` PNG strips.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Change a limit: coverage=% (0.1), max=0..255 (255), mean=channel (1.0),
+        /// psnr=dB (30), depth=window depth (1e-5). Repeatable.
+        #[arg(long = "threshold", value_name = "KEY=VALUE")]
+        thresholds: Vec<String>,
+        /// Image size WxH, overriding the scene's.
+        #[arg(long)]
+        size: Option<String>,
+        /// Override a scene field (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+        /// Background color R,G,B (0..255) for two images; default: each image's top-left pixel.
+        #[arg(long)]
+        background: Option<String>,
     },
     /// Build and run the student's exercise crates; points table, verdict and hints.
     Grade {
@@ -142,6 +180,61 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
     ))
 }
 
+fn parse_rgb(s: &str) -> Result<[u8; 4]> {
+    let bad = || Error::invalid("--background", s, "expected R,G,B with each in 0..=255");
+    let v = s
+        .split(',')
+        .map(|c| c.trim().parse::<u8>().map_err(|_| bad()))
+        .collect::<Result<Vec<_>>>()?;
+    match v[..] {
+        [r, g, b] => Ok([r, g, b, 255]),
+        _ => Err(bad()),
+    }
+}
+
+fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Result<Scene> {
+    let mut s = Scene::load(path, sets)?;
+    if let Some(size) = size {
+        let (w, h) = parse_size(size)?;
+        s.set_size(w, h)?;
+    }
+    Ok(s)
+}
+
+#[cfg(feature = "gpu")]
+fn render_gpu(scene: &Scene, plan: &Plan) -> Result<Frame> {
+    use stereolab::gpu::{GpuRenderer, GpuScene};
+    let r = GpuRenderer::new()?;
+    println!("gpu: {}", r.adapter_name());
+    r.render(&GpuScene::upload(&r, scene)?, plan)
+}
+
+#[cfg(feature = "gpu")]
+fn compare_scene(scene: &Scene, out: Option<&std::path::Path>) -> Result<Vec<Comparison>> {
+    let r = stereolab::gpu::GpuRenderer::new()?;
+    println!("cpu (expected) vs gpu (actual): {}", r.adapter_name());
+    stereolab::gpu::parity::compare_scene(&r, scene, &Plan::new(&scene.outputs), out)
+}
+
+#[cfg(not(feature = "gpu"))]
+fn no_gpu(what: &str) -> Error {
+    Error::invalid(
+        what,
+        "gpu",
+        "this stereolab was built without the GPU path: cargo build --release --features gpu",
+    )
+}
+
+#[cfg(not(feature = "gpu"))]
+fn render_gpu(_: &Scene, _: &Plan) -> Result<Frame> {
+    Err(no_gpu("--backend"))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn compare_scene(_: &Scene, _: Option<&std::path::Path>) -> Result<Vec<Comparison>> {
+    Err(no_gpu("compare SCENE (CPU against GPU)"))
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render {
@@ -150,15 +243,12 @@ fn run(cli: Cli) -> Result<()> {
             size,
             sets,
             explain,
+            backend,
             exercise,
             solution,
             exercises,
         } => {
-            let mut s = Scene::load(&scene, &sets)?;
-            if let Some(size) = size {
-                let (w, h) = parse_size(&size)?;
-                s.set_size(w, h)?;
-            }
+            let s = load_scene(&scene, &sets, size.as_deref())?;
             if let Some(name) = exercise {
                 let [ex] = grade::Exercise::parse_list(&name)?[..] else {
                     return Err(Error::invalid(
@@ -179,10 +269,24 @@ fn run(cli: Cli) -> Result<()> {
                 print!("{}", plan.explain());
                 return Ok(());
             }
-            let frame = render::render(&s, &plan)?;
+            let frame = match backend {
+                Backend::Cpu => render::render(&s, &plan)?,
+                Backend::Gpu => render_gpu(&s, &plan)?,
+            };
             let paths = output::write_all(&frame, &s, &out)?;
             println!("rendered {} ({}x{})", scene.display(), s.width, s.height);
-            for p in &frame.passes {
+            if backend == Backend::Gpu {
+                let ms = frame
+                    .passes
+                    .first()
+                    .map_or(0.0, |p| p.time.as_secs_f64() * 1e3);
+                println!(
+                    "  {} passes on the GPU in one submission: {ms:.2} ms including readback \
+                     and, on this first frame, shader compilation",
+                    frame.passes.len()
+                );
+            }
+            for p in frame.passes.iter().filter(|_| backend == Backend::Cpu) {
                 println!(
                     "  pass {:?} {:?}: {:.2} ms, {} triangles, {} fragments, {} clipped, {} culled",
                     p.pass.view,
@@ -201,6 +305,49 @@ fn run(cli: Cli) -> Result<()> {
                 println!("  wrote {}", p.display());
             }
             Ok(())
+        }
+        Command::Compare {
+            first,
+            second,
+            out,
+            thresholds,
+            size,
+            sets,
+            background,
+        } => {
+            let mut limits = Thresholds::default();
+            for t in &thresholds {
+                limits.set(t)?;
+            }
+            let rows = match second {
+                Some(second) => {
+                    let bg = background.as_deref().map(parse_rgb).transpose()?;
+                    vec![compare::compare_images(
+                        &first,
+                        &second,
+                        bg,
+                        out.as_deref(),
+                    )?]
+                }
+                None => {
+                    let s = load_scene(&first, &sets, size.as_deref())?;
+                    compare_scene(&s, out.as_deref())?
+                }
+            };
+            print!("{}", compare::table(&rows));
+            for p in rows.iter().filter_map(|r| r.strip.as_ref()) {
+                println!("  wrote {}", p.display());
+            }
+            let failed = limits.violations(&rows);
+            if failed.is_empty() {
+                Ok(())
+            } else {
+                Err(Error::invalid(
+                    "--threshold",
+                    format!("{} exceeded", failed.len()),
+                    failed.join("; "),
+                ))
+            }
         }
         Command::Grade {
             exercise,

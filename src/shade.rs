@@ -104,6 +104,36 @@ impl<'a> BlinnPhong<'a> {
             light_eye: view.transform_point3(light.position),
         }
     }
+
+    /// `view · model`: object space to the lighting eye's space.
+    pub fn modelview(&self) -> Mat4 {
+        self.modelview
+    }
+
+    /// Inverse transpose of the modelview's linear part (normals go through it).
+    pub fn normal_matrix(&self) -> Mat3 {
+        self.normal_matrix
+    }
+
+    /// The projection that completes the modelview (OpenGL clip space).
+    pub fn projection(&self) -> Mat4 {
+        self.projection
+    }
+
+    /// The light position in the lighting eye's space.
+    pub fn light_eye(&self) -> Vec3 {
+        self.light_eye
+    }
+
+    /// The material color, 0..1.
+    pub fn color(&self) -> Vec3 {
+        self.color
+    }
+
+    /// The light's ambient, specular and shininess terms.
+    pub fn light(&self) -> Light {
+        self.light
+    }
 }
 
 impl Shader for BlinnPhong<'_> {

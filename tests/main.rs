@@ -7,6 +7,8 @@ mod conformance;
 mod determinism;
 mod finalize;
 mod golden;
+#[cfg(feature = "gpu")]
+mod gpu_parity;
 mod grading;
 mod layout;
 mod rig;

@@ -24,6 +24,8 @@ pub struct Run {
 /// Builds `crate_dir`'s binary (named like the crate) with cargo, in the dev profile so it shares
 /// the workspace's compiled dependencies. `Ok(path)` is the executable; `Err` the compiler's
 /// messages (a compile error in the student's code is a result to report, not a crash).
+/// stereolab is built with the features this grader has (`gpu`), so the build the grader came
+/// from is reused instead of compiled again with other features.
 pub fn build(crate_dir: &Path, name: &str, solution: bool) -> Result<PathBuf, String> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let mut cmd = Command::new(cargo);
@@ -33,6 +35,9 @@ pub fn build(crate_dir: &Path, name: &str, solution: bool) -> Result<PathBuf, St
         .args(["--bin", name, "--message-format=json-render-diagnostics"]);
     if solution {
         cmd.args(["--features", "solution"]);
+    }
+    if cfg!(feature = "gpu") {
+        cmd.args(["--features", "stereolab/gpu"]);
     }
     let out = cmd
         .stdin(Stdio::null())

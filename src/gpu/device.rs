@@ -1,0 +1,133 @@
+//! The wgpu device: adapter selection, the pipeline cache, and one submit-and-wait helper.
+
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use crate::error::Result;
+
+use super::gpu_error;
+use super::readback::Target;
+
+/// Which pipeline a scene pass needs: its shading and the rasterizer options that change
+/// fixed-function state or the shader (see [`crate::raster::RasterOptions`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct PipelineKey {
+    /// Shaded Blinn-Phong (true) or depth only.
+    pub shaded: bool,
+    /// Back-face culling.
+    pub cull_back: bool,
+    /// Perspective-correct varyings (true) or `@interpolate(linear)`.
+    pub perspective_correct: bool,
+    /// Depth test LESS with writes (true), or neither.
+    pub depth_test: bool,
+}
+
+/// A wgpu device and queue with the pipelines built so far. Create once, render many frames.
+pub struct GpuRenderer {
+    pub(crate) device: wgpu::Device,
+    pub(crate) queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    /// Uniform buffer with dynamic offset, shared by the scene pipelines (group 0).
+    pub(crate) uniform_layout: wgpu::BindGroupLayout,
+    pub(crate) pipelines: Mutex<HashMap<PipelineKey, wgpu::RenderPipeline>>,
+    /// Targets of earlier frames, reused when the size matches (fresh ones cost page faults).
+    pub(crate) spare_targets: Mutex<Vec<Target>>,
+}
+
+impl GpuRenderer {
+    /// Opens the first Vulkan adapter wgpu finds (lavapipe's "llvmpipe" on a machine without a
+    /// GPU) and creates a device with the adapter's own limits.
+    ///
+    /// # Errors
+    /// No Vulkan adapter (`mesa-vulkan-drivers` missing), or the device cannot be created.
+    pub fn new() -> Result<GpuRenderer> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::VULKAN;
+        let instance = wgpu::Instance::new(desc);
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|e| {
+            gpu_error(
+                "no adapter",
+                format!(
+                    "no Vulkan adapter found ({e}); on Debian/Ubuntu install \
+                     mesa-vulkan-drivers and libvulkan1 for lavapipe"
+                ),
+            )
+        })?;
+        let info = adapter.get_info();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("stereolab"),
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| gpu_error(&info.name, format!("cannot create a device: {e}")))?;
+        let uniform_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene uniforms"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        Ok(GpuRenderer {
+            device,
+            queue,
+            info,
+            uniform_layout,
+            pipelines: Mutex::new(HashMap::new()),
+            spare_targets: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// The adapter's name and driver, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Mesa 22.3.6)`.
+    pub fn adapter_name(&self) -> String {
+        let i = &self.info;
+        if i.driver_info.is_empty() {
+            i.name.clone()
+        } else {
+            format!("{} ({})", i.name, i.driver_info)
+        }
+    }
+
+    /// `lavapipe` for Mesa's CPU driver, else the adapter's name.
+    pub fn short_name(&self) -> String {
+        if self.is_cpu_adapter() && self.info.name.starts_with("llvmpipe") {
+            "lavapipe".into()
+        } else {
+            self.info.name.clone()
+        }
+    }
+
+    /// True when the adapter is a CPU implementation (lavapipe, SwiftShader).
+    pub fn is_cpu_adapter(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Largest texture side the device accepts.
+    pub fn max_texture_side(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
+    }
+
+    /// Checks that a `width × height` target fits the device.
+    ///
+    /// # Errors
+    /// A side above [`GpuRenderer::max_texture_side`].
+    pub(crate) fn check_target_size(&self, width: u32, height: u32) -> Result<()> {
+        let max = self.max_texture_side();
+        if width > max || height > max {
+            return Err(gpu_error(
+                format!("{width}x{height}"),
+                format!("the adapter's largest texture side is {max} pixels"),
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,73 @@
+//! The GPU parity path: the same [`Plan`](crate::plan::Plan), meshes and matrices as the CPU
+//! path, rendered by wgpu (on lavapipe when no GPU is present) and read back into the same
+//! [`Framebuffer`](crate::Framebuffer) type, so that [`compare`](crate::compare) can measure the
+//! two paths pixel by pixel. Built only with the cargo feature `gpu`.
+//!
+//! Conventions (DESIGN.md "Conventions"):
+//! - the matrices are OpenGL's (NDC z in [−1, 1]); wgpu clips and maps z in [0, 1], so every
+//!   projection goes through [`GL_TO_WGPU_DEPTH`] (the only place the two conventions meet);
+//! - wgpu's NDC has y = +1 at the top row (wgpu itself gives Vulkan a negative viewport height),
+//!   exactly as the CPU viewport `y_win = (y/w)·(−H/2) + H/2`: nothing is flipped here;
+//! - color targets are `Rgba8Unorm` without sRGB; shaders quantize like
+//!   [`to_rgba8`](crate::shade::to_rgba8) so the unorm store is exact;
+//! - depth is `Depth32Float`, read back bit for bit.
+//!
+//! Layout: [`device`] (adapter, device, pipeline cache), [`raster`] (scene passes),
+//! [`fullscreen`] (the generic full-screen pass that effects mirror), [`readback`] (textures to
+//! framebuffers), [`parity`] (render both paths and compare, and the benchmark row).
+
+pub mod device;
+pub mod fullscreen;
+pub mod parity;
+pub mod raster;
+mod readback;
+
+pub use device::GpuRenderer;
+pub use fullscreen::FullscreenPass;
+pub use raster::GpuScene;
+
+use glam::{Mat4, Vec4};
+
+/// OpenGL clip space to wgpu clip space: `z' = z/2 + w/2`, x, y and w unchanged, so NDC z in
+/// [−1, 1] (`glDepthRange(0, 1)` then maps it to `z/2 + 1/2`) becomes wgpu's [0, 1] with the
+/// same window depth. Rows 0, 1 and 3 are unit rows, so `GL_TO_WGPU_DEPTH · P` keeps x, y and w
+/// of `P` bit for bit; only z is rounded differently (relative 1e-7).
+pub const GL_TO_WGPU_DEPTH: Mat4 = Mat4::from_cols(
+    Vec4::new(1.0, 0.0, 0.0, 0.0),
+    Vec4::new(0.0, 1.0, 0.0, 0.0),
+    Vec4::new(0.0, 0.0, 0.5, 0.0),
+    Vec4::new(0.0, 0.0, 0.5, 1.0),
+);
+
+/// An error from the GPU path, as the CLI reports it (`gpu = <what>: <why>`).
+pub(crate) fn gpu_error(what: impl std::fmt::Display, why: impl Into<String>) -> crate::Error {
+    crate::Error::invalid("gpu", what, why)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn depth_remap_maps_gl_near_and_far_to_zero_and_one() {
+        let near = GL_TO_WGPU_DEPTH * Vec4::new(0.3, -0.2, -2.0, 2.0);
+        let far = GL_TO_WGPU_DEPTH * Vec4::new(0.3, -0.2, 2.0, 2.0);
+        assert_eq!(near, Vec4::new(0.3, -0.2, 0.0, 2.0));
+        assert_eq!(far, Vec4::new(0.3, -0.2, 2.0, 2.0));
+    }
+
+    #[test]
+    fn depth_remap_keeps_x_y_w_of_a_projection_bit_for_bit() {
+        let p = crate::math::frustum(-0.7, 0.55, -0.4, 0.45, 1.3, 17.0);
+        let q = GL_TO_WGPU_DEPTH * p;
+        for c in 0..4 {
+            for r in [0, 1, 3] {
+                assert_eq!(
+                    q.col(c)[r].to_bits(),
+                    p.col(c)[r].to_bits(),
+                    "col {c} row {r}"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,151 @@
+//! Both paths on one scene: `stereolab compare SCENE` and the benchmark's CPU-vs-lavapipe row.
+
+use std::path::Path;
+
+use crate::bench::{Row, median_ms};
+use crate::compare::{Comparison, compare, framebuffer_from_image, write_diff_strip};
+use crate::error::Result;
+use crate::output::{Image, produce};
+use crate::plan::{Output, Plan};
+use crate::render::{Frame, render};
+use crate::scene::Scene;
+
+use super::device::GpuRenderer;
+use super::raster::GpuScene;
+
+/// Outputs that are one pass's framebuffer as it is: compared once, as the pass.
+const PASS_OUTPUTS: [Output; 4] = [
+    Output::Left,
+    Output::Right,
+    Output::LeftDepth,
+    Output::RightDepth,
+];
+
+/// Renders `plan` on the CPU (expected) and on the GPU (actual) and compares every pass
+/// (color, coverage and depth) and every other RGBA output (color and coverage against the
+/// scene's background). With `out`, writes an `expected | diff | actual` strip per row.
+///
+/// # Errors
+/// Rendering fails on either path, or a strip cannot be written.
+pub fn compare_scene(
+    r: &GpuRenderer,
+    scene: &Scene,
+    plan: &Plan,
+    out: Option<&Path>,
+) -> Result<Vec<Comparison>> {
+    let cpu = render(scene, plan)?;
+    let gpu = r.render(&GpuScene::upload(r, scene)?, plan)?;
+    compare_frames(&cpu, &gpu, scene, out)
+}
+
+/// Compares two frames of the same plan, as [`compare_scene`] describes.
+///
+/// # Errors
+/// Different sizes, a missing pass, or a strip that cannot be written.
+pub fn compare_frames(
+    expected: &Frame,
+    actual: &Frame,
+    scene: &Scene,
+    out: Option<&Path>,
+) -> Result<Vec<Comparison>> {
+    let mut rows = Vec::new();
+    for (e, a) in expected.passes.iter().zip(&actual.passes) {
+        let name = format!("{} pass", format!("{:?}", e.pass.view).to_lowercase());
+        let metrics = compare(&e.framebuffer, &a.framebuffer)?;
+        let strip = out
+            .map(|d| write_diff_strip(&e.framebuffer, &a.framebuffer, d, &name.replace(' ', "_")))
+            .transpose()?;
+        rows.push(Comparison {
+            name,
+            metrics,
+            has_depth: true,
+            strip,
+        });
+    }
+    for &o in &expected.plan.outputs {
+        if PASS_OUTPUTS.contains(&o) {
+            continue;
+        }
+        let (Image::Rgba(e), Image::Rgba(a)) =
+            (produce(o, expected, scene)?, produce(o, actual, scene)?)
+        else {
+            continue; // depth images: the pass rows already compare depth exactly
+        };
+        let (e, a) = (
+            framebuffer_from_image(&e, scene.background),
+            framebuffer_from_image(&a, scene.background),
+        );
+        let metrics = compare(&e, &a)?;
+        let strip = out
+            .map(|d| write_diff_strip(&e, &a, d, o.name()))
+            .transpose()?;
+        rows.push(Comparison {
+            name: o.name().to_string(),
+            metrics,
+            has_depth: false,
+            strip,
+        });
+    }
+    Ok(rows)
+}
+
+/// The stereo pair of `scene` on the CPU path and on the GPU, whole frame including readback
+/// into framebuffers (meshes uploaded once, outside the timing), as a ratio in the same run.
+/// Without an adapter the row says so instead of timing anything.
+///
+/// # Errors
+/// Rendering fails on either path.
+pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
+    let plan = Plan::new(&[Output::Left, Output::Right]);
+    let size = format!("{}x{}", scene.width, scene.height);
+    let row = |setting: String, error, ms, note: String| Row {
+        area: "gpu parity".into(),
+        knob: "backend".into(),
+        setting,
+        error,
+        error_unit: "% coverage vs cpu".into(),
+        ms,
+        note,
+    };
+    let r = match GpuRenderer::new() {
+        Ok(r) => r,
+        Err(e) => {
+            return Ok(vec![row(
+                "gpu".into(),
+                None,
+                f64::NAN,
+                format!("not measured: {e}"),
+            )]);
+        }
+    };
+    let gpu_scene = GpuScene::upload(&r, scene)?;
+    let cpu = render(scene, &plan)?;
+    let gpu = r.render(&gpu_scene, &plan)?;
+    let worst = compare_frames(&cpu, &gpu, scene, None)?
+        .iter()
+        .map(|c| c.metrics.coverage_mismatch_percent())
+        .fold(0.0, f64::max);
+    let mut failed = None;
+    let cpu_ms = median_ms(iters, || render(scene, &plan).map_err(|e| failed = Some(e)));
+    let gpu_ms = median_ms(iters, || {
+        r.render(&gpu_scene, &plan).map_err(|e| failed = Some(e))
+    });
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let ratio = cpu_ms / gpu_ms;
+    Ok(vec![
+        row(
+            "cpu".into(),
+            Some(0.0),
+            cpu_ms,
+            format!("stereo pair {size}, cpu/gpu time = {ratio:.2}"),
+        ),
+        row(
+            r.short_name(),
+            Some(worst),
+            gpu_ms,
+            format!("stereo pair {size} incl. readback; {}", r.adapter_name()),
+        ),
+    ])
+}

@@ -1,0 +1,423 @@
+//! Scene passes on the GPU: the plan's passes with the CPU path's meshes and matrices, drawn
+//! with the WGSL mirror of the CPU shaders and read back into [`Framebuffer`]s.
+
+use std::time::Instant;
+
+use crate::error::Result;
+use crate::framebuffer::Framebuffer;
+use crate::math::{EyeMatrices, StereoRig};
+use crate::plan::{Pass, Plan, Shading, View};
+use crate::raster::{RasterOptions, RasterStats};
+use crate::render::{Frame, PassResult};
+use crate::scene::Scene;
+use crate::shade::BlinnPhong;
+
+use super::device::{GpuRenderer, PipelineKey};
+use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
+use super::{GL_TO_WGPU_DEPTH, gpu_error};
+
+/// The mirror of [`BlinnPhong`](crate::shade::BlinnPhong).
+const BLINN_PHONG_WGSL: &str = include_str!("shaders/blinn_phong.wgsl");
+/// The mirror of [`DepthOnly`](crate::shade::DepthOnly).
+const DEPTH_ONLY_WGSL: &str = include_str!("shaders/depth_only.wgsl");
+
+/// Interleaved position + normal, 6 × f32.
+const VERTEX_STRIDE: u64 = 24;
+/// Bytes of the largest uniform block (blinn_phong.wgsl `Uniforms`: 2 mat4, 1 mat3, 3 × 16).
+const UNIFORM_BYTES: u64 = 224;
+
+/// One object's geometry on the GPU.
+struct GpuMesh {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+}
+
+/// A scene whose meshes have been uploaded once; render it as often as needed.
+pub struct GpuScene<'a> {
+    /// The scene (matrices, light, options are read from it at every render).
+    pub scene: &'a Scene,
+    meshes: Vec<GpuMesh>,
+}
+
+impl<'a> GpuScene<'a> {
+    /// Uploads every object's positions, normals and triangles.
+    ///
+    /// # Errors
+    /// The scene's rasterizer options have no GPU equivalent (subpixel bits other than
+    /// llvmpipe's 8), or the image is larger than the device allows.
+    pub fn upload(r: &GpuRenderer, scene: &'a Scene) -> Result<Self> {
+        if scene.raster.subpixel_bits != RasterOptions::default().subpixel_bits {
+            return Err(gpu_error(
+                format!("raster.subpixel_bits = {}", scene.raster.subpixel_bits),
+                "the GPU snaps to its own fixed 8 subpixel bits",
+            ));
+        }
+        r.check_target_size(scene.width, scene.height)?;
+        let meshes = scene
+            .objects
+            .iter()
+            .map(|o| {
+                let m = &o.mesh;
+                let vertices: Vec<u8> = m
+                    .positions
+                    .iter()
+                    .zip(&m.normals)
+                    .flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
+                    .flat_map(f32::to_ne_bytes)
+                    .collect();
+                let indices: Vec<u8> = m
+                    .triangles
+                    .iter()
+                    .flatten()
+                    .flat_map(|i| i.to_ne_bytes())
+                    .collect();
+                GpuMesh {
+                    vertices: buffer_with(r, "vertices", &vertices, wgpu::BufferUsages::VERTEX),
+                    indices: buffer_with(r, "indices", &indices, wgpu::BufferUsages::INDEX),
+                    index_count: 3 * m.triangles.len() as u32,
+                }
+            })
+            .collect();
+        Ok(GpuScene { scene, meshes })
+    }
+}
+
+/// A buffer initialized with `data`.
+fn buffer_with(
+    r: &GpuRenderer,
+    label: &str,
+    data: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let b = r.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: (data.len() as u64)
+            .next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT)
+            .max(4),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    r.queue.write_buffer(&b, 0, data);
+    b
+}
+
+impl GpuRenderer {
+    /// Renders every pass of `plan`, like [`crate::render::render`]: all passes go into one
+    /// submission, so each [`PassResult::time`] is the whole frame's time including readback,
+    /// and [`PassResult::stats`] only counts the triangles submitted (the GPU does not report
+    /// fragments).
+    ///
+    /// # Errors
+    /// Invalid camera or rig, or a GPU failure.
+    pub fn render(&self, scene: &GpuScene, plan: &Plan) -> Result<Frame> {
+        let s = scene.scene;
+        let eyes = s.rig.eyes(&s.camera, s.aspect())?;
+        let center = StereoRig::center(&s.camera, s.aspect())?;
+        let matrices = |v: View| match v {
+            View::Left => eyes[0],
+            View::Right => eyes[1],
+            View::Center => center,
+        };
+        let start = Instant::now();
+        let passes: Vec<(EyeMatrices, Shading)> = plan
+            .passes
+            .iter()
+            .map(|p| (matrices(p.view), p.shading))
+            .collect();
+        let framebuffers = self.render_views(scene, &passes)?;
+        let time = start.elapsed();
+        let triangles: usize = s.objects.iter().map(|o| o.mesh.triangles.len()).sum();
+        let passes = plan
+            .passes
+            .iter()
+            .zip(framebuffers)
+            .map(|(pass, framebuffer): (&Pass, Framebuffer)| PassResult {
+                pass: *pass,
+                framebuffer,
+                stats: RasterStats {
+                    triangles,
+                    ..RasterStats::default()
+                },
+                time,
+            })
+            .collect();
+        Ok(Frame {
+            plan: plan.clone(),
+            passes,
+            eyes,
+            center,
+        })
+    }
+
+    /// Renders the whole scene once from `m`, like [`crate::render::render_view`].
+    ///
+    /// # Errors
+    /// A GPU failure.
+    pub fn render_view(
+        &self,
+        scene: &GpuScene,
+        m: &EyeMatrices,
+        shading: Shading,
+    ) -> Result<Framebuffer> {
+        let mut fbs = self.render_views(scene, &[(*m, shading)])?;
+        fbs.pop()
+            .ok_or_else(|| gpu_error("render_view", "no framebuffer came back"))
+    }
+
+    /// Renders several views in one submission and reads them all back.
+    ///
+    /// # Errors
+    /// A GPU failure.
+    pub fn render_views(
+        &self,
+        scene: &GpuScene,
+        views: &[(EyeMatrices, Shading)],
+    ) -> Result<Vec<Framebuffer>> {
+        let s = scene.scene;
+        let align = self.device.limits().min_uniform_buffer_offset_alignment as u64;
+        let slot = UNIFORM_BYTES.next_multiple_of(align);
+        let draws = views.len() * s.objects.len();
+        let mut uniforms = vec![0u8; (draws as u64 * slot).max(slot) as usize];
+        for (v, (m, shading)) in views.iter().enumerate() {
+            for (k, o) in s.objects.iter().enumerate() {
+                let at = (v * s.objects.len() + k) * slot as usize;
+                let floats = match shading {
+                    Shading::Color => shaded_uniforms(&BlinnPhong::new(
+                        &[],
+                        &[],
+                        o.model,
+                        m.view,
+                        m.projection,
+                        o.color,
+                        s.light,
+                    )),
+                    Shading::DepthOnly => (GL_TO_WGPU_DEPTH * (m.mvp * o.model))
+                        .to_cols_array()
+                        .to_vec(),
+                    Shading::ChromaDepth => {
+                        return Err(gpu_error(
+                            "render",
+                            "the ChromaDepth pass has no WGSL mirror yet; render it with the CPU backend",
+                        ));
+                    }
+                };
+                let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_ne_bytes()).collect();
+                uniforms[at..at + bytes.len()].copy_from_slice(&bytes);
+            }
+        }
+        let uniform_buffer = buffer_with(
+            self,
+            "scene uniforms",
+            &uniforms,
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene uniforms"),
+            layout: &self.uniform_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniform_buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(UNIFORM_BYTES),
+                }),
+            }],
+        });
+        let targets = views
+            .iter()
+            .map(|_| Target::take(self, s.width, s.height, DepthKind::DepthBuffer))
+            .collect::<Result<Vec<_>>>()?;
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        let bg = s.background.map(|c| c as f64 / 255.0);
+        let clear = wgpu::Color {
+            r: bg[0],
+            g: bg[1],
+            b: bg[2],
+            a: bg[3],
+        };
+        for (v, ((_, shading), target)) in views.iter().zip(&targets).enumerate() {
+            let key = PipelineKey {
+                shaded: *shading == Shading::Color,
+                cull_back: s.raster.cull_back,
+                perspective_correct: s.raster.perspective_correct,
+                depth_test: s.raster.depth_test,
+            };
+            let pipeline = self.scene_pipeline(key)?;
+            let color_attachment = wgpu::RenderPassColorAttachment {
+                view: &target.color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            };
+            if !key.shaded {
+                // A depth-only pipeline has no color target: clear the color in a pass of its own,
+                // as the CPU path leaves the background where it never shades.
+                encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("clear color"),
+                    color_attachments: &[Some(color_attachment.clone())],
+                    ..Default::default()
+                });
+            }
+            let color_attachments = [Some(color_attachment)];
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("scene pass"),
+                color_attachments: if key.shaded { &color_attachments } else { &[] },
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &target.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            pass.set_pipeline(&pipeline);
+            for (k, mesh) in scene.meshes.iter().enumerate() {
+                let offset = ((v * s.objects.len() + k) as u64 * slot) as u32;
+                pass.set_bind_group(0, &bind_group, &[offset]);
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+            }
+        }
+        for t in &targets {
+            t.encode_copies(&mut encoder);
+        }
+        let refs: Vec<&Target> = targets.iter().collect();
+        let framebuffers = submit_and_read(self, encoder, &refs)?;
+        // Only after a clean readback: a failed one may leave a buffer mapped.
+        Target::give_back(self, targets);
+        Ok(framebuffers)
+    }
+
+    /// The pipeline for `key`, built on first use.
+    fn scene_pipeline(&self, key: PipelineKey) -> Result<wgpu::RenderPipeline> {
+        let mut cache = self
+            .pipelines
+            .lock()
+            .map_err(|_| gpu_error("pipeline cache", "poisoned by a panic in another thread"))?;
+        Ok(cache
+            .entry(key)
+            .or_insert_with(|| build_scene_pipeline(self, key))
+            .clone())
+    }
+}
+
+/// The floats of blinn_phong.wgsl's `Uniforms`, from the very values the CPU shader uses.
+fn shaded_uniforms(bp: &BlinnPhong) -> Vec<f32> {
+    let mut f = Vec::with_capacity(56);
+    f.extend(bp.modelview().to_cols_array());
+    f.extend((GL_TO_WGPU_DEPTH * bp.projection()).to_cols_array());
+    let n = bp.normal_matrix();
+    for c in [n.x_axis, n.y_axis, n.z_axis] {
+        f.extend([c.x, c.y, c.z, 0.0]);
+    }
+    let light = bp.light();
+    f.extend(bp.light_eye().to_array());
+    f.push(light.ambient);
+    f.extend(bp.color().to_array());
+    f.push(light.specular);
+    f.extend([light.shininess, 0.0, 0.0, 0.0]);
+    f
+}
+
+/// Builds the render pipeline for a scene pass: triangle list, counter-clockwise front faces
+/// (as the CPU path: counter-clockwise in NDC), depth LESS into `Depth32Float`.
+fn build_scene_pipeline(r: &GpuRenderer, key: PipelineKey) -> wgpu::RenderPipeline {
+    let source = if key.shaded {
+        BLINN_PHONG_WGSL
+    } else {
+        DEPTH_ONLY_WGSL
+    };
+    // Affine varyings are the same shader with linear (screen-space) interpolation.
+    let source = if key.perspective_correct {
+        source.to_string()
+    } else {
+        source.replace("@interpolate(perspective)", "@interpolate(linear)")
+    };
+    let module = r.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(if key.shaded {
+            "blinn_phong.wgsl"
+        } else {
+            "depth_only.wgsl"
+        }),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let layout = r
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene"),
+            bind_group_layouts: &[Some(&r.uniform_layout)],
+            immediate_size: 0,
+        });
+    let attributes = [
+        wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 0,
+            shader_location: 0,
+        },
+        wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 12,
+            shader_location: 1,
+        },
+    ];
+    let attributes = if key.shaded {
+        &attributes[..]
+    } else {
+        &attributes[..1]
+    };
+    let targets = [Some(wgpu::ColorTargetState {
+        format: COLOR_FORMAT,
+        blend: None,
+        write_mask: wgpu::ColorWrites::ALL,
+    })];
+    r.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("scene"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: VERTEX_STRIDE,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: key.cull_back.then_some(wgpu::Face::Back),
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DepthKind::DepthBuffer.format(),
+                depth_write_enabled: Some(key.depth_test),
+                depth_compare: Some(if key.depth_test {
+                    wgpu::CompareFunction::Less
+                } else {
+                    wgpu::CompareFunction::Always
+                }),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: key.shaded.then(|| wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+}
