@@ -9,10 +9,12 @@ pub mod bench;
 pub mod compare;
 pub mod effects;
 pub mod error;
+pub mod exercise;
 pub mod figures;
 pub mod framebuffer;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+pub mod grade;
 pub mod info;
 pub mod math;
 pub mod output;

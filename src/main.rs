@@ -1,7 +1,8 @@
 //! The `stereolab` command line.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
@@ -9,7 +10,7 @@ use stereolab::compare::{self, Comparison, Thresholds};
 use stereolab::plan::Plan;
 use stereolab::render::Frame;
 use stereolab::scene::Scene;
-use stereolab::{Error, Result, bench, effects, info, output, render};
+use stereolab::{Error, Result, bench, effects, grade, info, output, render};
 
 /// Which path renders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -52,6 +53,16 @@ enum Command {
         /// Which path renders.
         #[arg(long, value_enum, default_value = "cpu")]
         backend: Backend,
+        /// Instead of the scene's outputs: the student's exercise (ex1, ex2, ex3) next to the
+        /// reference, as `reference | diff | yours` images.
+        #[arg(long, value_name = "EXERCISE")]
+        exercise: Option<String>,
+        /// With --exercise: the instructor's solution instead of the student's code.
+        #[arg(long, requires = "exercise")]
+        solution: bool,
+        /// With --exercise: the folder holding the exercise crates (default: ./exercises or .).
+        #[arg(long, requires = "exercise")]
+        exercises: Option<PathBuf>,
     },
     /// Compare the CPU and GPU renders of a scene (`compare SCENE`), or any two images
     /// (`compare EXPECTED.png ACTUAL.png`); exits non-zero past a threshold.
@@ -76,6 +87,31 @@ enum Command {
         /// Background color R,G,B (0..255) for two images; default: each image's top-left pixel.
         #[arg(long)]
         background: Option<String>,
+    },
+    /// Build and run the student's exercise crates; points table, verdict and hints.
+    Grade {
+        /// ex1, ex2, ex3 or all.
+        exercise: String,
+        /// Also write Gradescope's results.json here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Grade the instructor's solution (the crates' `solution` feature).
+        #[arg(long)]
+        solution: bool,
+        /// The folder holding the exercise crates (default: ./exercises, else .).
+        #[arg(long)]
+        exercises: Option<PathBuf>,
+        /// Time limit per task in seconds (an endless loop costs that task only).
+        #[arg(long, default_value_t = 10.0)]
+        timeout: f64,
+        /// Where failing image checks write `expected | diff | actual`.
+        #[arg(long, default_value = "grade-out")]
+        out: PathBuf,
+    },
+    /// Exercise material.
+    Exercises {
+        #[command(subcommand)]
+        command: ExercisesCommand,
     },
     /// Print the derived cameras and the scene's parallax range.
     Info {
@@ -108,6 +144,31 @@ enum Command {
     /// Autostereograms (SIRDS): from a scene, from a depth map (--depth), animated (--frames),
     /// or decoded back to depth (--decode).
     Sirds(stereolab::effects::sirds::cli::SirdsArgs),
+}
+
+#[derive(Subcommand)]
+enum ExercisesCommand {
+    /// Write the student handout (stubs, tests, assets, the library with the grader; no
+    /// solutions) to DIR.
+    Export {
+        /// Output folder.
+        dir: PathBuf,
+        /// The stereolab repository (default: . when it has exercises/, else the build's source).
+        #[arg(long)]
+        root: Option<PathBuf>,
+    },
+}
+
+fn parse_timeout(seconds: f64) -> Result<Duration> {
+    if seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0 {
+        Ok(Duration::from_secs_f64(seconds))
+    } else {
+        Err(Error::invalid(
+            "--timeout",
+            seconds,
+            "must be between 0 and 3600 seconds",
+        ))
+    }
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32)> {
@@ -183,8 +244,26 @@ fn run(cli: Cli) -> Result<()> {
             sets,
             explain,
             backend,
+            exercise,
+            solution,
+            exercises,
         } => {
             let s = load_scene(&scene, &sets, size.as_deref())?;
+            if let Some(name) = exercise {
+                let [ex] = grade::Exercise::parse_list(&name)?[..] else {
+                    return Err(Error::invalid(
+                        "--exercise",
+                        name,
+                        "name one exercise: ex1, ex2 or ex3",
+                    ));
+                };
+                let dir = grade::exercises_dir(exercises)?;
+                let timeout = Duration::from_secs(30);
+                for line in grade::render_exercise(ex, s, &dir, solution, timeout, &out)? {
+                    println!("{line}");
+                }
+                return Ok(());
+            }
             let plan = Plan::new(&s.outputs);
             if explain {
                 print!("{}", plan.explain());
@@ -269,6 +348,44 @@ fn run(cli: Cli) -> Result<()> {
                     failed.join("; "),
                 ))
             }
+        }
+        Command::Grade {
+            exercise,
+            json,
+            solution,
+            exercises,
+            timeout,
+            out,
+        } => {
+            let opts = grade::GradeOptions {
+                exercises: grade::Exercise::parse_list(&exercise)?,
+                dir: grade::exercises_dir(exercises)?,
+                solution,
+                timeout: parse_timeout(timeout)?,
+                out,
+            };
+            let report = grade::grade(&opts, grade::fixture::grading_scene()?)?;
+            print!("{}", report.text());
+            if let Some(path) = json {
+                let text = serde_json::to_string_pretty(&report.gradescope())
+                    .map_err(|e| Error::io(&path, std::io::Error::other(e)))?;
+                std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+            }
+            Ok(())
+        }
+        Command::Exercises {
+            command: ExercisesCommand::Export { dir, root },
+        } => {
+            let root = root.unwrap_or_else(|| {
+                if Path::new("exercises/ex1_stereo").is_dir() {
+                    PathBuf::from(".")
+                } else {
+                    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                }
+            });
+            grade::export::export(&root, &dir)?;
+            println!("wrote the student handout to {}", dir.display());
+            Ok(())
         }
         Command::Info { scene, sets } => {
             let s = Scene::load(&scene, &sets)?;

@@ -11,6 +11,7 @@ mod golden;
 mod gpu_finalize;
 #[cfg(feature = "gpu")]
 mod gpu_parity;
+mod grading;
 mod layout;
 mod rig;
 mod sirds;

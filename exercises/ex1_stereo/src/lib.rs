@@ -1,0 +1,18 @@
+//! Exercise 1: Stereoscopy (seed 004, "Exercise 1 — Stereoscopy").
+//!
+//! Complete the functions in `src/stubs.rs`, then run `stereolab grade ex1` (points, hints)
+//! and `stereolab render --exercise ex1 SCENE` (your images next to the reference).
+//!
+//! Conventions (the same as stereolab's, see its README): right-handed eye space, the camera
+//! looks down −Z, Y up; OpenGL projection matrices with NDC Z in [−1, 1]; window depth and
+//! texture coordinates in [0, 1] with v = 0 at the bottom row; `glam` matrices are
+//! column-major and multiply column vectors (`P * MV * v`); eye index 0 is the left eye,
+//! 1 the right eye.
+#![warn(missing_docs)]
+
+// solution-begin
+#[cfg_attr(feature = "solution", path = "solution.rs")]
+// solution-end
+mod stubs;
+
+pub use stubs::*;

@@ -1,0 +1,189 @@
+//! The instructor's solution (feature `solution`). Never part of the student handout.
+//!
+//! `STEREOLAB_MUTANT=name[,name]` plants a known mistake for the grader's mutation tests
+//! (tests/grading.rs): `swapped-eyes`, `toe-in`, `full-separation`, `transposed-anaglyph`,
+//! `opengl-depth`, `hang-parallax`, `nan-parallax`.
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use stereolab::exercise::{AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, StereoSetup};
+use stereolab::math::{Lighting, look_at};
+
+fn planted(mistake: &str) -> bool {
+    std::env::var("STEREOLAB_MUTANT").is_ok_and(|v| v.split(',').any(|m| m == mistake))
+}
+
+/// `P_frustum(l, r, b, t, n, f)` (seed 004).
+pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
+    Mat4::from_cols(
+        Vec4::new(2.0 * n / (r - l), 0.0, 0.0, 0.0),
+        Vec4::new(0.0, 2.0 * n / (t - b), 0.0, 0.0),
+        Vec4::new(
+            (r + l) / (r - l),
+            (t + b) / (t - b),
+            (n + f) / (n - f),
+            -1.0,
+        ),
+        Vec4::new(0.0, 0.0, 2.0 * n * f / (n - f), 0.0),
+    )
+}
+
+/// −1 for the left eye (index 0), +1 for the right eye.
+fn side(eye: usize) -> f32 {
+    let eye = if planted("swapped-eyes") {
+        1 - eye
+    } else {
+        eye
+    };
+    if eye == 0 { -1.0 } else { 1.0 }
+}
+
+/// Half the eye separation (the whole of it with the `full-separation` mistake).
+fn half_separation(s: &StereoSetup) -> f32 {
+    if planted("full-separation") {
+        s.eye_separation
+    } else {
+        0.5 * s.eye_separation
+    }
+}
+
+/// `[l, r, b, t, n, f]` of `P_frustum±` (seed 004).
+pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
+    let t = setup.near * (setup.fov_y_degrees.to_radians() * 0.5).tan();
+    let w = t * setup.aspect;
+    let shift = if planted("toe-in") {
+        0.0
+    } else {
+        -side(eye) * half_separation(setup) * setup.near / setup.zero_parallax
+    };
+    [-w + shift, w + shift, -t, t, setup.near, setup.far]
+}
+
+/// View and projection of one eye (seed 004, per-eye or cyclopic lighting).
+pub fn stereo_matrices(
+    setup: &StereoSetup,
+    modelview: Mat4,
+    eye: usize,
+    lighting: Lighting,
+) -> EyeView {
+    let [l, r, b, t, n, f] = stereo_frustum(setup, eye);
+    let p = frustum(l, r, b, t, n, f);
+    let half = half_separation(setup);
+    let eye_view = if planted("toe-in") {
+        // Seed 001's rotated eyes: each looks at the fusion point on the center line.
+        let inv = modelview.inverse();
+        let at = inv.transform_point3(Vec3::new(side(eye) * half, 0.0, 0.0));
+        let fusion = inv.transform_point3(Vec3::new(0.0, 0.0, -setup.zero_parallax));
+        look_at(at, fusion, inv.transform_vector3(Vec3::Y))
+    } else {
+        Mat4::from_translation(Vec3::new(-side(eye) * half, 0.0, 0.0)) * modelview
+    };
+    match lighting {
+        Lighting::PerEye => EyeView {
+            view: eye_view,
+            projection: p,
+        },
+        Lighting::Cyclopic => EyeView {
+            view: modelview,
+            projection: p * eye_view * modelview.inverse(),
+        },
+    }
+}
+
+const LUMA: [f32; 3] = [0.299, 0.587, 0.114];
+const ZERO: [f32; 3] = [0.0; 3];
+
+fn transposed(m: ColorMatrix) -> ColorMatrix {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[j][i]))
+}
+
+/// ML, MR of seed 004's four anaglyphs.
+pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
+    let left = match kind {
+        AnaglyphKind::Color => [[1.0, 0.0, 0.0], ZERO, ZERO],
+        _ => [LUMA, ZERO, ZERO],
+    };
+    let right = match kind {
+        AnaglyphKind::True => [ZERO, ZERO, LUMA],
+        AnaglyphKind::Gray => [ZERO, LUMA, LUMA],
+        AnaglyphKind::Color | AnaglyphKind::HalfColor => [ZERO, [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    };
+    if planted("transposed-anaglyph") {
+        AnaglyphMatrices {
+            left: transposed(left),
+            right: transposed(right),
+        }
+    } else {
+        AnaglyphMatrices { left, right }
+    }
+}
+
+/// Dubois red-cyan (three.js' CRT-derived numbers).
+pub fn dubois_matrices() -> AnaglyphMatrices {
+    AnaglyphMatrices {
+        left: [
+            [0.456100, 0.500484, 0.176381],
+            [-0.0400822, -0.0378246, -0.0157589],
+            [-0.0152161, -0.0205971, -0.00546856],
+        ],
+        right: [
+            [-0.0434706, -0.0879388, -0.00155529],
+            [0.378476, 0.73364, -0.0184503],
+            [-0.0721527, -0.112961, 1.2264],
+        ],
+    }
+}
+
+/// Seed 004's remapping through `MVP_r · MVP_l⁻¹`.
+pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) -> Option<Vec3> {
+    let z_ndc = if planted("opengl-depth") {
+        depth_left
+    } else {
+        2.0 * depth_left - 1.0
+    };
+    let ndc_left = (2.0 * uv_left - Vec2::ONE).extend(z_ndc).extend(1.0);
+    let clip = mvp_right * mvp_left.inverse() * ndc_left;
+    if clip.w <= 0.0 {
+        return None;
+    }
+    let ndc = clip.truncate() / clip.w;
+    let depth = if planted("opengl-depth") {
+        ndc.z
+    } else {
+        0.5 * (ndc.z + 1.0)
+    };
+    Some(Vec3::new(0.5 * (ndc.x + 1.0), 0.5 * (ndc.y + 1.0), depth))
+}
+
+/// Seed 004's visibility check.
+pub fn visible(
+    uv_right: Option<Vec2>,
+    remapped_depth: f32,
+    stored_depth: f32,
+    tolerance: f32,
+) -> bool {
+    let Some(uv) = uv_right else { return false };
+    let inside = (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y);
+    inside && (stored_depth - remapped_depth).abs() <= tolerance
+}
+
+/// `p(z) = d (1 − z0/z)` (seed 004).
+pub fn parallax(z: f32, zero_parallax: f32, eye_separation: f32) -> f32 {
+    if planted("hang-parallax") {
+        #[allow(clippy::empty_loop)]
+        loop {}
+    }
+    if planted("nan-parallax") {
+        return f32::NAN;
+    }
+    eye_separation * (1.0 - zero_parallax / z)
+}
+
+/// Red for positive, blue for negative parallax.
+pub fn parallax_color(p: f32, max_abs: f32) -> [f32; 3] {
+    let t = (p / max_abs).clamp(-1.0, 1.0);
+    if t >= 0.0 {
+        [t, 0.0, 0.0]
+    } else {
+        [0.0, 0.0, -t]
+    }
+}

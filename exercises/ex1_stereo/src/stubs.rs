@@ -1,0 +1,135 @@
+//! Your code: complete every `todo!`. Each doc comment states the task, where its formula comes
+//! from, and the conventions; `stereolab grade ex1` scores each function on its own.
+
+use glam::{Mat4, Vec2, Vec3};
+use stereolab::exercise::{AnaglyphKind, AnaglyphMatrices, EyeView, StereoSetup};
+use stereolab::math::Lighting;
+
+/// Task `frustum` (2 points): the projection matrix `P_frustum(l, r, b, t, n, f)`.
+///
+/// Source: seed 004, "Projection Matrix – View Frustum" (OpenGL's `glFrustum`):
+/// ```text
+/// | 2n/(r-l)    0      (r+l)/(r-l)      0        |
+/// |    0     2n/(t-b)  (t+b)/(t-b)      0        |
+/// |    0        0      (n+f)/(n-f)  2nf/(n-f)    |
+/// |    0        0         -1            0        |
+/// ```
+/// `l, r, b, t` lie on the near plane; `n, f` are positive distances along −Z. Right-handed eye
+/// space, NDC Z in [−1, 1]. `glam::Mat4` is column-major: `Mat4::from_cols(c0, c1, c2, c3)`
+/// takes columns, so the matrix above is not typed row by row.
+pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
+    // TODO: build P_frustum column by column.
+    todo!("P_frustum(l={l:?}, r={r:?}, b={b:?}, t={t:?}, n={n:?}, f={f:?})")
+}
+
+/// Task `stereo_frustum` (2 points): the arguments `[l, r, b, t, n, f]` of eye `eye`'s
+/// `P_frustum±` in the off-axis (parallel-axis, asymmetric frustum) stereo rig.
+///
+/// Source: seed 004, "Projection Matrix Stereo Case": the mono frustum has
+/// `t = n · tan(fov_y / 2)`, `b = −t`, `r = t · aspect`, `l = −r`; each eye's frustum is
+/// translated by ∓d/2 and sheared by ±d/(2 z0), so on the near plane `l` and `r` move by
+/// `± (d/2) · n / z0` (intercept theorem): the left eye (index 0, at x = −d/2) moves them by
+/// `+(d/2)·n/z0`, the right eye (index 1, at x = +d/2) by `−(d/2)·n/z0`. `t, b, n, f` do not
+/// change. Toe-in (rotating the eyes) is wrong: it gives vertical parallax (seed 003).
+pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
+    // TODO: the mono frustum, then shift l and r for this eye.
+    todo!("frustum bounds of eye {eye:?} for {setup:?}")
+}
+
+/// Task `stereo_matrices` (2 points, image check): eye `eye`'s view and projection, given the
+/// camera's (cyclopean) modelview `modelview`.
+///
+/// Source: seed 004, "Transformation Matrices – Effect on lighting". `T±` moves the world so
+/// that the eye at x = ∓d/2 (eye space) becomes the origin: `T_left = translate(+d/2, 0, 0)`,
+/// `T_right = translate(−d/2, 0, 0)`. With `P±` = [`frustum`] of [`stereo_frustum`]:
+/// - per-eye lighting: `view = T± · MV`, `projection = P±`;
+/// - cyclopic lighting: `view = MV`, `projection = P± · T±`.
+///
+/// Both give the same MVP; they differ in where the shading sees the eye.
+pub fn stereo_matrices(
+    setup: &StereoSetup,
+    modelview: Mat4,
+    eye: usize,
+    lighting: Lighting,
+) -> EyeView {
+    // TODO: T± from the eye index, then combine as the lighting variant asks.
+    todo!("view and projection of eye {eye:?}, {lighting:?}, {setup:?}, MV = {modelview:?}")
+}
+
+/// Task `anaglyph_matrices` (2 points, image check): the matrices `ML`, `MR` of
+/// `out = clamp(ML · left + MR · right)` for `kind`.
+///
+/// Source: seed 004, "Anaglyph" (after 3dtv.at): true, gray, color and half-color anaglyphs for
+/// red (left eye, index 0) / cyan (right eye) glasses. Luminance weights `0.299, 0.587, 0.114`.
+/// `ColorMatrix` is written as on the slides: `m[row][column]`, rows are output R, G, B.
+pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
+    // TODO: one match arm per kind.
+    todo!("ML and MR of the {kind:?} anaglyph")
+}
+
+/// Bonus task `dubois_matrices` (1 bonus point): Dubois' least-squares red-cyan matrices.
+///
+/// Source: Eric Dubois (2001), the CRT-derived numbers as in three.js' `AnaglyphEffect.js`
+/// (listed in `data/anaglyph-matrices.md` of the course material): six significant digits.
+/// Same layout as [`anaglyph_matrices`].
+pub fn dubois_matrices() -> AnaglyphMatrices {
+    // TODO: copy the numbers carefully (public copies contain typos).
+    todo!("Dubois red-cyan ML and MR")
+}
+
+/// Task `remap` (2 points, image check): where the surface point seen by the left eye at
+/// texture coordinate `uv_left` with stored depth `depth_left` appears in the right image.
+///
+/// Source: seed 004, "Stereo Rendering – Remapping":
+/// `clip_r = MVP_r · MVP_l⁻¹ · (x_ndc,l, y_ndc,l, z_ndc,l, 1)`, `ndc_r = clip_r.xyz / clip_r.w`,
+/// `τ = ((x_ndc,r + 1)/2, (y_ndc,r + 1)/2)`.
+/// Conventions: `uv_left` and the returned `u, v` are texture coordinates in [0, 1]
+/// (v = 0 bottom); `depth_left` is a depth-texture value in [0, 1] (window depth), while NDC
+/// z lies in [−1, 1]. Returns `Some((u, v, depth_right))` with `depth_right` the point's window
+/// depth in [0, 1] as the right eye would store it, or `None` when `clip_r.w ≤ 0` (behind the
+/// right eye).
+pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) -> Option<Vec3> {
+    // TODO: texture coordinates and depth to NDC, through MVP_r · MVP_l⁻¹, w-divide, back.
+    todo!("remap uv {uv_left:?} depth {depth_left:?} with MVP_l {mvp_left:?}, MVP_r {mvp_right:?}")
+}
+
+/// Task `visible` (1 point, image check): is the left eye's surface point also visible to the
+/// right eye?
+///
+/// Source: seed 004, "Visibility Check": look up the right eye's depth texture at the remapped
+/// coordinate (`stored_depth`) and compare with the point's own remapped depth
+/// (`remapped_depth`, from [`remap`]): visible when they agree within `tolerance`
+/// (`|stored − remapped| ≤ tolerance`). Otherwise only `stored < remapped` is possible: the
+/// right eye sees something nearer, the point is occluded. A point that remaps outside the
+/// image (`u` or `v` outside [0, 1], or `uv_right == None`) is not visible either.
+pub fn visible(
+    uv_right: Option<Vec2>,
+    remapped_depth: f32,
+    stored_depth: f32,
+    tolerance: f32,
+) -> bool {
+    // TODO: out of the image → false; then compare the depths.
+    todo!(
+        "visible? uv {uv_right:?}, remapped {remapped_depth:?}, stored {stored_depth:?}, tolerance {tolerance:?}"
+    )
+}
+
+/// Task `parallax` (1 point): the screen parallax of a point at eye distance `z`.
+///
+/// Source: seed 004, "Parallax and Eye Separation": `p(z) = d · (1 − z0 / z)` with `z` and
+/// `z0` positive distances in front of the eyes and `d` the eye separation. Negative in front
+/// of the screen (`z < z0`), zero on it, positive behind it, approaching `d` at infinity.
+pub fn parallax(z: f32, zero_parallax: f32, eye_separation: f32) -> f32 {
+    // TODO: one line.
+    todo!("p(z = {z:?}) with z0 = {zero_parallax:?}, d = {eye_separation:?}")
+}
+
+/// Task `parallax_color` (1 point, image check): parallax shown as color (seed 004: "blue
+/// negative, red positive").
+///
+/// The mapping: `t = clamp(p / max_abs, −1, 1)`; positive `t` gives `[t, 0, 0]` (red), negative
+/// `t` gives `[0, 0, −t]` (blue), zero gives black. Components in [0, 1].
+pub fn parallax_color(p: f32, max_abs: f32) -> [f32; 3] {
+    // TODO: scale, clamp, pick the channel by the sign.
+    todo!("color of parallax {p:?} scaled by {max_abs:?}")
+}

@@ -1,0 +1,108 @@
+//! The values stubs take and return, shared with the grader so both sides read the same JSON.
+
+use glam::Mat4;
+use serde::{Deserialize, Serialize};
+
+use super::protocol::Answer;
+use crate::effects::anaglyph;
+pub use crate::effects::anaglyph::{AnaglyphMatrices, ColorMatrix};
+
+/// A mono camera's symmetric frustum plus the stereo rig (seed 004's parameters).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StereoSetup {
+    /// Vertical field of view in degrees.
+    pub fov_y_degrees: f32,
+    /// Image width / height.
+    pub aspect: f32,
+    /// Near plane distance n (> 0).
+    pub near: f32,
+    /// Far plane distance f (> n).
+    pub far: f32,
+    /// Eye separation d: the eyes sit at x = −d/2 (left, index 0) and x = +d/2 (right, index 1).
+    pub eye_separation: f32,
+    /// Zero-parallax (screen) distance z0, between near and far.
+    pub zero_parallax: f32,
+}
+
+/// The two matrices one eye renders with: `projection · view` is its MVP.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EyeView {
+    /// The modelview the shading happens in.
+    pub view: Mat4,
+    /// The projection completing it.
+    pub projection: Mat4,
+}
+
+/// Flattens as `view` then `projection`, each column-major.
+impl Answer for EyeView {
+    fn flatten(&self, out: &mut Vec<f64>) {
+        self.view.flatten(out);
+        self.projection.flatten(out);
+    }
+}
+
+/// The four anaglyph kinds of seed 004 (after 3dtv.at's comparison).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AnaglyphKind {
+    /// True anaglyph: left luminance to red, right luminance to blue.
+    True,
+    /// Gray anaglyph: left luminance to red, right luminance to green and blue.
+    Gray,
+    /// Color anaglyph: left red, right green and blue.
+    Color,
+    /// Half-color anaglyph: left luminance to red, right green and blue.
+    HalfColor,
+}
+
+impl AnaglyphKind {
+    /// All four, in seed 004's order.
+    pub const ALL: [AnaglyphKind; 4] = [
+        AnaglyphKind::True,
+        AnaglyphKind::Gray,
+        AnaglyphKind::Color,
+        AnaglyphKind::HalfColor,
+    ];
+
+    /// The same kind in stereolab's anaglyph module (the reference).
+    pub fn reference(self) -> anaglyph::AnaglyphKind {
+        match self {
+            AnaglyphKind::True => anaglyph::AnaglyphKind::True,
+            AnaglyphKind::Gray => anaglyph::AnaglyphKind::Gray,
+            AnaglyphKind::Color => anaglyph::AnaglyphKind::Color,
+            AnaglyphKind::HalfColor => anaglyph::AnaglyphKind::HalfColor,
+        }
+    }
+}
+
+/// Flattens as `left` then `right`, each row by row (`m[row][column]`, rows are the output
+/// R, G, B, as on the slides).
+impl Answer for AnaglyphMatrices {
+    fn flatten(&self, out: &mut Vec<f64>) {
+        self.left.flatten(out);
+        self.right.flatten(out);
+    }
+}
+
+/// Seed 002's viewing geometry for a scan line, in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SirdsGeometry {
+    /// Distance a between the eyes.
+    pub eye_distance: f32,
+    /// Distance f from the eyes to the image plane.
+    pub focal_length: f32,
+}
+
+/// What one SIRDS scan line needs: seed 002's eye geometry and the depth range the nearness
+/// values span, all in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SirdsSetup {
+    /// Distance a between the eyes.
+    pub eye_distance: f32,
+    /// Distance f from the eyes to the image plane.
+    pub focal_length: f32,
+    /// Depth behind the image plane of nearness 1 (the front of the range).
+    pub depth_near: f32,
+    /// Depth behind the image plane of nearness 0 (the background plane).
+    pub depth_far: f32,
+}

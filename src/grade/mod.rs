@@ -1,0 +1,245 @@
+//! The auto-grader: builds a student's exercise crate, runs each task in a subprocess, scores it
+//! with partial credit against the reference, and reports (points table, the course's passing
+//! verdict, hints naming the likely mistake, Gradescope JSON).
+//!
+//! Protocol: see [`crate::exercise::protocol`]. A task's inputs go to `<crate binary> <task>`
+//! in one subprocess; a panic costs that input, an endless loop the task (the child is killed
+//! after the time limit), NaN the inputs it spoils. The grader itself never panics on an answer.
+
+pub mod child;
+pub mod ex1;
+pub mod ex2;
+pub mod ex3;
+pub mod export;
+pub mod fixture;
+pub mod report;
+pub mod score;
+pub mod spec;
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use serde_json::Value;
+
+use crate::compare::{compare, write_diff_strip};
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+use fixture::Fixture;
+use report::{ExerciseResult, Report};
+use score::TaskResult;
+use spec::TaskSpec;
+
+/// The exercises of the course.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exercise {
+    /// Stereo frusta, anaglyphs, remapping, parallax (seed 004).
+    Ex1,
+    /// ChromaDepth (seed 000).
+    Ex2,
+    /// SIRDS (seed 002).
+    Ex3,
+}
+
+impl Exercise {
+    /// All, in course order.
+    pub const ALL: [Exercise; 3] = [Exercise::Ex1, Exercise::Ex2, Exercise::Ex3];
+
+    /// `ex1`, `ex2`, `ex3`.
+    pub fn id(self) -> &'static str {
+        match self {
+            Exercise::Ex1 => "ex1",
+            Exercise::Ex2 => "ex2",
+            Exercise::Ex3 => "ex3",
+        }
+    }
+
+    /// The crate (and its binary) under `exercises/`.
+    pub fn crate_name(self) -> &'static str {
+        match self {
+            Exercise::Ex1 => "ex1_stereo",
+            Exercise::Ex2 => "ex2_chromadepth",
+            Exercise::Ex3 => "ex3_sirds",
+        }
+    }
+
+    /// `ex1`, `ex2`, `ex3` or `all`.
+    ///
+    /// # Errors
+    /// Any other name.
+    pub fn parse_list(name: &str) -> Result<Vec<Exercise>> {
+        if name == "all" {
+            return Ok(Exercise::ALL.to_vec());
+        }
+        Exercise::ALL
+            .into_iter()
+            .find(|e| e.id() == name)
+            .map(|e| vec![e])
+            .ok_or_else(|| Error::invalid("exercise", name, "expected ex1, ex2, ex3 or all"))
+    }
+
+    /// The tasks, with reference answers computed for `fx`.
+    pub fn tasks(self, fx: &Fixture) -> Vec<TaskSpec> {
+        match self {
+            Exercise::Ex1 => ex1::tasks(fx),
+            Exercise::Ex2 => ex2::tasks(fx),
+            Exercise::Ex3 => ex3::tasks(fx),
+        }
+    }
+}
+
+/// How to grade.
+#[derive(Clone, Debug)]
+pub struct GradeOptions {
+    /// Which exercises.
+    pub exercises: Vec<Exercise>,
+    /// The folder holding the exercise crates (`exercises/` of the repository or the handout).
+    pub dir: PathBuf,
+    /// Build with the `solution` feature (the instructor's solution).
+    pub solution: bool,
+    /// Time limit of one task's subprocess.
+    pub timeout: Duration,
+    /// Where diff images of failing image checks go.
+    pub out: PathBuf,
+}
+
+/// The exercises folder: `given`, else `./exercises`, else `.` when it holds `ex1_stereo`.
+///
+/// # Errors
+/// No such folder.
+pub fn exercises_dir(given: Option<PathBuf>) -> Result<PathBuf> {
+    let candidates = match given {
+        Some(g) => vec![g],
+        None => vec![PathBuf::from("exercises"), PathBuf::from(".")],
+    };
+    candidates
+        .iter()
+        .find(|d| {
+            d.join(Exercise::Ex1.crate_name())
+                .join("Cargo.toml")
+                .is_file()
+        })
+        .cloned()
+        .ok_or_else(|| {
+            Error::invalid(
+                "--exercises",
+                candidates[0].display(),
+                "no exercise crates there (expected ex1_stereo/Cargo.toml)",
+            )
+        })
+}
+
+fn inputs_of(spec: &TaskSpec) -> Vec<Value> {
+    let mut v: Vec<Value> = spec.cases.iter().map(|c| c.input.clone()).collect();
+    if let Some(img) = &spec.image {
+        v.extend(img.inputs.iter().cloned());
+    }
+    v
+}
+
+/// Grades `opts.exercises` on `scene` (the image checks' scene; normally
+/// [`fixture::grading_scene`]).
+///
+/// # Errors
+/// Only setup problems (an exercise crate missing, the scene invalid): a student's compile
+/// error, panic, endless loop or NaN is a result in the report.
+pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
+    let fx = Fixture::new(scene)?;
+    let mut exercises = Vec::new();
+    for &ex in &opts.exercises {
+        let crate_dir = crate_dir(&opts.dir, ex)?;
+        let specs = ex.tasks(&fx);
+        let result = match child::build(&crate_dir, ex.crate_name(), opts.solution) {
+            Err(log) => ExerciseResult {
+                exercise: ex,
+                build_error: Some(log),
+                tasks: specs
+                    .iter()
+                    .map(|s| TaskResult::not_built(ex.id(), s))
+                    .collect(),
+            },
+            Ok(binary) => ExerciseResult {
+                exercise: ex,
+                build_error: None,
+                tasks: specs
+                    .iter()
+                    .map(|s| {
+                        let run = child::run(&binary, s.name, &inputs_of(s), opts.timeout);
+                        score::evaluate(ex.id(), s, &run, &opts.out)
+                    })
+                    .collect(),
+            },
+        };
+        exercises.push(result);
+    }
+    Ok(Report { exercises })
+}
+
+fn crate_dir(dir: &Path, ex: Exercise) -> Result<PathBuf> {
+    let d = dir.join(ex.crate_name());
+    if d.join("Cargo.toml").is_file() {
+        Ok(d)
+    } else {
+        Err(Error::invalid(
+            "--exercises",
+            dir.display(),
+            format!("no {}/Cargo.toml there", ex.crate_name()),
+        ))
+    }
+}
+
+/// `stereolab render --exercise`: runs the image checks of `ex` on `scene` and writes, for every
+/// picture, `expected | diff | actual` (the reference next to the student's result) to `out`.
+/// Returns one line per picture (metrics and path).
+///
+/// # Errors
+/// A missing crate, a compile error (with the compiler's messages), an unwritable folder.
+pub fn render_exercise(
+    ex: Exercise,
+    scene: Scene,
+    dir: &Path,
+    solution: bool,
+    timeout: Duration,
+    out: &Path,
+) -> Result<Vec<String>> {
+    let fx = Fixture::new(scene)?;
+    let crate_dir = crate_dir(dir, ex)?;
+    let binary = child::build(&crate_dir, ex.crate_name(), solution)
+        .map_err(|log| Error::invalid(ex.crate_name(), "does not compile", log))?;
+    let mut lines = Vec::new();
+    for spec in ex.tasks(&fx) {
+        let Some(img) = &spec.image else { continue };
+        let run = child::run(&binary, spec.name, &img.inputs, timeout);
+        let answers: Vec<Option<Vec<f64>>> = (0..img.inputs.len())
+            .map(|k| run.replies.get(k).and_then(|r| r.as_ref().ok().cloned()))
+            .collect();
+        for p in (img.build)(&answers) {
+            let m = compare(&p.expected, &p.actual)?;
+            let path = write_diff_strip(&p.expected, &p.actual, out, &p.name)?;
+            lines.push(format!(
+                "{:<34} coverage mismatch {:>6.2}%, mean channel difference {:>6.2}: {} (reference | diff | yours)",
+                p.name,
+                m.coverage_mismatch_percent(),
+                m.mean_channel_diff,
+                path.display()
+            ));
+        }
+        if run.timed_out {
+            lines.push(format!("{}: timed out after {timeout:?}", spec.name));
+        }
+        let panics: Vec<&String> = run
+            .replies
+            .iter()
+            .filter_map(|r| r.as_ref().err())
+            .collect();
+        if let Some(first) = panics.first() {
+            lines.push(format!(
+                "{}: {} of {} inputs panicked, e.g. {}",
+                spec.name,
+                panics.len(),
+                img.inputs.len(),
+                first.chars().take(120).collect::<String>()
+            ));
+        }
+    }
+    Ok(lines)
+}

@@ -1,0 +1,140 @@
+//! What a task is to the grader: inputs, expected answers, tolerance, known mistakes, images.
+
+use serde_json::Value;
+
+use crate::framebuffer::Framebuffer;
+
+/// A numeric tolerance: an answer element `a` matches `e` when `|a − e| ≤ abs + rel · |e|`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    /// Absolute part.
+    pub abs: f64,
+    /// Relative part.
+    pub rel: f64,
+    /// Where the numbers come from (printed with every failure).
+    pub why: &'static str,
+}
+
+impl Tolerance {
+    /// Exact equality (integers, booleans, indices).
+    pub const EXACT: Tolerance = Tolerance {
+        abs: 0.0,
+        rel: 0.0,
+        why: "exact: integers and booleans",
+    };
+
+    /// Whether `actual` matches `expected` element by element (same length, all finite where
+    /// expected is finite).
+    pub fn accepts(&self, expected: &[f64], actual: &[f64]) -> bool {
+        expected.len() == actual.len()
+            && expected
+                .iter()
+                .zip(actual)
+                .all(|(e, a)| (a - e).abs() <= self.abs + self.rel * e.abs())
+    }
+
+    /// Human-readable: `1e-4·|expected| + 1e-6`.
+    pub fn describe(&self) -> String {
+        match (self.abs, self.rel) {
+            (0.0, 0.0) => "exact".to_string(),
+            (a, 0.0) => format!("{a:e}"),
+            (0.0, r) => format!("{r:e}·|expected|"),
+            (a, r) => format!("{r:e}·|expected| + {a:e}"),
+        }
+    }
+}
+
+/// One numeric check: an input and the reference's answer to it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Case {
+    /// Names the input for the student (`eye 0, per-eye lighting`).
+    pub label: String,
+    /// The input as the exercise binary reads it.
+    pub input: Value,
+    /// The reference's answer, flattened (empty: `None`).
+    pub expected: Vec<f64>,
+}
+
+/// A known wrong formula: what it answers for each case. When a student's failing answers all
+/// match it, the grader names it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mistake {
+    /// Short stable name, printed in brackets (`[swapped-eyes]`).
+    pub id: &'static str,
+    /// What to check, in words a student can act on.
+    pub hint: &'static str,
+    /// The mistaken answer per case (same order as the task's cases).
+    pub answers: Vec<Vec<f64>>,
+}
+
+/// One image compared: the reference's and the one built from the student's answers.
+#[derive(Clone, Debug)]
+pub struct Picture {
+    /// File-name-friendly name (`stereo_matrices_left_per_eye`).
+    pub name: String,
+    /// Reference.
+    pub expected: Framebuffer,
+    /// From the student's answers.
+    pub actual: Framebuffer,
+}
+
+/// Builds the student's pictures from the answers to [`ImageCheck::inputs`] (`None` where the
+/// student's code panicked or gave no answer).
+pub type PictureBuilder = Box<dyn Fn(&[Option<Vec<f64>>]) -> Vec<Picture>>;
+
+/// An image check: the student's functions plugged into the real pipeline vs the reference.
+pub struct ImageCheck {
+    /// Inputs whose answers the pictures are built from.
+    pub inputs: Vec<Value>,
+    /// The builder.
+    pub build: PictureBuilder,
+}
+
+/// Largest share of pixels whose coverage may differ, in percent. A matrix inside the numeric
+/// tolerance (1e-4 relative) moves an edge by well under 0.01 pixel at these sizes, which flips
+/// only pixels whose centers lie that close to an edge: a handful, far below 1%.
+pub const IMAGE_MAX_COVERAGE_PERCENT: f64 = 1.0;
+/// Largest mean RGB difference (0..255). Answers inside the numeric tolerances change an 8-bit
+/// channel by at most one step on a few pixels; a real mistake changes whole regions.
+pub const IMAGE_MAX_MEAN_DIFF: f64 = 1.0;
+
+/// A task: one stub, scored on its own.
+pub struct TaskSpec {
+    /// The stub's name and the task name in the protocol.
+    pub name: &'static str,
+    /// Points for a complete answer.
+    pub points: f64,
+    /// Bonus points count towards the score but not towards the total to reach.
+    pub bonus: bool,
+    /// For the numeric checks.
+    pub tolerance: Tolerance,
+    /// The numeric checks.
+    pub cases: Vec<Case>,
+    /// Known mistakes, most specific first.
+    pub mistakes: Vec<Mistake>,
+    /// Optional image check.
+    pub image: Option<ImageCheck>,
+}
+
+/// Share of a task's points the image check carries when the task has one.
+pub const IMAGE_SHARE: f64 = 0.3;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tolerance_is_absolute_plus_relative_and_refuses_nan_and_length_mismatch() {
+        let t = Tolerance {
+            abs: 1e-3,
+            rel: 1e-2,
+            why: "test",
+        };
+        assert!(t.accepts(&[100.0], &[100.9]));
+        assert!(!t.accepts(&[100.0], &[101.1]));
+        assert!(!t.accepts(&[1.0], &[f64::NAN]));
+        assert!(!t.accepts(&[1.0, 2.0], &[1.0]));
+        assert!(Tolerance::EXACT.accepts(&[3.0], &[3.0]));
+        assert_eq!(t.describe(), "1e-2·|expected| + 1e-3");
+    }
+}

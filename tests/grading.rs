@@ -1,0 +1,455 @@
+//! The grader end to end: the instructor's solution scores full marks, the untouched stubs score
+//! zero without crashing the grader, planted mistakes lose points on the right task with the
+//! right hint, and the exported handout builds and grades.
+//!
+//! Every test here runs `stereolab grade`, which builds the exercise crates with cargo in this
+//! workspace's target folder (dependencies are shared, only the small exercise crates compile).
+//! The builds overwrite the same `target/debug/ex*` executables, so the tests take turns.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::{Mutex, MutexGuard};
+
+use serde_json::Value;
+
+use crate::common::{out_dir, root};
+
+static BUILDS: Mutex<()> = Mutex::new(());
+
+fn take_turn() -> MutexGuard<'static, ()> {
+    BUILDS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Per-task time limit: ample for every task (they answer in milliseconds), short enough that
+/// the endless-loop mutant costs little.
+const TIMEOUT: &str = "4";
+
+/// Runs `stereolab grade WHAT --json …` on `exercises`, with `STEREOLAB_MUTANT` when given.
+fn grade(
+    what: &str,
+    extra: &[&str],
+    exercises: &Path,
+    mutant: Option<&str>,
+    name: &str,
+) -> (Output, Value) {
+    let dir = out_dir(&format!("grading_{name}"));
+    let json = dir.join("results.json");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_stereolab"));
+    cmd.args(["grade", what, "--timeout", TIMEOUT, "--json"])
+        .arg(&json)
+        .arg("--out")
+        .arg(dir.join("images"))
+        .arg("--exercises")
+        .arg(exercises)
+        .args(extra)
+        .env("CARGO_TARGET_DIR", target_dir())
+        .env_remove("STEREOLAB_MUTANT");
+    if let Some(m) = mutant {
+        cmd.env("STEREOLAB_MUTANT", m);
+    }
+    let out = cmd.output().expect("run stereolab grade");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "grade {what} {extra:?} (mutant {mutant:?}) must exit cleanly; stdout:\n{stdout}\nstderr:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&json).expect("results.json written");
+    (
+        out,
+        serde_json::from_str(&text).expect("results.json is JSON"),
+    )
+}
+
+/// The target folder this test binary was built in (`<target>/debug/stereolab`): nested builds
+/// use it too, so the compiled dependencies are shared whatever `CARGO_TARGET_DIR` CI sets.
+fn target_dir() -> PathBuf {
+    let exe = Path::new(env!("CARGO_BIN_EXE_stereolab"));
+    exe.parent()
+        .and_then(Path::parent)
+        .expect("the binary lies in <target>/<profile>/")
+        .to_path_buf()
+}
+
+fn repo_exercises() -> PathBuf {
+    root().join("exercises")
+}
+
+fn tests_of(v: &Value) -> &Vec<Value> {
+    v["tests"].as_array().expect("tests array")
+}
+
+fn test_named<'a>(v: &'a Value, name: &str) -> &'a Value {
+    tests_of(v)
+        .iter()
+        .find(|t| {
+            t["name"]
+                .as_str()
+                .is_some_and(|n| n.trim_end_matches(" (bonus)") == name)
+        })
+        .unwrap_or_else(|| panic!("no test {name} in {v}"))
+}
+
+#[test]
+fn solution_scores_full_marks_on_every_task() {
+    let _turn = take_turn();
+    let (out, v) = grade("all", &["--solution"], &repo_exercises(), None, "solution");
+    for t in tests_of(&v) {
+        assert_eq!(t["score"], t["max_score"], "{}: {}", t["name"], t["output"]);
+    }
+    // 13 + 5 + 5 points, plus ex1's Dubois bonus point.
+    assert_eq!(v["score"].as_f64(), Some(24.0), "{v}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("\nPASSED: 24.00 of 23.00 points"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn untouched_stubs_score_zero_and_the_grader_exits_cleanly_with_the_table() {
+    let _turn = take_turn();
+    let (out, v) = grade("all", &[], &repo_exercises(), None, "stubs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    for t in tests_of(&v) {
+        assert_eq!(
+            t["score"].as_f64(),
+            Some(0.0),
+            "{}: {}",
+            t["name"],
+            t["output"]
+        );
+        let output = t["output"].as_str().unwrap_or_default();
+        assert!(output.contains("hint [todo]"), "{}: {output}", t["name"]);
+    }
+    assert_eq!(v["score"].as_f64(), Some(0.0));
+    assert!(
+        stdout.contains("ex1  frustum"),
+        "the points table:\n{stdout}"
+    );
+    assert!(
+        stdout.contains("NOT PASSED: 0.00 of 23.00 points"),
+        "{stdout}"
+    );
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+}
+
+/// One planted mistake and the tasks it must cost, each with the hint it must get.
+struct Planted {
+    mutant: &'static str,
+    loses: &'static [(&'static str, &'static str)],
+}
+
+/// Plants the mistakes together (they touch disjoint tasks), grades once, and checks that each
+/// lost points on exactly its tasks with its hint while every other task kept full marks.
+fn check_planted(what: &str, planted: &[Planted], name: &str) {
+    let _turn = take_turn();
+    let mutants: Vec<&str> = planted.iter().map(|p| p.mutant).collect();
+    let (_, v) = grade(
+        what,
+        &["--solution"],
+        &repo_exercises(),
+        Some(&mutants.join(",")),
+        name,
+    );
+    for p in planted {
+        for (task, hint) in p.loses {
+            let t = test_named(&v, task);
+            let output = t["output"].as_str().unwrap_or_default();
+            assert!(
+                t["score"].as_f64() < t["max_score"].as_f64(),
+                "{}: {task} should lose points: {output}",
+                p.mutant
+            );
+            assert!(
+                output.contains(&format!("hint [{hint}]")),
+                "{}: {task} should get hint [{hint}]:\n{output}",
+                p.mutant
+            );
+        }
+    }
+    let targeted: Vec<&str> = planted
+        .iter()
+        .flat_map(|p| p.loses.iter().map(|l| l.0))
+        .collect();
+    for t in tests_of(&v) {
+        let name = t["name"]
+            .as_str()
+            .unwrap_or_default()
+            .trim_end_matches(" (bonus)");
+        if !targeted.contains(&name) {
+            assert_eq!(
+                t["score"], t["max_score"],
+                "{name} was not targeted: {}",
+                t["output"]
+            );
+        }
+    }
+}
+
+#[test]
+fn swapped_eyes_transposed_anaglyph_opengl_depth_nan_reversed_ramp_full_disparity_lose_points_with_their_hints()
+ {
+    check_planted(
+        "all",
+        &[
+            Planted {
+                mutant: "swapped-eyes",
+                loses: &[
+                    ("ex1 stereo_frustum", "swapped-eyes"),
+                    ("ex1 stereo_matrices", "swapped-eyes"),
+                ],
+            },
+            Planted {
+                mutant: "transposed-anaglyph",
+                loses: &[("ex1 anaglyph_matrices", "transposed")],
+            },
+            Planted {
+                mutant: "opengl-depth",
+                loses: &[("ex1 remap", "opengl-depth")],
+            },
+            Planted {
+                mutant: "nan-parallax",
+                loses: &[("ex1 parallax", "nan")],
+            },
+            Planted {
+                mutant: "reversed-ramp",
+                loses: &[("ex2 hsv_ramp", "ramp-reversed")],
+            },
+            Planted {
+                mutant: "full-disparity",
+                loses: &[("ex3 link_row", "d-instead-of-half-d")],
+            },
+        ],
+        "mutants_a",
+    );
+}
+
+#[test]
+fn toe_in_endless_loop_texgen_sign_and_missing_hidden_surfaces_lose_points_with_their_hints() {
+    check_planted(
+        "all",
+        &[
+            Planted {
+                mutant: "toe-in",
+                loses: &[
+                    ("ex1 stereo_frustum", "toe-in"),
+                    ("ex1 stereo_matrices", "toe-in"),
+                ],
+            },
+            Planted {
+                mutant: "hang-parallax",
+                loses: &[("ex1 parallax", "timeout")],
+            },
+            Planted {
+                mutant: "texgen-sign",
+                loses: &[("ex2 texgen", "texgen-sign")],
+            },
+            Planted {
+                mutant: "no-hidden-surfaces",
+                loses: &[("ex3 link_row", "no-hidden-surfaces")],
+            },
+        ],
+        "mutants_b",
+    );
+}
+
+#[test]
+fn d_instead_of_half_d_in_the_rig_loses_points_with_its_hint() {
+    check_planted(
+        "ex1",
+        &[Planted {
+            mutant: "full-separation",
+            loses: &[
+                ("ex1 stereo_frustum", "d-instead-of-half-d"),
+                ("ex1 stereo_matrices", "d-instead-of-half-d"),
+            ],
+        }],
+        "mutants_c",
+    );
+}
+
+fn files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut v = Vec::new();
+    for e in std::fs::read_dir(dir).expect("read folder").flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            v.extend(files_under(&p));
+        } else {
+            v.push(p);
+        }
+    }
+    v
+}
+
+#[test]
+fn exported_handout_has_no_solutions_builds_and_grades() {
+    let _turn = take_turn();
+    let handout = out_dir("handout");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(["exercises", "export"])
+        .arg(&handout)
+        .arg("--root")
+        .arg(root())
+        .output()
+        .expect("run export");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let files = files_under(&handout);
+    assert!(
+        !files.iter().any(|f| f.ends_with("solution.rs")),
+        "{files:?}"
+    );
+    for ex in ["ex1_stereo", "ex2_chromadepth", "ex3_sirds"] {
+        for f in ["src/stubs.rs", "src/main.rs", "tests/worked_examples.rs"] {
+            assert!(handout.join(ex).join(f).is_file(), "{ex}/{f} missing");
+        }
+        for f in ["Cargo.toml", "src/lib.rs"] {
+            let text = std::fs::read_to_string(handout.join(ex).join(f)).unwrap();
+            assert!(
+                !text.contains("solution"),
+                "{ex}/{f} mentions the solution:\n{text}"
+            );
+        }
+    }
+    assert!(handout.join("stereolab/assets/scenes/wuson.toml").is_file());
+
+    // The handout's crates build (the grader builds them) and the untouched stubs grade to zero.
+    let (_, v) = grade("all", &[], &handout, None, "handout");
+    assert_eq!(v["score"].as_f64(), Some(0.0), "{v}");
+    // The students' own tests compile too.
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let tests = Command::new(cargo)
+        .current_dir(&handout)
+        .args([
+            "test",
+            "--offline",
+            "--no-run",
+            "-p",
+            "ex1_stereo",
+            "-p",
+            "ex2_chromadepth",
+            "-p",
+            "ex3_sirds",
+        ])
+        .env("CARGO_TARGET_DIR", target_dir())
+        .output()
+        .expect("run cargo");
+    assert!(
+        tests.status.success(),
+        "{}",
+        String::from_utf8_lossy(&tests.stderr)
+    );
+
+    // A compile error costs its exercise only: the grader reports it and still exits cleanly.
+    std::fs::write(
+        handout.join("ex3_sirds/src/stubs.rs"),
+        "pub fn broken( {}\n",
+    )
+    .unwrap();
+    let (out, v) = grade("all", &[], &handout, None, "handout_broken");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("ex3_sirds: does not compile"), "{stdout}");
+    assert!(
+        test_named(&v, "ex3 link_row")["output"]
+            .as_str()
+            .unwrap()
+            .contains("hint [build]")
+    );
+    assert!(
+        test_named(&v, "ex2 texgen")["output"]
+            .as_str()
+            .unwrap()
+            .contains("hint [todo]")
+    );
+}
+
+#[test]
+fn students_worked_examples_pass_with_the_solution() {
+    let _turn = take_turn();
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .current_dir(root())
+        .args(["test", "--offline", "--all-features"])
+        .args([
+            "-p",
+            "ex1_stereo",
+            "-p",
+            "ex2_chromadepth",
+            "-p",
+            "ex3_sirds",
+        ])
+        .env("CARGO_TARGET_DIR", target_dir())
+        .env_remove("STEREOLAB_MUTANT")
+        .output()
+        .expect("run cargo test");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(stdout.matches("test result: ok").count(), 3, "{stdout}");
+}
+
+#[test]
+fn bad_grade_arguments_get_clear_errors() {
+    for (args, says) in [
+        (vec!["grade", "ex9"], "expected ex1, ex2, ex3 or all"),
+        (vec!["grade", "ex1", "--timeout", "0"], "--timeout"),
+        (
+            vec!["grade", "ex1", "--exercises", "/nonexistent"],
+            "no exercise crates there",
+        ),
+        (
+            vec!["render", "assets/scenes/wuson.toml", "--exercise", "all"],
+            "name one exercise",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .current_dir(root())
+            .args(&args)
+            .output()
+            .expect("run stereolab");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(says),
+            "{args:?}: {err}"
+        );
+    }
+}
+
+#[test]
+fn render_exercise_writes_the_solution_next_to_the_reference_on_any_scene() {
+    let _turn = take_turn();
+    let dir = out_dir("render_exercise");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .current_dir(root())
+        .args(["render", "assets/scenes/wuson.toml", "--size", "96x72"])
+        .args(["--exercise", "ex1", "--solution", "--out"])
+        .arg(&dir)
+        .env("CARGO_TARGET_DIR", target_dir())
+        .env_remove("STEREOLAB_MUTANT")
+        .output()
+        .expect("run stereolab render --exercise");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Four eye renders, four anaglyphs, remap, visibility, parallax colors.
+    assert_eq!(stdout.lines().count(), 11, "{stdout}");
+    for line in stdout.lines() {
+        assert!(
+            line.contains("mismatch   0.00%, mean channel difference   0.00"),
+            "{line}"
+        );
+    }
+    let strip = image::open(dir.join("anaglyph_true.png")).expect("strip written");
+    assert_eq!((strip.width(), strip.height()), (3 * 96, 72));
+}
