@@ -87,6 +87,16 @@ enum Command {
         /// Background color R,G,B (0..255) for two images; default: each image's top-left pixel.
         #[arg(long)]
         background: Option<String>,
+        /// Instead of the scene's outputs: the student's ex1 stereo matrices rendered on the
+        /// CPU (actual) against the reference rig on the GPU (expected), one row per eye.
+        #[arg(long, value_name = "EXERCISE", conflicts_with_all = ["second", "background"])]
+        exercise: Option<String>,
+        /// With --exercise: the instructor's solution instead of the student's code.
+        #[arg(long, requires = "exercise")]
+        solution: bool,
+        /// With --exercise: the folder holding the exercise crates (default: ./exercises or .).
+        #[arg(long, requires = "exercise")]
+        exercises: Option<PathBuf>,
     },
     /// Build and run the student's exercise crates; points table, verdict and hints.
     Grade {
@@ -216,6 +226,44 @@ fn compare_scene(scene: &Scene, out: Option<&std::path::Path>) -> Result<Vec<Com
     stereolab::gpu::parity::compare_scene(&r, scene, &Plan::new(&scene.outputs), out)
 }
 
+/// `compare --exercise`: rows and the student's per-eye problems.
+#[cfg(feature = "gpu")]
+fn compare_exercise(
+    ex: grade::Exercise,
+    scene: &Scene,
+    exercises: Option<PathBuf>,
+    solution: bool,
+    out: Option<&std::path::Path>,
+) -> Result<(Vec<Comparison>, Vec<String>)> {
+    let dir = grade::exercises_dir(exercises)?;
+    let r = stereolab::gpu::GpuRenderer::new()?;
+    println!(
+        "gpu reference (expected) vs your matrices on the cpu (actual): {}",
+        r.adapter_name()
+    );
+    let c = grade::gpu_compare::compare_exercise(
+        &r,
+        ex,
+        scene,
+        &dir,
+        solution,
+        Duration::from_secs(30),
+        out,
+    )?;
+    Ok((c.rows, c.problems))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn compare_exercise(
+    _: grade::Exercise,
+    _: &Scene,
+    _: Option<PathBuf>,
+    _: bool,
+    _: Option<&std::path::Path>,
+) -> Result<(Vec<Comparison>, Vec<String>)> {
+    Err(no_gpu("compare --exercise (your matrices against the GPU)"))
+}
+
 #[cfg(not(feature = "gpu"))]
 fn no_gpu(what: &str) -> Error {
     Error::invalid(
@@ -314,12 +362,26 @@ fn run(cli: Cli) -> Result<()> {
             size,
             sets,
             background,
+            exercise,
+            solution,
+            exercises,
         } => {
             let mut limits = Thresholds::default();
             for t in &thresholds {
                 limits.set(t)?;
             }
+            let mut problems = Vec::new();
             let rows = match second {
+                None if exercise.is_some() => {
+                    let name = exercise.unwrap_or_default();
+                    let [ex] = grade::Exercise::parse_list(&name)?[..] else {
+                        return Err(Error::invalid("--exercise", name, "name one exercise: ex1"));
+                    };
+                    let s = load_scene(&first, &sets, size.as_deref())?;
+                    let (rows, p) = compare_exercise(ex, &s, exercises, solution, out.as_deref())?;
+                    problems = p;
+                    rows
+                }
                 Some(second) => {
                     let bg = background.as_deref().map(parse_rgb).transpose()?;
                     vec![compare::compare_images(
@@ -338,7 +400,11 @@ fn run(cli: Cli) -> Result<()> {
             for p in rows.iter().filter_map(|r| r.strip.as_ref()) {
                 println!("  wrote {}", p.display());
             }
-            let failed = limits.violations(&rows);
+            for p in &problems {
+                println!("  {p}");
+            }
+            let mut failed = limits.violations(&rows);
+            failed.extend(problems);
             if failed.is_empty() {
                 Ok(())
             } else {

@@ -453,3 +453,81 @@ fn render_exercise_writes_the_solution_next_to_the_reference_on_any_scene() {
     let strip = image::open(dir.join("anaglyph_true.png")).expect("strip written");
     assert_eq!((strip.width(), strip.height()), (3 * 96, 72));
 }
+
+/// Runs `stereolab compare --exercise ex1` on a small wuson with the solution, planting
+/// `mutant` when given; returns the exit code and stdout.
+#[cfg(feature = "gpu")]
+fn compare_exercise(mutant: Option<&str>, name: &str) -> (Option<i32>, String) {
+    let dir = out_dir(name);
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_stereolab"));
+    cmd.current_dir(root())
+        .args(["compare", "assets/scenes/wuson.toml", "--size", "96x72"])
+        .args(["--exercise", "ex1", "--solution", "--out"])
+        .arg(&dir)
+        .env("CARGO_TARGET_DIR", target_dir())
+        .env_remove("STEREOLAB_MUTANT");
+    if let Some(m) = mutant {
+        cmd.env("STEREOLAB_MUTANT", m);
+    }
+    let out = cmd.output().expect("run stereolab compare --exercise");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for side in ["left", "right"] {
+        let strip = image::open(dir.join(format!("ex1_stereo_matrices_{side}.png")))
+            .unwrap_or_else(|e| panic!("{side} strip: {e}\n{text}"));
+        assert_eq!((strip.width(), strip.height()), (3 * 96, 72));
+    }
+    (out.status.code(), text)
+}
+
+/// Measured (lavapipe, Mesa 22.3.6): the solution's pair matches the GPU reference with 0
+/// coverage mismatch, identical colors and depth within 2.4e-7 on both eyes; swapped eyes
+/// mismatch 0.35% coverage with depth differences of 2.1e-2 and exit 1.
+#[cfg(feature = "gpu")]
+#[test]
+fn compare_exercise_solution_matches_the_gpu_and_swapped_eyes_exceed_the_parity_thresholds() {
+    if crate::gpu_parity::gpu().is_none() {
+        return;
+    }
+    let _turn = take_turn();
+    let (code, text) = compare_exercise(None, "compare_exercise_solution");
+    assert_eq!(code, Some(0), "{text}");
+    for side in ["left", "right"] {
+        let row = text
+            .lines()
+            .find(|l| l.starts_with(&format!("{side} (gpu | yours)")))
+            .unwrap_or_else(|| panic!("no {side} row:\n{text}"));
+        let cols: Vec<&str> = row.split_whitespace().collect();
+        // name (4 words), coverage %, max diff, mean diff, PSNR, max depth.
+        assert_eq!(cols[4], "0.00000", "coverage mismatch: {row}");
+        let depth: f64 = cols[8].parse().expect("depth column");
+        assert!(depth <= 1e-6, "{row}");
+    }
+    let (code, text) = compare_exercise(Some("swapped-eyes"), "compare_exercise_swapped");
+    assert_eq!(code, Some(1), "{text}");
+    for side in ["left", "right"] {
+        assert!(
+            text.contains(&format!("{side} (gpu | yours): coverage mismatch %")),
+            "{text}"
+        );
+    }
+}
+
+#[cfg(not(feature = "gpu"))]
+#[test]
+fn compare_exercise_without_the_gpu_feature_is_a_clear_error() {
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .current_dir(root())
+        .args(["compare", "assets/scenes/wuson.toml", "--exercise", "ex1"])
+        .output()
+        .expect("run stereolab compare --exercise");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("built without the GPU path"),
+        "{err}"
+    );
+}

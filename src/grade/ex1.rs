@@ -223,8 +223,27 @@ fn stereo_frustum_task(fx: &Fixture) -> TaskSpec {
     }
 }
 
-fn eye_view_input(s: &StereoSetup, mv: &Mat4, eye: usize, lighting: Lighting) -> Value {
+/// The `stereo_matrices` task's input for one eye: setup, cyclopean modelview, eye index
+/// (0 = left), lighting.
+pub(crate) fn eye_view_input(s: &StereoSetup, mv: &Mat4, eye: usize, lighting: Lighting) -> Value {
     json!([s, mv.to_cols_array(), eye, lighting])
+}
+
+/// The student's `stereo_matrices` answer (view then projection, 16 column-major numbers each)
+/// as [`EyeMatrices`] for `render_view`; `None` when it has the wrong length.
+pub(crate) fn eye_matrices_from_answer(a: &[f64]) -> Option<EyeMatrices> {
+    if a.len() != 32 {
+        return None;
+    }
+    let view = Mat4::from_cols_array(&std::array::from_fn(|i| a[i] as f32));
+    let projection = Mat4::from_cols_array(&std::array::from_fn(|i| a[16 + i] as f32));
+    Some(EyeMatrices {
+        view,
+        projection,
+        mvp: projection * view,
+        eye_world: Vec3::ZERO,
+        frustum: [0.0; 6],
+    })
 }
 
 fn eye_answer(m: &EyeMatrices) -> Vec<f64> {
@@ -307,21 +326,9 @@ fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
             .zip(answers)
             .map(|((name, expected), a)| {
                 let actual = a
-                    .as_ref()
-                    .filter(|a| a.len() == 32)
-                    .and_then(|a| {
-                        let view = Mat4::from_cols_array(&std::array::from_fn(|i| a[i] as f32));
-                        let projection =
-                            Mat4::from_cols_array(&std::array::from_fn(|i| a[16 + i] as f32));
-                        let m = EyeMatrices {
-                            view,
-                            projection,
-                            mvp: projection * view,
-                            eye_world: Vec3::ZERO,
-                            frustum: [0.0; 6],
-                        };
-                        render_view(&scene, &m, Shading::Color).ok().map(|r| r.0)
-                    })
+                    .as_deref()
+                    .and_then(eye_matrices_from_answer)
+                    .and_then(|m| render_view(&scene, &m, Shading::Color).ok().map(|r| r.0))
                     .unwrap_or_else(|| blank(expected, scene.background));
                 Picture {
                     name: format!("stereo_matrices_{name}"),

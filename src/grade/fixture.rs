@@ -92,6 +92,23 @@ pub fn reference_rig(setup: &StereoSetup, lighting: Lighting) -> StereoRig {
     }
 }
 
+/// `scene`'s camera and resolved rig as the exercises take them.
+///
+/// # Errors
+/// An invalid camera or rig.
+pub fn stereo_setup(scene: &Scene) -> Result<StereoSetup> {
+    let aspect = scene.aspect();
+    let resolved = scene.rig.resolve(&scene.camera, aspect)?;
+    Ok(StereoSetup {
+        fov_y_degrees: scene.camera.fov_y,
+        aspect,
+        near: scene.camera.near,
+        far: scene.camera.far,
+        eye_separation: resolved.eye_separation,
+        zero_parallax: resolved.zero_parallax_distance,
+    })
+}
+
 impl Fixture {
     /// Renders the reference views of `scene`.
     ///
@@ -99,15 +116,7 @@ impl Fixture {
     /// An invalid camera or rig.
     pub fn new(scene: Scene) -> Result<Fixture> {
         let aspect = scene.aspect();
-        let resolved = scene.rig.resolve(&scene.camera, aspect)?;
-        let setup = StereoSetup {
-            fov_y_degrees: scene.camera.fov_y,
-            aspect,
-            near: scene.camera.near,
-            far: scene.camera.far,
-            eye_separation: resolved.eye_separation,
-            zero_parallax: resolved.zero_parallax_distance,
-        };
+        let setup = stereo_setup(&scene)?;
         let eyes = reference_rig(&setup, Lighting::PerEye).eyes(&scene.camera, aspect)?;
         let center_matrices = StereoRig::center(&scene.camera, aspect)?;
         let views = [

@@ -12,6 +12,8 @@ pub mod ex2;
 pub mod ex3;
 pub mod export;
 pub mod fixture;
+#[cfg(feature = "gpu")]
+pub mod gpu_compare;
 pub mod report;
 pub mod score;
 pub mod spec;
@@ -174,7 +176,7 @@ pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
     Ok(Report { exercises })
 }
 
-fn crate_dir(dir: &Path, ex: Exercise) -> Result<PathBuf> {
+pub(crate) fn crate_dir(dir: &Path, ex: Exercise) -> Result<PathBuf> {
     let d = dir.join(ex.crate_name());
     if d.join("Cargo.toml").is_file() {
         Ok(d)
