@@ -2,7 +2,7 @@
 
 #![allow(dead_code)]
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The repository root.
 pub fn root() -> PathBuf {
@@ -27,9 +27,4 @@ pub fn failure_dir() -> PathBuf {
     let d = root().join("tests").join("failures");
     std::fs::create_dir_all(&d).expect("create tests/failures");
     d
-}
-
-/// True when `path` exists.
-pub fn exists(p: &Path) -> bool {
-    p.exists()
 }

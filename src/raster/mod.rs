@@ -8,10 +8,7 @@ mod clip;
 mod setup;
 
 pub use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
-pub use setup::{
-    Band, Setup, SetupTriangle, WindowVertex, rasterize_window_triangle, setup_triangle, snap,
-    traverse,
-};
+pub use setup::{Band, Setup, SetupTriangle, WindowVertex, setup_triangle, snap, traverse};
 
 use rayon::prelude::*;
 

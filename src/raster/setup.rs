@@ -1,6 +1,5 @@
 //! Fixed-point triangle setup and traversal: llvmpipe's rules, written out in DESIGN.md.
 
-use crate::framebuffer::Framebuffer;
 use crate::shade::{Fragment, MAX_VARYINGS, Shader, Varyings};
 
 use super::RasterOptions;
@@ -310,29 +309,4 @@ pub fn traverse<S: Shader>(
         }
     }
     fragments
-}
-
-/// Setup + traversal of one window-space triangle over the whole framebuffer.
-/// Returns `(culled, fragments)`.
-pub fn rasterize_window_triangle<S: Shader>(
-    v: [WindowVertex; 3],
-    var: [&Varyings; 3],
-    nvar: usize,
-    shader: &S,
-    fb: &mut Framebuffer,
-    opts: &RasterOptions,
-) -> (bool, usize) {
-    match setup_triangle(v, var, nvar, fb.width, fb.height, opts) {
-        Setup::Empty => (false, 0),
-        Setup::Culled => (true, 0),
-        Setup::Triangle(t) => {
-            let mut band = Band {
-                width: fb.width,
-                y0: 0,
-                color: &mut fb.color,
-                depth: &mut fb.depth,
-            };
-            (false, traverse(&t, shader, &mut band, opts))
-        }
-    }
 }
