@@ -46,7 +46,13 @@ pub struct BenchOptions {
     pub width: u32,
     /// Image height.
     pub height: u32,
+    /// Run only these groups (`stereo`, `raster`, `chromadepth`, `finalize`, `sirds`, `gpu`);
+    /// empty: all.
+    pub only: Vec<String>,
 }
+
+/// The benchmark groups, in the order they run.
+pub const GROUPS: [&str; 6] = ["stereo", "raster", "chromadepth", "finalize", "sirds", "gpu"];
 
 impl Default for BenchOptions {
     fn default() -> Self {
@@ -55,6 +61,7 @@ impl Default for BenchOptions {
             iterations: 15,
             width: 1024,
             height: 768,
+            only: Vec::new(),
         }
     }
 }
@@ -73,28 +80,44 @@ pub fn median_ms<T>(iters: usize, mut f: impl FnMut() -> T) -> f64 {
     v[v.len() / 2]
 }
 
-/// Runs every benchmark.
+/// Runs every benchmark group `opts.only` asks for (all when empty).
 ///
 /// # Errors
-/// The scene cannot be loaded or rendered.
+/// `Invalid` naming `bench.only` for a group not in [`GROUPS`]. The scene cannot be loaded or
+/// rendered.
 pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
+    if let Some(bad) = opts.only.iter().find(|g| !GROUPS.contains(&g.as_str())) {
+        return Err(Error::invalid(
+            "bench.only",
+            bad,
+            format!("unknown group; one of {}", GROUPS.join(", ")),
+        ));
+    }
+    let want = |g: &str| opts.only.is_empty() || opts.only.iter().any(|o| o == g);
+    let iters = opts.iterations;
     let mut rows = Vec::new();
     let mut scene = Scene::load(&opts.scene, &[])?;
     scene.set_size(opts.width, opts.height)?;
-    rows.extend(stereo_pair(&scene, opts.iterations)?);
-    rows.extend(subpixel_bits(&scene, opts.iterations)?);
-    rows.extend(perspective_correction(opts.iterations)?);
-    rows.extend(crate::effects::chromadepth::bench::rows(
-        &scene,
-        opts.iterations,
-    )?);
-    rows.extend(crate::effects::finalize_bench::rows(
-        &scene,
-        opts.iterations,
-    )?);
-    rows.extend(crate::effects::sirds::bench::rows(opts.iterations)?);
+    if want("stereo") {
+        rows.extend(stereo_pair(&scene, iters)?);
+    }
+    if want("raster") {
+        rows.extend(subpixel_bits(&scene, iters)?);
+        rows.extend(perspective_correction(iters)?);
+    }
+    if want("chromadepth") {
+        rows.extend(crate::effects::chromadepth::bench::rows(&scene, iters)?);
+    }
+    if want("finalize") {
+        rows.extend(crate::effects::finalize_bench::rows(&scene, iters)?);
+    }
+    if want("sirds") {
+        rows.extend(crate::effects::sirds::bench::rows(iters)?);
+    }
     #[cfg(feature = "gpu")]
-    rows.extend(crate::gpu::parity::bench_rows(&scene, opts.iterations)?);
+    if want("gpu") {
+        rows.extend(crate::gpu::parity::bench_rows(&scene, iters)?);
+    }
     Ok(rows)
 }
 

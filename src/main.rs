@@ -150,6 +150,10 @@ enum Command {
         /// Repetitions per timing (median reported).
         #[arg(long, default_value_t = 15)]
         iterations: usize,
+        /// Run only these groups, comma-separated: stereo, raster, chromadepth, finalize, sirds,
+        /// gpu (default: all).
+        #[arg(long, value_delimiter = ',')]
+        only: Vec<String>,
     },
     /// Autostereograms (SIRDS): from a scene, from a depth map (--depth), animated (--frames),
     /// or decoded back to depth (--decode).
@@ -469,9 +473,11 @@ fn run(cli: Cli) -> Result<()> {
             csv,
             scene,
             iterations,
+            only,
         } => {
             let mut opts = bench::BenchOptions {
                 iterations,
+                only,
                 ..Default::default()
             };
             if let Some(s) = scene {
