@@ -52,7 +52,14 @@ pub struct BenchOptions {
 }
 
 /// The benchmark groups, in the order they run.
-pub const GROUPS: [&str; 6] = ["stereo", "raster", "chromadepth", "finalize", "sirds", "gpu"];
+pub const GROUPS: [&str; 6] = [
+    "stereo",
+    "raster",
+    "chromadepth",
+    "finalize",
+    "sirds",
+    "gpu",
+];
 
 impl Default for BenchOptions {
     fn default() -> Self {

@@ -175,10 +175,29 @@ impl Shader for BlinnPhong<'_> {
 /// usual case, several times cheaper than `powf` and within a few ulps of it), `powf` otherwise.
 #[inline]
 pub fn specular_power(x: f32, shininess: f32) -> f32 {
-    if shininess.fract() == 0.0 && (0.0..=1024.0).contains(&shininess) {
-        x.powi(shininess as i32)
+    // A whole number in range, checked with casts (`fract` is a libm call on baseline x86-64).
+    if (0.0..=1024.0).contains(&shininess) && (shininess as u32) as f32 == shininess {
+        powi(x, shininess as u32)
     } else {
         x.powf(shininess)
+    }
+}
+
+/// `x^n` by repeated squaring, the same multiplications in the same order as `f32::powi`
+/// (compiler-builtins' `__powisf2`), so the same bits, but inlined instead of a library call
+/// per fragment.
+#[inline]
+pub fn powi(mut x: f32, mut n: u32) -> f32 {
+    let mut r = 1.0f32;
+    loop {
+        if n & 1 != 0 {
+            r *= x;
+        }
+        n >>= 1;
+        if n == 0 {
+            return r;
+        }
+        x *= x;
     }
 }
 
@@ -206,5 +225,37 @@ impl Shader for DepthOnly<'_> {
     }
     fn writes_color(&self) -> bool {
         false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inlined_powi_gives_the_bits_of_std_powi() {
+        for n in 0..=1024u32 {
+            for k in 0..200 {
+                let x = k as f32 / 199.0 * 1.01;
+                assert_eq!(
+                    powi(x, n).to_bits(),
+                    x.powi(std::hint::black_box(n as i32)).to_bits(),
+                    "x = {x}, n = {n}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn specular_power_takes_powf_for_fractional_or_huge_exponents() {
+        assert_eq!(specular_power(0.5, 2.5), 0.5f32.powf(2.5));
+        assert_eq!(specular_power(0.9, 2000.0), 0.9f32.powf(2000.0));
+        // Against the runtime library call (a constant exponent would be folded at compile
+        // time by another method, which can differ in the last bit).
+        let n = std::hint::black_box(32);
+        assert_eq!(
+            specular_power(0.9, 32.0).to_bits(),
+            0.9f32.powi(n).to_bits()
+        );
     }
 }

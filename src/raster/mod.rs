@@ -70,7 +70,8 @@ pub fn rasterize<S: Shader>(
     fb: &mut Framebuffer,
     opts: &RasterOptions,
 ) -> RasterStats {
-    let (setups, mut stats) = setup_all(triangles, vertex_count, shader, fb.width, fb.height, opts);
+    let (setups, mut stats) =
+        setup_triangles(triangles, vertex_count, shader, fb.width, fb.height, opts);
     let width = fb.width as usize;
     stats.fragments = fb
         .color
@@ -82,6 +83,7 @@ pub fn rasterize<S: Shader>(
             let y1 = y0 + (depth.len() / width) as u32 - 1;
             let mut band = Band {
                 width: fb.width,
+                x0: 0,
                 y0,
                 color,
                 depth,
@@ -99,8 +101,10 @@ pub fn rasterize<S: Shader>(
     stats
 }
 
-/// Vertex stage, clipping, perspective divide and triangle setup for every triangle, in order.
-fn setup_all<S: Shader>(
+/// Vertex stage, clipping, perspective divide and triangle setup for every triangle, in
+/// submission order, for a `width`×`height` target: what [`traverse`] needs, for callers that
+/// traverse tiles themselves.
+pub fn setup_triangles<S: Shader>(
     triangles: &[[u32; 3]],
     vertex_count: usize,
     shader: &S,
@@ -108,19 +112,50 @@ fn setup_all<S: Shader>(
     height: u32,
     opts: &RasterOptions,
 ) -> (Vec<SetupTriangle>, RasterStats) {
-    let nvar = shader.varying_count().min(crate::shade::MAX_VARYINGS);
-    // Vertex stage, once per vertex (a post-transform cache, like a GPU's).
+    // Vertex stage, once per vertex (a post-transform cache, like a GPU's), in parallel.
     let verts: Vec<ClipVertex> = (0..vertex_count as u32)
+        .into_par_iter()
+        .with_min_len(SETUP_CHUNK)
         .map(|i| {
             let mut var: Varyings = [0.0; crate::shade::MAX_VARYINGS];
             let pos = shader.vertex(i, &mut var);
             ClipVertex { pos, var }
         })
         .collect();
+    let nvar = shader.varying_count().min(crate::shade::MAX_VARYINGS);
+    // Chunks of triangles set up in parallel and concatenated in order: the same list for
+    // any thread count.
+    let parts: Vec<(Vec<SetupTriangle>, RasterStats)> = triangles
+        .par_chunks(SETUP_CHUNK)
+        .map(|chunk| setup_chunk(chunk, &verts, nvar, width, height, opts))
+        .collect();
     let mut stats = RasterStats {
         triangles: triangles.len(),
         ..Default::default()
     };
+    let mut setups = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
+    for (part, s) in parts {
+        setups.extend(part);
+        stats.non_finite += s.non_finite;
+        stats.clipped += s.clipped;
+        stats.culled += s.culled;
+    }
+    (setups, stats)
+}
+
+/// Triangles per setup task.
+const SETUP_CHUNK: usize = 1024;
+
+/// Clipping, perspective divide and setup of one chunk of triangles, in order.
+fn setup_chunk(
+    triangles: &[[u32; 3]],
+    verts: &[ClipVertex],
+    nvar: usize,
+    width: u32,
+    height: u32,
+    opts: &RasterOptions,
+) -> (Vec<SetupTriangle>, RasterStats) {
+    let mut stats = RasterStats::default();
     let mut setups = Vec::with_capacity(triangles.len());
     let blank = ClipVertex {
         pos: glam::Vec4::ZERO,
@@ -170,7 +205,7 @@ fn setup_all<S: Shader>(
                 height,
                 opts,
             ) {
-                Setup::Triangle(t) => setups.push(*t),
+                Setup::Triangle(t) => setups.push(t),
                 Setup::Culled => culled = true,
                 Setup::Empty => {}
             }

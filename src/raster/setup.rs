@@ -90,15 +90,17 @@ pub struct SetupTriangle {
     nvar: usize,
 }
 
-/// The outcome of [`setup_triangle`].
+/// The outcome of [`setup_triangle`]. Not boxed: setup runs once per triangle per pass, and a
+/// heap allocation each time cost more than moving the larger value.
 #[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)]
 pub enum Setup {
     /// Covers no sample point (zero area on the grid, outside the target, degenerate).
     Empty,
     /// Back-facing and culled.
     Culled,
     /// Ready to traverse.
-    Triangle(Box<SetupTriangle>),
+    Triangle(SetupTriangle),
 }
 
 /// Triangle setup: snap to the subpixel grid, orient, build the edge functions with the
@@ -195,7 +197,7 @@ pub fn setup_triangle(
             plane([var[0][k], var[1][k], var[2][k]])
         };
     }
-    Setup::Triangle(Box::new(SetupTriangle {
+    Setup::Triangle(SetupTriangle {
         c,
         dcdx,
         dcdy,
@@ -211,7 +213,7 @@ pub fn setup_triangle(
         inv_w,
         var: var_planes,
         nvar,
-    }))
+    })
 }
 
 impl SetupTriangle {
@@ -219,18 +221,93 @@ impl SetupTriangle {
     pub fn rows(&self) -> (u32, u32) {
         (self.py0 as u32, self.py1 as u32)
     }
+
+    /// First and last pixel column the triangle may cover.
+    pub fn columns(&self) -> (u32, u32) {
+        (self.px0 as u32, self.px1 as u32)
+    }
 }
 
-/// A band of rows of a framebuffer: rows `y0 .. y0 + color.len() / width`.
+/// A tile of a framebuffer: columns `x0 .. x0 + width`, rows `y0 .. y0 + color.len() / width`
+/// (a band of whole rows when `x0 = 0` and `width` is the target's). Traversal touches only
+/// the tile's pixels, as a scissor rectangle would.
 pub struct Band<'a> {
-    /// Row width in pixels.
+    /// Tile width in pixels (the row stride of `color` and `depth`).
     pub width: u32,
-    /// First row of the band.
+    /// First column of the tile.
+    pub x0: u32,
+    /// First row of the tile.
     pub y0: u32,
     /// The band's colors.
     pub color: &'a mut [[u8; 4]],
     /// The band's depths.
     pub depth: &'a mut [f32],
+}
+
+/// One edge's covered-span bound along a row, stepped from row to row without dividing.
+///
+/// Edge `i` at pixel `px0 + k` of a row is `e − m·k` with `m = dcdx·S`; the covered `k` satisfy
+/// `e − m·k ≥ 0`. For `m > 0` that is `k ≤ ⌊e/m⌋`, for `m < 0` it is `k ≥ −⌊e/|m|⌋`. From one row
+/// to the next `e` grows by `D = dcdy·S`, so `q = ⌊e/|m|⌋` and `r = e − q|m|` advance by the
+/// precomputed `⌊D/|m|⌋` and `D mod |m|` with one carry: exact integers, as the per-row division
+/// they replace.
+#[derive(Clone, Copy)]
+struct EdgeStep {
+    /// `sign(m)`: +1 bounds `k` above, −1 below, 0 a horizontal-step edge (`e` alone decides).
+    sign: i64,
+    /// `|m|` (1 for `m = 0`, unused).
+    m: i64,
+    /// `⌊e/|m|⌋` and `e mod |m|` (for `m = 0`: `q = e`).
+    q: i64,
+    r: i64,
+    /// Per-row increments.
+    dq: i64,
+    dr: i64,
+}
+
+impl EdgeStep {
+    fn new(e: i64, m: i64, d: i64) -> EdgeStep {
+        if m == 0 {
+            return EdgeStep {
+                sign: 0,
+                m: 1,
+                q: e,
+                r: 0,
+                dq: d,
+                dr: 0,
+            };
+        }
+        let a = m.abs();
+        EdgeStep {
+            sign: m.signum(),
+            m: a,
+            q: e.div_euclid(a),
+            r: e.rem_euclid(a),
+            dq: d.div_euclid(a),
+            dr: d.rem_euclid(a),
+        }
+    }
+
+    #[inline]
+    fn advance(&mut self) {
+        self.q += self.dq;
+        self.r += self.dr;
+        if self.r >= self.m {
+            self.r -= self.m;
+            self.q += 1;
+        }
+    }
+
+    /// Narrows `[k0, k1]` to this edge's covered pixels.
+    #[inline]
+    fn bound(&self, k0: &mut i64, k1: &mut i64) {
+        match self.sign {
+            1 => *k1 = (*k1).min(self.q),
+            -1 => *k0 = (*k0).max(-self.q),
+            _ if self.q < 0 => *k1 = -1,
+            _ => {}
+        }
+    }
 }
 
 /// Traverses a set-up triangle over the rows of `band`: coverage from the edge functions, then
@@ -244,34 +321,56 @@ pub fn traverse<S: Shader>(
     let rows = (band.depth.len() / band.width.max(1) as usize) as i64;
     let py0 = t.py0.max(band.y0 as i64);
     let py1 = t.py1.min(band.y0 as i64 + rows - 1);
+    let cx0 = t.px0.max(band.x0 as i64);
+    let cx1 = t.px1.min(band.x0 as i64 + band.width as i64 - 1);
+    if py0 > py1 || cx0 > cx1 {
+        return 0;
+    }
     let s = 1i64 << t.bits;
     let writes_color = shader.writes_color();
+    // The shader's own count (a constant once inlined, so the loop below unrolls). `t` must
+    // have been set up with the same varyings (planes past its count copy the depth plane).
+    let nvar = shader.varying_count().min(MAX_VARYINGS);
     let mut frag_var: Varyings = [0.0; MAX_VARYINGS];
     let mut fragments = 0;
     let span = t.px1 - t.px0;
+    // Edge i at pixel px0 + k of row py is c + dcdy·py·S − dcdx·(px0 + k)·S: solved for k
+    // exactly in integers, so only covered pixels are visited (the same coverage as testing
+    // each pixel).
+    let mut edges: [EdgeStep; 3] = std::array::from_fn(|i| {
+        let e = t.c[i] + t.dcdy[i] * py0 * s - t.dcdx[i] * t.px0 * s;
+        EdgeStep::new(e, t.dcdx[i] * s, t.dcdy[i] * s)
+    });
     for py in py0..=py1 {
-        let sy = py * s;
-        // Edge i at pixel px0 + k is e_i − step_i·k; solve e_i − step_i·k ≥ 0 for k exactly in
-        // integers, so only covered pixels are visited (same coverage as testing each pixel).
         let (mut k0, mut k1) = (0i64, span);
-        for i in 0..3 {
-            let e = t.c[i] + t.dcdy[i] * sy - t.dcdx[i] * t.px0 * s;
-            let step = t.dcdx[i] * s;
-            match step.cmp(&0) {
-                std::cmp::Ordering::Greater => k1 = k1.min(e.div_euclid(step)),
-                std::cmp::Ordering::Less => {
-                    k0 = k0.max((-e).div_euclid(-step) + ((-e).rem_euclid(-step) != 0) as i64)
-                }
-                std::cmp::Ordering::Equal if e < 0 => k1 = -1,
-                std::cmp::Ordering::Equal => {}
-            }
+        for e in &mut edges {
+            e.bound(&mut k0, &mut k1);
+            e.advance();
         }
         if k0 > k1 {
             continue;
         }
         let fy = py as f32 + 0.5 - t.y0;
-        let row = (py - band.y0 as i64) as usize * band.width as usize;
-        for px in t.px0 + k0..=t.px0 + k1 {
+        let (x_lo, x_hi) = ((t.px0 + k0).max(cx0), (t.px0 + k1).min(cx1));
+        if x_lo > x_hi {
+            continue;
+        }
+        // Index of pixel (px, py) in the tile: row + px.
+        let row = ((py - band.y0 as i64) * band.width as i64 - band.x0 as i64) as usize;
+        if !writes_color && opts.depth_test {
+            // Depth only: a branch-free span the compiler vectorizes; z is the same expression
+            // as below, so the bits are the same.
+            let depth = &mut band.depth[row + x_lo as usize..=row + x_hi as usize];
+            for (k, d) in depth.iter_mut().enumerate() {
+                let fx = (x_lo + k as i64) as f32 + 0.5 - t.x0;
+                let z = t.z.at(fx, fy).clamp(0.0, 1.0);
+                let pass = z < *d;
+                *d = if pass { z } else { *d };
+                fragments += pass as usize;
+            }
+            continue;
+        }
+        for px in x_lo..=x_hi {
             let fx = px as f32 + 0.5 - t.x0;
             let z = t.z.at(fx, fy).clamp(0.0, 1.0);
             let idx = row + px as usize;
@@ -286,7 +385,7 @@ pub fn traverse<S: Shader>(
                 } else {
                     1.0
                 };
-                for (out, plane) in frag_var.iter_mut().zip(&t.var[..t.nvar]) {
+                for (out, plane) in frag_var.iter_mut().zip(&t.var[..nvar]) {
                     *out = plane.at(fx, fy) * w;
                 }
                 let f = Fragment {

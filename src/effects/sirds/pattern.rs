@@ -106,12 +106,44 @@ impl Pattern {
         }
     }
 
+    /// Row `y` of the pattern into `row` (columns `0..row.len()`): the same colors as
+    /// [`Pattern::color`], with the pattern kind decided once per row.
+    pub fn fill_row(&self, y: u32, row: &mut [[u8; 4]]) {
+        let xs = row.iter_mut().zip(0u32..);
+        match self {
+            Pattern::BlackWhite { seed } => {
+                for (p, x) in xs {
+                    let v = if random(*seed, x, y) & 1 == 0 { 0 } else { 255 };
+                    *p = [v, v, v, 255];
+                }
+            }
+            Pattern::Gray { seed } => {
+                for (p, x) in xs {
+                    let v = (random(*seed, x, y) >> 24) as u8;
+                    *p = [v, v, v, 255];
+                }
+            }
+            Pattern::Color { seed } => {
+                for (p, x) in xs {
+                    let r = random(*seed, x, y);
+                    *p = [(r >> 8) as u8, (r >> 24) as u8, (r >> 40) as u8, 255];
+                }
+            }
+            Pattern::Image(_) => {
+                for (p, x) in xs {
+                    *p = self.color(x, y);
+                }
+            }
+        }
+    }
+
     /// A whole `width × height` image of the pattern (the strip algorithm's starting image).
     pub fn fill(&self, width: u32, height: u32) -> Vec<[u8; 4]> {
-        (0..height)
-            .flat_map(|y| (0..width).map(move |x| (x, y)))
-            .map(|(x, y)| self.color(x, y))
-            .collect()
+        let mut img = vec![[0u8; 4]; width as usize * height as usize];
+        for (y, row) in img.chunks_exact_mut(width.max(1) as usize).enumerate() {
+            self.fill_row(y as u32, row);
+        }
+        img
     }
 }
 

@@ -5,9 +5,10 @@
 //!
 //! Each iteration finishes one vertical strip: a pixel `x` copies the pixel `x − d`, and
 //! `d ≥ δ` (the front separation), so a strip narrower than `δ` reads only finished strips and
-//! never changes again (§3). We therefore render each iteration into its strip only — the
-//! rasterizer's clipper cuts the scene to the strip — which is the same image as rendering the
-//! whole frame k times, for about the cost of one frame.
+//! never changes again (§3). We therefore traverse each iteration's strip only (a scissor on
+//! its columns), which is the same image as rendering the whole frame k times, for about the
+//! cost of one frame; every right-going pass draws the same shifted geometry, so triangle setup
+//! runs once per direction.
 
 use std::sync::atomic::{AtomicI32, Ordering};
 
@@ -19,9 +20,8 @@ use super::disparity::Disparity;
 use super::pattern::Pattern;
 use super::per_pixel::check_inputs;
 use crate::error::{Error, Result};
-use crate::framebuffer::Framebuffer;
 use crate::math::EyeMatrices;
-use crate::raster::{RasterOptions, rasterize};
+use crate::raster::{Band, RasterOptions, SetupTriangle, setup_triangles, traverse};
 use crate::scene::Scene;
 use crate::shade::{Fragment, Shader, Varyings};
 
@@ -57,9 +57,6 @@ pub struct PerVertexOptions {
     /// Iterations k (the strip width is ⌈W / k⌉); `None`: the fewest the geometry allows.
     pub iterations: Option<u32>,
 }
-
-/// Row bands rendered in parallel. Fixed, so the bytes never depend on the thread count.
-pub const BANDS: u32 = 4;
 
 /// The scene as the strip passes see it: cyclopean clip positions, each vertex's separation,
 /// and the triangles, the background plane last (drawn last, most of it fails the depth test).
@@ -205,62 +202,36 @@ fn plan_strips(width: u32, d: &Disparity, opts: &PerVertexOptions) -> Result<Vec
     Ok(strips)
 }
 
-/// Fig. 4 as a [`Shader`]: the vertex stage shifts the cyclopean position by `±d/2` (already in
-/// `clip`) and maps the strip/band to the framebuffer; the fragment stage reads the current
-/// image `d` pixels back (the texture coordinate `x ∓ d/2` of the unshifted vertex).
-struct StripShader<'a> {
-    clip: &'a [Vec4],
-    separation: &'a [f32],
-    /// Window-space remap to the strip × band framebuffer: `x' = x sx + w ox`, `y' = y sy + w oy`.
-    remap: [f32; 4],
-    image: &'a [[u8; 4]],
-    width: usize,
-    strip: Strip,
-    bilinear: bool,
-    links: Option<&'a [AtomicI32]>,
+/// Where a fragment at column `x` with separation `sep` samples the image (Fig. 4's texture
+/// coordinate `x ∓ d/2` of the unshifted vertex, in pixel-index units, centers at integers):
+/// the pixels `i0` and `i1` and the weight `t` of `i1` (nearest: `i0 == i1`, `t = 0`). `None`
+/// when a source falls outside `[lo, hi)`: the fragment is discarded and the pixel keeps what
+/// was there.
+#[inline]
+fn source(x: u32, sep: f32, strip: &Strip, bilinear: bool) -> Option<(usize, usize, f32)> {
+    let p = x as f32 - strip.toward * sep;
+    let (lo, hi) = (strip.lo, strip.hi);
+    if bilinear {
+        let i0 = floor(p);
+        let t = p - i0 as f32;
+        let i1 = if t > 0.0 { i0 + 1 } else { i0 };
+        (i0 >= lo && i1 < hi).then_some((i0 as usize, i1 as usize, t))
+    } else {
+        let i = floor(p + 0.5);
+        (i >= lo && i < hi).then_some((i as usize, i as usize, 0.0))
+    }
 }
 
-impl Shader for StripShader<'_> {
-    fn varying_count(&self) -> usize {
-        1
+/// The color a fragment writes: the source pixel, or the two mixed linearly and rounded to
+/// the nearest level (alpha opaque).
+#[inline]
+fn sample(row: &[[u8; 4]], (i0, i1, t): (usize, usize, f32)) -> [u8; 4] {
+    let (a, b) = (row[i0], row[i1]);
+    if i0 == i1 {
+        return a;
     }
-
-    fn vertex(&self, index: u32, out: &mut Varyings) -> Vec4 {
-        let i = index as usize;
-        out[0] = self.separation[i];
-        let c = self.clip[i];
-        let [sx, ox, sy, oy] = self.remap;
-        Vec4::new(c.x * sx + c.w * ox, c.y * sy + c.w * oy, c.z, c.w)
-    }
-
-    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
-        let x = f.x + self.strip.x0;
-        let row = f.y as usize * self.width;
-        // Source position in pixel-index units (pixel centers at integers).
-        let p = x as f32 - self.strip.toward * f.varyings[0];
-        let (lo, hi) = (self.strip.lo, self.strip.hi);
-        let (source, color) = if self.bilinear {
-            let i0 = floor(p);
-            let t = p - i0 as f32;
-            let i1 = if t > 0.0 { i0 + 1 } else { i0 };
-            if i0 < lo || i1 >= hi {
-                return None;
-            }
-            let (a, b) = (self.image[row + i0 as usize], self.image[row + i1 as usize]);
-            let mix = |k: usize| (a[k] as f32 + (b[k] as f32 - a[k] as f32) * t + 0.5) as u8;
-            (i0, [mix(0), mix(1), mix(2), 255])
-        } else {
-            let i = floor(p + 0.5);
-            if i < lo || i >= hi {
-                return None;
-            }
-            (i, self.image[row + i as usize])
-        };
-        if let Some(links) = self.links {
-            links[row + x as usize].store(source as i32, Ordering::Relaxed);
-        }
-        Some(color)
-    }
+    let mix = |k: usize| (a[k] as f32 + (b[k] as f32 - a[k] as f32) * t + 0.5) as u8;
+    [mix(0), mix(1), mix(2), 255]
 }
 
 /// `⌊v⌋` without a libm call (the default x86-64 target has no SSE4.1 `roundss`).
@@ -270,38 +241,72 @@ fn floor(v: f32) -> i64 {
     i - ((i as f32) > v) as i64
 }
 
-/// Window-space bounds `[x0, x1, y0, y1]` of each triangle after the horizontal shift; the
-/// whole image for a triangle with a vertex behind the eye (the clipper sorts it out).
-fn triangle_bounds(clip: &[Vec4], triangles: &[[u32; 3]], w: f32, h: f32) -> Vec<[f32; 4]> {
-    triangles
-        .iter()
-        .map(|t| {
-            let mut b = [
-                f32::INFINITY,
-                f32::NEG_INFINITY,
-                f32::INFINITY,
-                f32::NEG_INFINITY,
-            ];
-            for &i in t {
-                let c = clip[i as usize];
-                if c.w.is_nan() || c.w <= 0.0 {
-                    return [
-                        f32::NEG_INFINITY,
-                        f32::INFINITY,
-                        f32::NEG_INFINITY,
-                        f32::INFINITY,
-                    ];
-                }
-                let (x, y) = ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h);
-                b = [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)];
-            }
-            b
-        })
-        .collect()
+/// Fig. 4's vertex program: the shifted position and the vertex's separation as the varying.
+struct StripVertices<'a> {
+    clip: &'a [Vec4],
+    separation: &'a [f32],
 }
 
-/// Makes a SIRDS with the strip algorithm: `BANDS` row bands in parallel (rows never interact),
-/// each band's strips in order.
+impl Shader for StripVertices<'_> {
+    fn varying_count(&self) -> usize {
+        1
+    }
+
+    fn vertex(&self, index: u32, out: &mut Varyings) -> Vec4 {
+        out[0] = self.separation[index as usize];
+        self.clip[index as usize]
+    }
+
+    /// Never called: this shader only feeds [`setup_triangles`].
+    fn fragment(&self, _: &Fragment) -> Option<[u8; 4]> {
+        None
+    }
+}
+
+/// Fig. 4's fragment program over one band of rows: reads the band's current image `d` pixels
+/// toward the start. [`traverse`] calls only the fragment stage.
+struct StripSampler<'a> {
+    /// The band's rows as they stand (finished strips final).
+    image: &'a [[u8; 4]],
+    width: usize,
+    y0: u32,
+    strip: Strip,
+    bilinear: bool,
+    /// Per band pixel, the source it copied (bilinear: the left one of the two).
+    links: Option<&'a [AtomicI32]>,
+}
+
+impl Shader for StripSampler<'_> {
+    fn varying_count(&self) -> usize {
+        1
+    }
+
+    /// Never called: the vertices went through [`StripVertices`].
+    fn vertex(&self, _: u32, _: &mut Varyings) -> Vec4 {
+        Vec4::ZERO
+    }
+
+    #[inline]
+    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
+        let row_start = (f.y - self.y0) as usize * self.width;
+        let src = source(f.x, f.varyings[0], &self.strip, self.bilinear)?;
+        if let Some(links) = self.links {
+            links[row_start + f.x as usize].store(src.0 as i32, Ordering::Relaxed);
+        }
+        Some(sample(&self.image[row_start..row_start + self.width], src))
+    }
+}
+
+/// Rows per band: bands run in parallel. Fixed, so the bytes never depend on the thread count.
+pub const BAND_ROWS: u32 = 16;
+
+/// Makes a SIRDS with the strip algorithm.
+///
+/// Every right-going pass draws the same shifted geometry (and every left-going one the
+/// other), so triangle setup runs once per direction; each strip is then traversed with a
+/// scissor on its columns, in strip order, its fragments sampling the image the earlier strips
+/// finished, with its own depth buffer (each pixel belongs to one strip). Bands of
+/// [`BAND_ROWS`] rows run in parallel: rows never interact.
 ///
 /// # Errors
 /// As [`check_inputs`], and k too small for the front separation.
@@ -315,124 +320,112 @@ pub fn per_vertex(
     record_links: bool,
 ) -> Result<StripResult> {
     check_inputs(width, d, pattern)?;
+    // The same size checks as any framebuffer.
+    crate::framebuffer::check_size(width, height)?;
     let strips = plan_strips(width, d, opts)?;
-    let (wf, hf) = (width as f32, height as f32);
-    // Both shifted copies of the vertices: right-going (+d/2) and left-going (−d/2).
-    let shifted = |toward: f32| -> Vec<Vec4> {
-        geometry
+    let (w, wf) = (width as usize, width as f32);
+    let raster = RasterOptions::default();
+    let setups = |toward: f32| {
+        let clip: Vec<Vec4> = geometry
             .clip
             .iter()
             .zip(&geometry.separation)
             .map(|(c, s)| Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w))
-            .collect()
+            .collect();
+        let vertices = StripVertices {
+            clip: &clip,
+            separation: &geometry.separation,
+        };
+        setup_triangles(
+            &geometry.triangles,
+            clip.len(),
+            &vertices,
+            width,
+            height,
+            &raster,
+        )
+        .0
     };
-    let right = shifted(1.0);
+    let right = setups(1.0);
     let left = if strips.iter().any(|s| s.toward < 0.0) {
-        shifted(-1.0)
+        setups(-1.0)
     } else {
         Vec::new()
     };
-    let bounds_right = triangle_bounds(&right, &geometry.triangles, wf, hf);
-    let bounds_left = if left.is_empty() {
-        Vec::new()
+    let widest = strips.iter().map(|s| s.width as usize).max().unwrap_or(0);
+    let mut pixels = vec![[0u8, 0, 0, 255]; w * height as usize];
+    let links: Vec<AtomicI32> = if record_links {
+        (0..pixels.len()).map(|_| AtomicI32::new(-1)).collect()
     } else {
-        triangle_bounds(&left, &geometry.triangles, wf, hf)
+        Vec::new()
     };
-    let band_rows = height.div_ceil(BANDS);
-    let raster = RasterOptions::default();
-    let bands: Vec<(u32, u32)> = (0..height)
-        .step_by(band_rows as usize)
-        .map(|y0| (y0, band_rows.min(height - y0)))
-        .collect();
-    let results = bands
-        .par_iter()
-        .map(|&(y0, bh)| -> Result<(Vec<[u8; 4]>, Vec<AtomicI32>)> {
-            let w = width as usize;
-            let mut image: Vec<[u8; 4]> = (y0..y0 + bh)
-                .flat_map(|y| (0..width).map(move |x| (x, y)))
-                .map(|(x, y)| pattern.color(x, y))
-                .collect();
-            let links: Vec<AtomicI32> = if record_links {
-                (0..image.len()).map(|_| AtomicI32::new(-1)).collect()
-            } else {
-                Vec::new()
+    let band_len = w * BAND_ROWS as usize;
+    pixels
+        .par_chunks_mut(band_len)
+        .enumerate()
+        .for_each(|(b, image)| {
+            let y0 = b as u32 * BAND_ROWS;
+            let rows = image.len() / w;
+            let y1 = y0 + rows as u32 - 1;
+            for (r, row) in image.chunks_exact_mut(w).enumerate() {
+                pattern.fill_row(y0 + r as u32, row);
+            }
+            let in_band = |list: &[SetupTriangle]| -> Vec<usize> {
+                (0..list.len())
+                    .filter(|&i| {
+                        let (r0, r1) = list[i].rows();
+                        r0 <= y1 && r1 >= y0
+                    })
+                    .collect()
             };
-            let (y_lo, y_hi) = (y0 as f32 - 1.0, (y0 + bh) as f32 + 1.0);
-            let n = geometry.clip.len();
-            let (mut seen, mut remap, mut stamp) = (vec![0u32; n], vec![0u32; n], 0u32);
-            let (mut tris, mut local_clip, mut local_sep) = (Vec::new(), Vec::new(), Vec::new());
+            let (right_here, left_here) = (in_band(&right), in_band(&left));
+            let band_links = record_links.then(|| &links[b * band_len..b * band_len + image.len()]);
+            let mut color = vec![[0u8; 4]; widest * rows];
+            let mut depth = vec![1.0f32; widest * rows];
             for strip in &strips {
-                let (clip, bounds) = if strip.toward > 0.0 {
-                    (&right, &bounds_right)
+                let (x0, sw) = (strip.x0 as usize, strip.width as usize);
+                let (list, here) = if strip.toward > 0.0 {
+                    (&right, &right_here)
                 } else {
-                    (&left, &bounds_left)
+                    (&left, &left_here)
                 };
-                let (x_lo, x_hi) = (strip.x0 as f32 - 1.0, (strip.x0 + strip.width) as f32 + 1.0);
-                // Only the triangles that reach this strip × band, with their vertices
-                // compacted, so the vertex stage runs on those alone.
-                tris.clear();
-                local_clip.clear();
-                local_sep.clear();
-                stamp += 1;
-                for (t, b) in geometry.triangles.iter().zip(bounds) {
-                    if !(b[1] >= x_lo && b[0] <= x_hi && b[3] >= y_lo && b[2] <= y_hi) {
-                        continue;
-                    }
-                    tris.push(t.map(|i| {
-                        let i = i as usize;
-                        if seen[i] != stamp {
-                            seen[i] = stamp;
-                            remap[i] = local_clip.len() as u32;
-                            local_clip.push(clip[i]);
-                            local_sep.push(geometry.separation[i]);
-                        }
-                        remap[i]
-                    }));
+                let color = &mut color[..sw * rows];
+                let depth = &mut depth[..sw * rows];
+                for (r, c) in color.chunks_exact_mut(sw).enumerate() {
+                    c.copy_from_slice(&image[r * w + x0..r * w + x0 + sw]);
                 }
-                let sw = strip.width as f32;
-                let bhf = bh as f32;
-                let remap = [
-                    wf / sw,
-                    (wf - 2.0 * strip.x0 as f32 - sw) / sw,
-                    hf / bhf,
-                    -(hf - 2.0 * y0 as f32 - bhf) / bhf,
-                ];
-                let mut fb = Framebuffer::new(strip.width, bh, [0, 0, 0, 255])?;
-                for (r, row) in fb.color.chunks_exact_mut(strip.width as usize).enumerate() {
-                    let start = r * w + strip.x0 as usize;
-                    row.copy_from_slice(&image[start..start + strip.width as usize]);
-                }
-                let shader = StripShader {
-                    clip: &local_clip,
-                    separation: &local_sep,
-                    remap,
-                    image: &image,
+                depth.fill(1.0);
+                let sampler = StripSampler {
+                    image,
                     width: w,
+                    y0,
                     strip: *strip,
                     bilinear: opts.filter == Filter::Bilinear,
-                    links: record_links.then_some(links.as_slice()),
+                    links: band_links,
                 };
-                rasterize(&tris, local_clip.len(), &shader, &mut fb, &raster);
-                for (r, row) in fb.color.chunks_exact(strip.width as usize).enumerate() {
-                    let start = r * w + strip.x0 as usize;
-                    image[start..start + strip.width as usize].copy_from_slice(row);
+                let mut tile = Band {
+                    width: strip.width,
+                    x0: strip.x0,
+                    y0,
+                    color,
+                    depth,
+                };
+                let (c0, c1) = (strip.x0, strip.x0 + strip.width - 1);
+                for &i in here {
+                    let (a, z) = list[i].columns();
+                    if a <= c1 && z >= c0 {
+                        traverse(&list[i], &sampler, &mut tile, &raster);
+                    }
+                }
+                for (r, c) in tile.color.chunks_exact(sw).enumerate() {
+                    image[r * w + x0..r * w + x0 + sw].copy_from_slice(c);
                 }
             }
-            Ok((image, links))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let mut pixels = Vec::with_capacity(width as usize * height as usize);
-    let mut links = record_links.then(Vec::new);
-    for (img, l) in results {
-        pixels.extend(img);
-        if let Some(all) = links.as_mut() {
-            all.extend(l.into_iter().map(AtomicI32::into_inner));
-        }
-    }
+        });
     Ok(StripResult {
         pixels,
         iterations: strips.len() as u32,
         strip_width: strips.first().map_or(0, |s| s.width),
-        links,
+        links: record_links.then(|| links.into_iter().map(AtomicI32::into_inner).collect()),
     })
 }
