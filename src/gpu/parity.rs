@@ -43,6 +43,7 @@ pub fn compare_scene(
     let gpu = r.render(&GpuScene::upload(r, scene)?, plan)?;
     let mut rows = compare_frames(&cpu, &gpu, scene, out)?;
     rows.extend(compare_finalize(r, &cpu, scene, out)?);
+    rows.extend(super::sirds::compare_strips(r, &cpu, scene, out)?);
     Ok(rows)
 }
 
