@@ -20,6 +20,7 @@
 
 pub mod device;
 pub mod effects;
+pub mod finalize_bench;
 pub mod fullscreen;
 pub mod parity;
 pub mod raster;

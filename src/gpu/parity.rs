@@ -208,7 +208,7 @@ pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         return Err(e);
     }
     let ratio = cpu_ms / gpu_ms;
-    Ok(vec![
+    let mut rows = vec![
         row(
             "cpu".into(),
             Some(0.0),
@@ -221,5 +221,8 @@ pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             gpu_ms,
             format!("stereo pair {size} incl. readback; {}", r.adapter_name()),
         ),
-    ])
+    ];
+    rows.extend(super::finalize_bench::rows(&r, &cpu, scene, iters)?);
+    rows.extend(super::sirds::bench_rows(&r, iters)?);
+    Ok(rows)
 }

@@ -11,6 +11,8 @@
 //! - the depth buffer is cleared once per frame: the scissor keeps every strip's depth writes
 //!   inside the strip and strips are disjoint, so each strip starts from a cleared depth buffer
 //!   exactly as the CPU's fresh per-strip framebuffer does;
+//! - each strip draws only the triangles whose shifted bounds reach it (an index range per
+//!   strip), as the CPU culls before its vertex stage;
 //! - B is read back into RGBA pixels.
 //!
 //! The vertex inputs are the CPU's bit for bit (`x + toward·s·w/W` computed on the host with
@@ -207,39 +209,59 @@ impl GpuStrips {
         r.check_target_size(width, height)?;
         let wf = width as f32;
         // Both shifted copies of the vertices, with per_vertex's own f32 expression so that the
-        // positions are the CPU's bit for bit; z then goes to wgpu's [0, w].
-        let shifted = |toward: f32| -> Vec<u8> {
+        // positions are the CPU's bit for bit.
+        let shifted = |toward: f32| -> Vec<Vec4> {
             geometry
                 .clip()
                 .iter()
                 .zip(geometry.separation())
-                .map(|(c, s)| {
-                    GL_TO_WGPU_DEPTH * Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w)
-                })
-                .flat_map(|v| v.to_array())
-                .flat_map(f32::to_ne_bytes)
+                .map(|(c, s)| Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w))
                 .collect()
         };
+        let right_clip = shifted(1.0);
+        let left_clip = strips.iter().any(|s| s.toward < 0.0).then(|| shifted(-1.0));
+        // Per strip, only the triangles that reach it (the CPU culls by the same bounds before
+        // its vertex stage): one index buffer, one range per strip.
+        let x_right = x_bounds(&right_clip, geometry.triangles(), wf);
+        let x_left = left_clip
+            .as_ref()
+            .map(|c| x_bounds(c, geometry.triangles(), wf));
+        let mut indices: Vec<u32> = Vec::new();
+        let mut ranges = Vec::with_capacity(strips.len());
+        for s in &strips {
+            let bounds = match (&x_left, s.toward < 0.0) {
+                (Some(l), true) => l,
+                _ => &x_right,
+            };
+            let (lo, hi) = (s.x0 as f32 - 1.0, (s.x0 + s.width) as f32 + 1.0);
+            let start = indices.len() as u32;
+            for (t, b) in geometry.triangles().iter().zip(bounds) {
+                if b[1] >= lo && b[0] <= hi {
+                    indices.extend(t);
+                }
+            }
+            ranges.push(start..indices.len() as u32);
+        }
         let vertex = |label, bytes: &[u8], usage| buffer_with(r, label, bytes, usage);
-        let right = vertex("strip right", &shifted(1.0), wgpu::BufferUsages::VERTEX);
-        let left = strips
-            .iter()
-            .any(|s| s.toward < 0.0)
-            .then(|| vertex("strip left", &shifted(-1.0), wgpu::BufferUsages::VERTEX));
+        // z goes to wgpu's [0, w]; x, y and w stay bit for bit (GL_TO_WGPU_DEPTH's unit rows).
+        let positions = |label, clip: &[Vec4]| {
+            let bytes: Vec<u8> = clip
+                .iter()
+                .flat_map(|c| (GL_TO_WGPU_DEPTH * *c).to_array())
+                .flat_map(f32::to_ne_bytes)
+                .collect();
+            vertex(label, &bytes, wgpu::BufferUsages::VERTEX)
+        };
+        let right = positions("strip right", &right_clip);
+        let left = left_clip.map(|c| positions("strip left", &c));
         let separation: Vec<u8> = geometry
             .separation()
             .iter()
             .flat_map(|s| s.to_ne_bytes())
             .collect();
         let separation = vertex("strip separation", &separation, wgpu::BufferUsages::VERTEX);
-        let indices: Vec<u8> = geometry
-            .triangles()
-            .iter()
-            .flatten()
-            .flat_map(|i| i.to_ne_bytes())
-            .collect();
-        let index_count = 3 * geometry.triangles().len() as u32;
-        let indices = vertex("strip indices", &indices, wgpu::BufferUsages::INDEX);
+        let index_bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
+        let indices = vertex("strip indices", &index_bytes, wgpu::BufferUsages::INDEX);
 
         let align = r.device.limits().min_uniform_buffer_offset_alignment as u64;
         let slot = STRIP_UNIFORM_BYTES.next_multiple_of(align);
@@ -326,7 +348,7 @@ impl GpuStrips {
                 pass.set_vertex_buffer(0, positions.slice(..));
                 pass.set_vertex_buffer(1, separation.slice(..));
                 pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..index_count, 0, 0..1);
+                pass.draw_indexed(ranges[k].clone(), 0, 0..1);
             }
             // The finished strip into A, where the next iterations read it.
             let origin = wgpu::Origin3d {
@@ -401,6 +423,26 @@ impl StripTargets {
             }),
         }
     }
+}
+
+/// Window-space `[x_min, x_max]` of each triangle of `clip`; everything for a triangle with a
+/// vertex at or behind the eye (the clipper sorts it out). As per_vertex's `triangle_bounds`.
+fn x_bounds(clip: &[Vec4], triangles: &[[u32; 3]], width: f32) -> Vec<[f32; 2]> {
+    triangles
+        .iter()
+        .map(|t| {
+            let mut b = [f32::INFINITY, f32::NEG_INFINITY];
+            for &i in t {
+                let c = clip[i as usize];
+                if c.w.is_nan() || c.w <= 0.0 {
+                    return [f32::NEG_INFINITY, f32::INFINITY];
+                }
+                let x = (c.x / c.w + 1.0) * 0.5 * width;
+                b = [b[0].min(x), b[1].max(x)];
+            }
+            b
+        })
+        .collect()
 }
 
 /// A buffer initialized with `data`.
@@ -614,4 +656,80 @@ pub fn compare_strips(
         has_depth: false,
         strip,
     }])
+}
+
+/// Seed 002 Table 1's first row (512×512, 2,500 triangles, k = 10, left start, bilinear) as a
+/// whole frame on each path: the depth pass (GPU: including its readback, which the depth range
+/// needs), the strip geometry on the host, the strips (GPU: including the image's readback).
+/// The GPU row's error is the share of pixels that differ from the CPU's, in percent.
+///
+/// # Errors
+/// Either path fails.
+pub fn bench_rows(r: &GpuRenderer, iters: usize) -> Result<Vec<crate::bench::Row>> {
+    use crate::bench::{Row, median_ms};
+    use crate::effects::sirds::bench::{TABLE_1, table_scene};
+    use crate::effects::sirds::depth_range;
+    use crate::effects::sirds::per_vertex::per_vertex;
+    use crate::math::StereoRig;
+    use crate::plan::Shading;
+    use crate::render::render_view;
+
+    let (w, h, tris, k, paper_hz) = TABLE_1[0];
+    let s = table_scene(w, h, tris, k)?;
+    let center = StereoRig::center(&s.camera, s.aspect())?;
+    let d = s.sirds.geometry.to_pixels()?;
+    let opts = &s.sirds.per_vertex;
+    let cpu_frame = || -> Result<Vec<[u8; 4]>> {
+        let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
+        let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
+        let g = StripGeometry::new(&s, &center, &range, &d, false);
+        Ok(per_vertex(&g, w, h, &d, &s.sirds.pattern, opts, false)?.pixels)
+    };
+    let gpu_scene = super::GpuScene::upload(r, &s)?;
+    let strips = GpuStrips::new(r)?;
+    let gpu_frame = || -> Result<Vec<[u8; 4]>> {
+        let fb = r.render_view(&gpu_scene, &center, Shading::DepthOnly)?;
+        let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
+        let g = StripGeometry::new(&s, &center, &range, &d, false);
+        Ok(strips.run(r, &g, w, h, &d, &s.sirds.pattern, opts)?.pixels)
+    };
+    let (cpu, gpu) = (cpu_frame()?, gpu_frame()?);
+    let differ = cpu.iter().zip(&gpu).filter(|(a, b)| a != b).count();
+    let differ_percent = 100.0 * differ as f64 / cpu.len() as f64;
+    let mut failed = None;
+    let cpu_ms = median_ms(iters, || cpu_frame().map_err(|e| failed = Some(e)));
+    let gpu_ms = median_ms(iters, || gpu_frame().map_err(|e| failed = Some(e)));
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let row = |setting: String, error, ms: f64, note: String| Row {
+        area: "gpu parity".into(),
+        knob: "sirds strips, seed 002 Table 1".into(),
+        setting,
+        error,
+        error_unit: "% pixels differing from cpu".into(),
+        ms,
+        note,
+    };
+    let what = format!("{w}x{h} {tris} tris k={k}");
+    Ok(vec![
+        row(
+            format!("cpu {what}"),
+            Some(0.0),
+            cpu_ms,
+            format!(
+                "depth pass + strips; cpu/gpu time = {:.2}; paper {paper_hz} Hz",
+                cpu_ms / gpu_ms
+            ),
+        ),
+        row(
+            format!("{} {what}", r.short_name()),
+            Some(differ_percent),
+            gpu_ms,
+            format!(
+                "depth pass + readback + WGSL strips + readback: {:.0} Hz",
+                1e3 / gpu_ms
+            ),
+        ),
+    ])
 }
