@@ -215,12 +215,15 @@ fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Re
     Ok(s)
 }
 
+/// Renders on the GPU and writes the outputs (a per-vertex `sirds` with the WGSL strips).
 #[cfg(feature = "gpu")]
-fn render_gpu(scene: &Scene, plan: &Plan) -> Result<Frame> {
+fn render_gpu(scene: &Scene, plan: &Plan, out: &Path) -> Result<(Frame, Vec<PathBuf>)> {
     use stereolab::gpu::{GpuRenderer, GpuScene};
     let r = GpuRenderer::new()?;
     println!("gpu: {}", r.adapter_name());
-    r.render(&GpuScene::upload(&r, scene)?, plan)
+    let frame = r.render(&GpuScene::upload(&r, scene)?, plan)?;
+    let paths = stereolab::gpu::sirds::write_all(&r, &frame, scene, out)?;
+    Ok((frame, paths))
 }
 
 #[cfg(feature = "gpu")]
@@ -278,7 +281,7 @@ fn no_gpu(what: &str) -> Error {
 }
 
 #[cfg(not(feature = "gpu"))]
-fn render_gpu(_: &Scene, _: &Plan) -> Result<Frame> {
+fn render_gpu(_: &Scene, _: &Plan, _: &Path) -> Result<(Frame, Vec<PathBuf>)> {
     Err(no_gpu("--backend"))
 }
 
@@ -321,11 +324,14 @@ fn run(cli: Cli) -> Result<()> {
                 print!("{}", plan.explain());
                 return Ok(());
             }
-            let frame = match backend {
-                Backend::Cpu => render::render(&s, &plan)?,
-                Backend::Gpu => render_gpu(&s, &plan)?,
+            let (frame, paths) = match backend {
+                Backend::Cpu => {
+                    let frame = render::render(&s, &plan)?;
+                    let paths = output::write_all(&frame, &s, &out)?;
+                    (frame, paths)
+                }
+                Backend::Gpu => render_gpu(&s, &plan, &out)?,
             };
-            let paths = output::write_all(&frame, &s, &out)?;
             println!("rendered {} ({}x{})", scene.display(), s.width, s.height);
             if backend == Backend::Gpu {
                 let ms = frame

@@ -11,6 +11,8 @@ mod golden;
 mod gpu_finalize;
 #[cfg(feature = "gpu")]
 mod gpu_parity;
+#[cfg(feature = "gpu")]
+mod gpu_sirds;
 mod grading;
 mod layout;
 mod rig;

@@ -15,14 +15,17 @@
 //! Layout: [`device`] (adapter, device, pipeline cache), [`raster`] (scene passes),
 //! [`fullscreen`] (the generic full-screen pass that effects mirror), [`effects`] (the finalize
 //! effects in WGSL), [`readback`] (textures to
-//! framebuffers), [`parity`] (render both paths and compare, and the benchmark row).
+//! framebuffers), [`sirds`] (seed 002's strips as render-to-texture ping-pong), [`parity`]
+//! (render both paths and compare, and the benchmark row).
 
 pub mod device;
 pub mod effects;
+pub mod finalize_bench;
 pub mod fullscreen;
 pub mod parity;
 pub mod raster;
 mod readback;
+pub mod sirds;
 
 pub use device::GpuRenderer;
 pub use effects::GpuFinalize;

@@ -43,6 +43,7 @@ pub fn compare_scene(
     let gpu = r.render(&GpuScene::upload(r, scene)?, plan)?;
     let mut rows = compare_frames(&cpu, &gpu, scene, out)?;
     rows.extend(compare_finalize(r, &cpu, scene, out)?);
+    rows.extend(super::sirds::compare_strips(r, &cpu, scene, out)?);
     Ok(rows)
 }
 
@@ -207,7 +208,7 @@ pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         return Err(e);
     }
     let ratio = cpu_ms / gpu_ms;
-    Ok(vec![
+    let mut rows = vec![
         row(
             "cpu".into(),
             Some(0.0),
@@ -220,5 +221,8 @@ pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             gpu_ms,
             format!("stereo pair {size} incl. readback; {}", r.adapter_name()),
         ),
-    ])
+    ];
+    rows.extend(super::finalize_bench::rows(&r, &cpu, scene, iters)?);
+    rows.extend(super::sirds::bench_rows(&r, iters)?);
+    Ok(rows)
 }

@@ -115,6 +115,21 @@ impl StripGeometry {
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }
+
+    /// Cyclopean clip positions (the GPU mirror uploads them).
+    pub fn clip(&self) -> &[Vec4] {
+        &self.clip
+    }
+
+    /// Per-vertex separation in pixels.
+    pub fn separation(&self) -> &[f32] {
+        &self.separation
+    }
+
+    /// Triangles (vertex indices), the background plane last.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
 }
 
 /// What a strip run produced.
@@ -133,14 +148,14 @@ pub struct StripResult {
 
 /// One iteration: a strip `[x0, x0 + width)` and the direction it copies from.
 #[derive(Clone, Copy, Debug)]
-struct Strip {
-    x0: u32,
-    width: u32,
+pub(crate) struct Strip {
+    pub(crate) x0: u32,
+    pub(crate) width: u32,
     /// +1: copies from `x − d` (right-going), −1: from `x + d` (left-going).
-    toward: f32,
+    pub(crate) toward: f32,
     /// Sources allowed in `[lo, hi)`; outside, the pixel keeps the pattern.
-    lo: i64,
-    hi: i64,
+    pub(crate) lo: i64,
+    pub(crate) hi: i64,
 }
 
 /// The strip width and strips for `width` pixels.
@@ -148,7 +163,11 @@ struct Strip {
 /// # Errors
 /// `Invalid` naming `sirds.iterations` when k strips would be wider than `⌊δ⌋ − 1` (a strip
 /// would read itself), or k is 0.
-fn plan_strips(width: u32, d: &Disparity, opts: &PerVertexOptions) -> Result<Vec<Strip>> {
+pub(crate) fn plan_strips(
+    width: u32,
+    d: &Disparity,
+    opts: &PerVertexOptions,
+) -> Result<Vec<Strip>> {
     let widest = (d.min_separation().floor() as u32).saturating_sub(1).max(1);
     let strip = match opts.iterations {
         None => widest,
