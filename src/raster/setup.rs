@@ -331,6 +331,10 @@ pub fn traverse<S: Shader>(
     // The shader's own count (a constant once inlined, so the loop below unrolls). `t` must
     // have been set up with the same varyings (planes past its count copy the depth plane).
     let nvar = shader.varying_count().min(MAX_VARYINGS);
+    debug_assert!(
+        nvar <= t.nvar,
+        "traversed with more varyings than were set up"
+    );
     let mut frag_var: Varyings = [0.0; MAX_VARYINGS];
     let mut fragments = 0;
     let span = t.px1 - t.px0;
@@ -355,12 +359,13 @@ pub fn traverse<S: Shader>(
         if x_lo > x_hi {
             continue;
         }
-        // Index of pixel (px, py) in the tile: row + px.
-        let row = ((py - band.y0 as i64) * band.width as i64 - band.x0 as i64) as usize;
+        // Index of pixel (px, py) in the tile: row + px − x0.
+        let row = (py - band.y0 as i64) as usize * band.width as usize;
+        let x0 = band.x0 as i64;
         if !writes_color && opts.depth_test {
             // Depth only: a branch-free span the compiler vectorizes; z is the same expression
             // as below, so the bits are the same.
-            let depth = &mut band.depth[row + x_lo as usize..=row + x_hi as usize];
+            let depth = &mut band.depth[row + (x_lo - x0) as usize..=row + (x_hi - x0) as usize];
             for (k, d) in depth.iter_mut().enumerate() {
                 let fx = (x_lo + k as i64) as f32 + 0.5 - t.x0;
                 let z = t.z.at(fx, fy).clamp(0.0, 1.0);
@@ -373,7 +378,7 @@ pub fn traverse<S: Shader>(
         for px in x_lo..=x_hi {
             let fx = px as f32 + 0.5 - t.x0;
             let z = t.z.at(fx, fy).clamp(0.0, 1.0);
-            let idx = row + px as usize;
+            let idx = row + (px - x0) as usize;
             if opts.depth_test && z >= band.depth[idx] {
                 continue;
             }
