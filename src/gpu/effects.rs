@@ -190,6 +190,59 @@ impl GpuFinalize {
     }
 }
 
+/// The output made by its WGSL mirror on the GPU, for the finalize outputs that have one
+/// (anaglyphs, remap, occlusion); `None` for every other output (layouts and the parallax
+/// image with its tiny-skia legend stay on the CPU). `stereolab render --backend gpu` uses it.
+///
+/// # Errors
+/// A missing eye pass, or the pass fails.
+pub fn produce_wgsl(
+    r: &GpuRenderer,
+    fin: &GpuFinalize,
+    output: crate::plan::Output,
+    frame: &crate::render::Frame,
+    scene: &crate::scene::Scene,
+) -> Result<Option<RgbaImage>> {
+    use crate::plan::{Output, View};
+    let eye = |v: View| {
+        frame.view(v).ok_or_else(|| {
+            Error::invalid(
+                "plan",
+                output.name(),
+                format!("the {v:?} pass was not run"),
+            )
+        })
+    };
+    let mvps = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
+    Ok(Some(match output {
+        Output::Anaglyph(kind) => fin.anaglyph(
+            r,
+            eye(View::Left)?,
+            eye(View::Right)?,
+            kind,
+            scene.finalize,
+        )?,
+        Output::RemapLeft => fin.remap_color(
+            r,
+            eye(View::Left)?,
+            eye(View::Right)?,
+            mvps[0],
+            mvps[1],
+        )?,
+        Output::RemapRight => fin.remap_color(
+            r,
+            eye(View::Right)?,
+            eye(View::Left)?,
+            mvps[1],
+            mvps[0],
+        )?,
+        Output::Occlusion => {
+            fin.occlusion_image(r, eye(View::Left)?, eye(View::Right)?, mvps)?
+        }
+        _ => return Ok(None),
+    }))
+}
+
 /// remap.wgsl's parameters: `MVP_other · MVP_this⁻¹` composed in f64 and rounded to f32 (as
 /// `Remapper` does for `F32Composed`), the mode, the tolerance, the depth extremes, the colors.
 ///

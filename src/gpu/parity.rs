@@ -222,7 +222,72 @@ pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             format!("stereo pair {size} incl. readback; {}", r.adapter_name()),
         ),
     ];
+    rows.extend(pair_and_anaglyph(&r, &gpu_scene, scene, iters)?);
     rows.extend(super::finalize_bench::rows(&r, &cpu, scene, iters)?);
     rows.extend(super::sirds::bench_rows(&r, iters)?);
     Ok(rows)
+}
+
+/// The stereo pair + Dubois anaglyph frame as each backend's `render` makes it: the CPU path
+/// (passes + `anaglyph`), and the GPU path (passes, readback, then the WGSL anaglyph pass with
+/// its upload and readback, as `render --backend gpu` does), as a ratio in the same run.
+fn pair_and_anaglyph(
+    r: &GpuRenderer,
+    gpu_scene: &GpuScene,
+    scene: &Scene,
+    iters: usize,
+) -> Result<Vec<Row>> {
+    let output = Output::Anaglyph(anaglyph::AnaglyphKind::DuboisRedCyan);
+    let plan = Plan::new(&[output]);
+    let fin = GpuFinalize::new(r)?;
+    let cpu_frame = || -> Result<Image> { produce(output, &render(scene, &plan)?, scene) };
+    let gpu_frame = || -> Result<Image> {
+        let frame = r.render(gpu_scene, &plan)?;
+        super::effects::produce_wgsl(r, &fin, output, &frame, scene)?
+            .map(Image::Rgba)
+            .ok_or_else(|| super::gpu_error("anaglyph", "no WGSL pass"))
+    };
+    let rgba = |i: Image| match i {
+        Image::Rgba(img) => Ok(img),
+        _ => Err(super::gpu_error("anaglyph", "not an RGBA image")),
+    };
+    let (cpu_img, gpu_img) = (rgba(cpu_frame()?)?, rgba(gpu_frame()?)?);
+    let max_diff = cpu_img
+        .as_raw()
+        .iter()
+        .zip(gpu_img.as_raw())
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap_or(0);
+    let mut failed = None;
+    let cpu_ms = median_ms(iters, || cpu_frame().map_err(|e| failed = Some(e)));
+    let gpu_ms = median_ms(iters, || gpu_frame().map_err(|e| failed = Some(e)));
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let size = format!("{}x{}", scene.width, scene.height);
+    let row = |setting: String, ms: f64, note: String| Row {
+        area: "gpu parity".into(),
+        knob: "pair + anaglyph".into(),
+        setting,
+        error: Some(f64::from(max_diff)),
+        error_unit: "max level vs cpu".into(),
+        ms,
+        note,
+    };
+    Ok(vec![
+        row(
+            "cpu".into(),
+            cpu_ms,
+            format!(
+                "stereo pair + Dubois anaglyph {size}; cpu/gpu time = {:.2}",
+                cpu_ms / gpu_ms
+            ),
+        ),
+        row(
+            r.short_name(),
+            gpu_ms,
+            format!("{size}: passes + readback + WGSL anaglyph (upload, pass, readback)"),
+        ),
+    ])
 }

@@ -588,8 +588,9 @@ pub fn from_frame(
 }
 
 /// Writes every output of `frame` as `DIR/<name>.png` like
-/// [`output::write_all`](crate::output::write_all), but makes `sirds` with the GPU strips
-/// (`stereolab render --backend gpu`).
+/// [`output::write_all`](crate::output::write_all), but makes `sirds` with the GPU strips and
+/// the anaglyph, remap and occlusion outputs with their WGSL passes
+/// ([`produce_wgsl`](super::effects::produce_wgsl)) (`stereolab render --backend gpu`).
 ///
 /// # Errors
 /// The folder cannot be created, or an output fails.
@@ -606,6 +607,7 @@ pub fn write_all(
         .contains(&Output::Sirds)
         .then(|| GpuStrips::new(r))
         .transpose()?;
+    let fin = super::effects::GpuFinalize::new(r)?;
     frame
         .plan
         .outputs
@@ -616,7 +618,10 @@ pub fn write_all(
                 (Some(strips), Output::Sirds) => {
                     Image::Rgba(from_frame(r, strips, frame, scene)?.to_rgba_image())
                 }
-                _ => produce(o, frame, scene)?,
+                _ => match super::effects::produce_wgsl(r, &fin, o, frame, scene)? {
+                    Some(img) => Image::Rgba(img),
+                    None => produce(o, frame, scene)?,
+                },
             };
             image.save_png(&path)?;
             Ok(path)
