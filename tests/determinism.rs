@@ -42,3 +42,34 @@ fn two_runs_and_one_vs_many_threads_give_identical_bytes() {
     assert_eq!(one, render_bytes(2), "2 threads differ from 1");
     assert_eq!(one, render_bytes(4), "4 threads differ from 1");
 }
+
+/// SIRDS of a shipped scene (strip algorithm and TIW) under a pool of `threads` threads.
+fn sirds_bytes(threads: usize) -> Vec<Vec<[u8; 4]>> {
+    use stereolab::effects::sirds::{Algorithm, from_frame};
+    let mut scene = Scene::load(&asset("scenes/sirds_sphere.toml"), &[]).unwrap();
+    scene.set_size(300, 150).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let frame = render(&scene, &Plan::new(&[Output::Sirds])).unwrap();
+        [Algorithm::PerVertex, Algorithm::PerPixel]
+            .into_iter()
+            .map(|a| {
+                let mut s = scene.clone();
+                s.sirds.algorithm = a;
+                from_frame(&frame, &s).unwrap().pixels
+            })
+            .collect()
+    })
+}
+
+#[test]
+fn sirds_bytes_do_not_depend_on_the_thread_count() {
+    let one = sirds_bytes(1);
+    assert_ne!(one[0], one[1], "the two algorithms should not agree byte for byte");
+    assert_eq!(one, sirds_bytes(2), "2 threads differ from 1");
+    assert_eq!(one, sirds_bytes(3), "3 threads differ from 1");
+    assert_eq!(one, sirds_bytes(4), "4 threads differ from 1");
+}
