@@ -275,3 +275,17 @@ fn figures_draws_both_eyes_frusta_and_the_plot() {
     );
     assert!(dir.join("parallax_vs_depth.png").exists() && dir.join("rig_toe_in.png").exists());
 }
+
+#[test]
+fn bench_runs_one_group_and_refuses_an_unknown_one() {
+    let err = fails(&["bench", "--only", "nonsense"]);
+    assert!(
+        err.contains("bench.only") && err.contains("nonsense"),
+        "{err}"
+    );
+    let out = stereolab(&["bench", "--only", "raster", "--iterations", "1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("subpixel"), "{text}");
+    assert!(!text.contains("sirds"), "only the raster group ran: {text}");
+}

@@ -68,7 +68,10 @@ fn sirds_bytes(threads: usize) -> Vec<Vec<[u8; 4]>> {
 #[test]
 fn sirds_bytes_do_not_depend_on_the_thread_count() {
     let one = sirds_bytes(1);
-    assert_ne!(one[0], one[1], "the two algorithms should not agree byte for byte");
+    assert_ne!(
+        one[0], one[1],
+        "the two algorithms should not agree byte for byte"
+    );
     assert_eq!(one, sirds_bytes(2), "2 threads differ from 1");
     assert_eq!(one, sirds_bytes(3), "3 threads differ from 1");
     assert_eq!(one, sirds_bytes(4), "4 threads differ from 1");

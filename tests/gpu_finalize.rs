@@ -271,7 +271,10 @@ fn gpu_render_writes_the_wgsl_finalize_outputs() {
         Output::SideBySide,
     ];
     let frame = r
-        .render(&GpuScene::upload(r, &scene).expect("upload"), &Plan::new(&outputs))
+        .render(
+            &GpuScene::upload(r, &scene).expect("upload"),
+            &Plan::new(&outputs),
+        )
         .expect("gpu frame");
     let dir = common::out_dir("gpu_finalize_render");
     let paths = stereolab::gpu::sirds::write_all(r, &frame, &scene, &dir).expect("writes");

@@ -186,7 +186,8 @@ fn sphere_over_ramp(w: u32, h: u32) -> DepthMap {
 
 #[test]
 fn per_pixel_linked_pixels_have_equal_colors() {
-    let depth = sphere_over_ramp(300, 60);
+    // 150 rows: three streamed chunks of rows (64, 64, 22), so rows out of order would show.
+    let depth = sphere_over_ramp(300, 150);
     let d = Geometry::default().to_pixels().expect("valid");
     for hidden_surface in [false, true] {
         let pattern = Pattern::Color { seed: 7 };
@@ -204,6 +205,9 @@ fn per_pixel_linked_pixels_have_equal_colors() {
                 if s as usize != x {
                     links += 1;
                     assert_eq!(row[x], row[s as usize], "row {y}: {x} linked to {s}");
+                } else {
+                    // A free pixel shows the pattern of its own row and column.
+                    assert_eq!(row[x], pattern.color(x as u32, y), "row {y}: free {x}");
                 }
             }
         }

@@ -206,39 +206,21 @@ pub fn produce_wgsl(
     use crate::plan::{Output, View};
     let eye = |v: View| {
         frame.view(v).ok_or_else(|| {
-            Error::invalid(
-                "plan",
-                output.name(),
-                format!("the {v:?} pass was not run"),
-            )
+            Error::invalid("plan", output.name(), format!("the {v:?} pass was not run"))
         })
     };
     let mvps = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
     Ok(Some(match output {
-        Output::Anaglyph(kind) => fin.anaglyph(
-            r,
-            eye(View::Left)?,
-            eye(View::Right)?,
-            kind,
-            scene.finalize,
-        )?,
-        Output::RemapLeft => fin.remap_color(
-            r,
-            eye(View::Left)?,
-            eye(View::Right)?,
-            mvps[0],
-            mvps[1],
-        )?,
-        Output::RemapRight => fin.remap_color(
-            r,
-            eye(View::Right)?,
-            eye(View::Left)?,
-            mvps[1],
-            mvps[0],
-        )?,
-        Output::Occlusion => {
-            fin.occlusion_image(r, eye(View::Left)?, eye(View::Right)?, mvps)?
+        Output::Anaglyph(kind) => {
+            fin.anaglyph(r, eye(View::Left)?, eye(View::Right)?, kind, scene.finalize)?
         }
+        Output::RemapLeft => {
+            fin.remap_color(r, eye(View::Left)?, eye(View::Right)?, mvps[0], mvps[1])?
+        }
+        Output::RemapRight => {
+            fin.remap_color(r, eye(View::Right)?, eye(View::Left)?, mvps[1], mvps[0])?
+        }
+        Output::Occlusion => fin.occlusion_image(r, eye(View::Left)?, eye(View::Right)?, mvps)?,
         _ => return Ok(None),
     }))
 }

@@ -216,6 +216,110 @@ fn large_depth_map(iters: usize) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// Median wall time of `iters` runs of a whole process (stdout into `stdout`), after one
+/// warm-up run; `Err` with what failed.
+fn process_ms(
+    iters: usize,
+    program: &Path,
+    args: &[&std::ffi::OsStr],
+    stdout: &Path,
+) -> std::result::Result<f64, String> {
+    let run = || -> std::result::Result<(), String> {
+        let out = std::fs::File::create(stdout).map_err(|e| e.to_string())?;
+        let status = std::process::Command::new(program)
+            .args(args)
+            .stdout(out)
+            .stderr(std::process::Stdio::null())
+            .status()
+            .map_err(|e| format!("{}: {e}", program.display()))?;
+        if status.success() {
+            Ok(())
+        } else {
+            Err(format!("{} exited with {status}", program.display()))
+        }
+    };
+    run()?;
+    let mut times = Vec::with_capacity(iters.max(1));
+    for _ in 0..iters.max(1) {
+        let t = std::time::Instant::now();
+        run()?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times[times.len() / 2])
+}
+
+/// TIW as a whole process against netpbm's `pamstereogram` on the same 4096×3072 PGM (a
+/// sphere over a ramp), both writing uncompressed images (PPM / PAM), in the same run. Only
+/// from the `stereolab` binary (it runs itself); a row says why when it cannot measure.
+fn netpbm(iters: usize) -> Result<Vec<Row>> {
+    let dir = std::env::temp_dir().join(format!("stereolab-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| crate::Error::io(&dir, e))?;
+    let map = dir.join("sphere_over_ramp.pgm");
+    sphere_over_ramp(4096, 3072)
+        .to_image()
+        .save(&map)
+        .map_err(|e| crate::Error::io(&map, std::io::Error::other(e.to_string())))?;
+    let ours =
+        std::env::current_exe().map_err(|e| crate::Error::io(Path::new("current_exe"), e))?;
+    let out = dir.join("ours.ppm");
+    let ours_args: Vec<&std::ffi::OsStr> = vec![
+        "sirds".as_ref(),
+        "--depth".as_ref(),
+        map.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ];
+    let row = |setting: &str, ms: f64, note: String| Row {
+        area: "sirds".into(),
+        knob: "TIW vs pamstereogram".into(),
+        setting: setting.into(),
+        error: None,
+        error_unit: String::new(),
+        ms,
+        note,
+    };
+    let is_stereolab = ours
+        .file_stem()
+        .is_some_and(|n| n.to_string_lossy() == "stereolab");
+    let result = if is_stereolab {
+        process_ms(iters, &ours, &ours_args, &dir.join("ours.log")).and_then(|a| {
+            process_ms(
+                iters,
+                Path::new("pamstereogram"),
+                &[map.as_os_str()],
+                &dir.join("netpbm.pam"),
+            )
+            .map(|b| (a, b))
+        })
+    } else {
+        Err("only measured from the stereolab binary".into())
+    };
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(match result {
+        Ok((a, b)) => vec![
+            row(
+                "stereolab sirds --depth (hsr)",
+                a,
+                format!(
+                    "4096x3072 PGM -> PPM, whole process; ours/netpbm time = {:.2}",
+                    a / b
+                ),
+            ),
+            row(
+                "pamstereogram",
+                b,
+                "4096x3072 PGM -> PAM, whole process (netpbm, plain algorithm)".into(),
+            ),
+        ],
+        Err(why) => vec![row(
+            "pamstereogram",
+            f64::NAN,
+            format!("not measured: {why}"),
+        )],
+    })
+}
+
 /// All SIRDS rows.
 ///
 /// # Errors
@@ -224,5 +328,6 @@ pub fn rows(iters: usize) -> Result<Vec<Row>> {
     let mut rows = table_1(iters)?;
     rows.extend(knobs(iters.min(5))?);
     rows.extend(large_depth_map(iters)?);
+    rows.extend(netpbm(iters.min(5))?);
     Ok(rows)
 }

@@ -104,6 +104,7 @@ fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u3
         image::DynamicImage::ImageLuma8(g) => {
             (g.into_raw().into_iter().map(u16::from).collect(), 255.0)
         }
+        image::DynamicImage::ImageLuma16(g) => (g.into_raw(), 65535.0),
         other => (other.to_luma16().into_raw(), 65535.0),
     };
     let invert = settings.cross_eyed;
@@ -127,8 +128,10 @@ fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u3
         &settings.pattern,
         &settings.per_pixel,
         |rows| {
-            bytes.clear();
-            bytes.extend(rows.iter().flat_map(|p| [p[0], p[1], p[2]]));
+            bytes.resize(rows.len() * 3, 0);
+            for (b, p) in bytes.chunks_exact_mut(3).zip(rows) {
+                b.copy_from_slice(&p[..3]);
+            }
             writer.write_all(&bytes).map_err(|e| Error::io(out, e))
         },
     )?;

@@ -186,8 +186,9 @@ pub fn per_pixel(
 const CHUNK_ROWS: usize = 64;
 
 /// TIW without holding the whole image: `depth_row(y, buf)` appends row y's nearness to `buf`,
-/// and `sink` receives the finished rows in order, `CHUNK_ROWS` at a time. Rows of a chunk run
-/// in parallel; the bytes do not depend on the thread count.
+/// and `sink` receives the finished rows in order, `CHUNK_ROWS` at a time, while the next
+/// chunk is computed. Rows of a chunk run in parallel; the bytes do not depend on the thread
+/// count.
 ///
 /// # Errors
 /// As [`per_pixel`], or whatever `sink` returns.
@@ -199,7 +200,7 @@ pub fn per_pixel_streamed(
     d: &Disparity,
     pattern: &Pattern,
     opts: &PerPixelOptions,
-    mut sink: impl FnMut(&[[u8; 4]]) -> Result<()>,
+    mut sink: impl FnMut(&[[u8; 4]]) -> Result<()> + Send,
 ) -> Result<()> {
     check_inputs(width, d, pattern)?;
     let o = opts.oversample;
@@ -211,34 +212,50 @@ pub fn per_pixel_streamed(
         ));
     }
     let w = width as usize;
-    let mut chunk = vec![[0u8; 4]; w * CHUNK_ROWS];
+    let compute = |y0: usize, chunk: &mut [[u8; 4]]| {
+        chunk.par_chunks_mut(w).enumerate().for_each_init(
+            || (RowLinker::default(), Vec::new(), Vec::new(), Vec::new()),
+            |(linker, row, fine, colors), (dy, row_out)| {
+                let y = (y0 + dy) as u32;
+                row.clear();
+                depth_row(y, row);
+                let z: &[f32] = if o == 1 {
+                    row
+                } else {
+                    oversample_row(row, o, fine);
+                    fine
+                };
+                linker.link_row(z, y, d, o, opts.hidden_surface);
+                color_row(&linker.same, y, o, pattern, colors);
+                if o == 1 {
+                    row_out.copy_from_slice(colors);
+                } else {
+                    average_subpixels(colors, o, row_out);
+                }
+            },
+        );
+    };
+    // Double-buffered: the sink writes chunk i − 1 while chunk i is computed.
+    let (mut next, mut done) = (
+        vec![[0u8; 4]; w * CHUNK_ROWS],
+        vec![[0u8; 4]; w * CHUNK_ROWS],
+    );
+    let mut done_rows = 0;
     for y0 in (0..height as usize).step_by(CHUNK_ROWS) {
         let rows = CHUNK_ROWS.min(height as usize - y0);
-        chunk[..rows * w]
-            .par_chunks_mut(w)
-            .enumerate()
-            .for_each_init(
-                || (RowLinker::default(), Vec::new(), Vec::new(), Vec::new()),
-                |(linker, row, fine, colors), (dy, row_out)| {
-                    let y = (y0 + dy) as u32;
-                    row.clear();
-                    depth_row(y, row);
-                    let z: &[f32] = if o == 1 {
-                        row
-                    } else {
-                        oversample_row(row, o, fine);
-                        fine
-                    };
-                    linker.link_row(z, y, d, o, opts.hidden_surface);
-                    color_row(&linker.same, y, o, pattern, colors);
-                    if o == 1 {
-                        row_out.copy_from_slice(colors);
-                    } else {
-                        average_subpixels(colors, o, row_out);
-                    }
-                },
-            );
-        sink(&chunk[..rows * w])?;
+        let (_, written) = rayon::join(
+            || compute(y0, &mut next[..rows * w]),
+            || match done_rows {
+                0 => Ok(()),
+                n => sink(&done[..n * w]),
+            },
+        );
+        written?;
+        std::mem::swap(&mut next, &mut done);
+        done_rows = rows;
+    }
+    if done_rows > 0 {
+        sink(&done[..done_rows * w])?;
     }
     Ok(())
 }
