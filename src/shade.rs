@@ -150,6 +150,7 @@ impl Shader for BlinnPhong<'_> {
         self.projection * p_eye.extend(1.0)
     }
 
+    #[inline]
     fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
         let v = f.varyings;
         let p = Vec3::new(v[0], v[1], v[2]);

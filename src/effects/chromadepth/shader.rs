@@ -103,6 +103,7 @@ impl Shader for ChromaDepthShader<'_> {
         self.projection * p_eye.extend(1.0)
     }
 
+    #[inline]
     fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
         let color = self.ramp.sample(self.s_at(f), self.sampling);
         let Some((light_eye, ambient)) = self.lighting else {
@@ -133,6 +134,8 @@ impl Shader for RecordS<'_> {
     fn vertex(&self, index: u32, out: &mut Varyings) -> Vec4 {
         self.0.vertex(index, out)
     }
+
+    #[inline]
     fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
         Some(self.0.s_at(f).to_le_bytes())
     }
