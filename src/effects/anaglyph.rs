@@ -7,6 +7,7 @@
 //! from is said at [`AnaglyphKind::matrices`].
 
 use image::RgbaImage;
+use rayon::prelude::*;
 
 use super::eye_input::check_same_size;
 use crate::error::Result;
@@ -275,23 +276,30 @@ pub fn anaglyph(
     };
     let m = kind.matrices();
     let mut bytes = vec![0u8; left.color.len() * 4];
-    let pixels = bytes
-        .chunks_exact_mut(4)
-        .zip(left.color.iter().zip(&right.color));
+    // Rows in parallel (every pixel is independent, so the bytes do not depend on the thread
+    // count).
+    let w = left.width.max(1) as usize;
+    let rows = bytes
+        .par_chunks_mut(4 * w)
+        .zip(left.color.par_chunks(w).zip(right.color.par_chunks(w)));
     if options.linear_light {
         // A GPU decodes an sRGB texture in the sampler; a 256-entry table is the same thing.
         let decode: Vec<f32> = (0..=255u8)
             .map(|v| srgb_to_linear(v as f32 / 255.0))
             .collect();
         let lin = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| decode[v as usize]);
-        for (out, (l, r)) in pixels {
-            let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
-            out.copy_from_slice(&[c[0], c[1], c[2], 255]);
-        }
+        rows.for_each(|(out, (l, r))| {
+            for (out, (l, r)) in out.chunks_exact_mut(4).zip(l.iter().zip(r)) {
+                let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
+                out.copy_from_slice(&[c[0], c[1], c[2], 255]);
+            }
+        });
     } else {
-        for (out, (l, r)) in pixels {
-            out.copy_from_slice(&anaglyph_pixel(&m, *l, *r, false));
-        }
+        rows.for_each(|(out, (l, r))| {
+            for (out, (l, r)) in out.chunks_exact_mut(4).zip(l.iter().zip(r)) {
+                out.copy_from_slice(&anaglyph_pixel(&m, *l, *r, false));
+            }
+        });
     }
     Ok(RgbaImage::from_raw(left.width, left.height, bytes).expect("4 bytes per pixel"))
 }

@@ -3,6 +3,7 @@
 
 use glam::Mat4;
 use image::RgbaImage;
+use rayon::prelude::*;
 
 use super::remap::{Precision, Visibility, visibility_map};
 use crate::error::Result;
@@ -63,16 +64,21 @@ pub fn occlusion_image(
     let (w, h) = (left.width, left.height);
     let extremes = [depth_extremes(left), depth_extremes(right)];
     let eyes = [left, right];
-    let mut out = RgbaImage::new(2 * w, h);
-    for (k, map) in maps.iter().enumerate() {
-        let (near, far) = extremes[k];
-        for y in 0..h {
-            for x in 0..w {
-                let i = eyes[k].index(x, y);
-                let p = occlusion_pixel(map[i], eyes[k].depth[i], near, far);
-                out.put_pixel(k as u32 * w + x, y, image::Rgba(p));
+    let mut bytes = vec![0u8; 2 * 4 * w as usize * h as usize];
+    let wu = w as usize;
+    // Output rows in parallel: the left eye's row, then the right eye's.
+    bytes
+        .par_chunks_mut(2 * 4 * wu.max(1))
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (k, half) in row.chunks_exact_mut(4 * wu).enumerate() {
+                let (near, far) = extremes[k];
+                for (x, out) in half.chunks_exact_mut(4).enumerate() {
+                    let i = y * wu + x;
+                    out.copy_from_slice(&occlusion_pixel(maps[k][i], eyes[k].depth[i], near, far));
+                }
             }
-        }
-    }
+        });
+    let out = RgbaImage::from_raw(2 * w, h, bytes).expect("4 bytes per pixel");
     Ok(out)
 }

@@ -17,6 +17,7 @@
 
 use glam::{DMat4, DVec4, Mat4, Vec4};
 use image::RgbaImage;
+use rayon::prelude::*;
 
 use super::eye_input::{check_depth, check_same_size};
 use crate::error::{Error, Result};
@@ -197,10 +198,17 @@ pub fn remap_color(
     let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
     let (w, h) = (this.width, this.height);
     let mut bytes = vec![0u8; this.depth.len() * 4];
-    for (i, out) in bytes.chunks_exact_mut(4).enumerate() {
-        let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
-        out.copy_from_slice(&remap_color_pixel(&r, other, x, y, this.depth[i]));
-    }
+    // Rows in parallel: every pixel is independent, so the bytes do not depend on the threads.
+    let wu = w.max(1) as usize;
+    bytes
+        .par_chunks_mut(4 * wu)
+        .zip(this.depth.par_chunks(wu))
+        .enumerate()
+        .for_each(|(y, (row, depth))| {
+            for (x, (out, d)) in row.chunks_exact_mut(4).zip(depth).enumerate() {
+                out.copy_from_slice(&remap_color_pixel(&r, other, x as u32, y as u32, *d));
+            }
+        });
     Ok(RgbaImage::from_raw(w, h, bytes).expect("4 bytes per pixel"))
 }
 
@@ -315,16 +323,23 @@ pub fn visibility_map(
     check_depth("other", other)?;
     let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
     let (w, h) = (this.width, this.height);
-    let mut out = Vec::with_capacity(this.depth.len());
-    for y in 0..h {
-        for x in 0..w {
-            let d = this.depth[this.index(x, y)];
-            let target = r.remap(x, y, d).and_then(|m| {
-                m.texel(w, h)
-                    .map(|(tx, ty)| (m, other.depth[other.index(tx, ty)]))
-            });
-            out.push(classify(d, target, tolerance(depth_slope(this, x, y))));
-        }
-    }
+    // Rows in parallel, collected in order: the same map for any thread count.
+    let out = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let r = &r;
+            (0..w).map(move |x| {
+                let d = this.depth[this.index(x, y)];
+                if d >= 1.0 {
+                    return Visibility::Background; // what `classify` says, without the remap
+                }
+                let target = r.remap(x, y, d).and_then(|m| {
+                    m.texel(w, h)
+                        .map(|(tx, ty)| (m, other.depth[other.index(tx, ty)]))
+                });
+                classify(d, target, tolerance(depth_slope(this, x, y)))
+            })
+        })
+        .collect();
     Ok(out)
 }
