@@ -229,7 +229,7 @@ fn render_gpu(scene: &Scene, plan: &Plan, out: &Path) -> Result<(Frame, Vec<Path
     let r = GpuRenderer::new()?;
     println!("gpu: {}", r.adapter_name());
     let frame = r.render(&GpuScene::upload(&r, scene)?, plan)?;
-    let paths = stereolab::gpu::sirds::write_all(&r, &frame, scene, out)?;
+    let paths = stereolab::gpu::output::write_all(&r, &frame, scene, out)?;
     Ok((frame, paths))
 }
 

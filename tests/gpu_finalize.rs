@@ -253,7 +253,7 @@ fn chromadepth_pass_matches_the_cpu_in_every_mode() {
     }
 }
 
-/// `render --backend gpu` (`gpu::sirds::write_all`) writes the anaglyph, remap and occlusion
+/// `render --backend gpu` (`gpu::output::write_all`) writes the anaglyph, remap and occlusion
 /// outputs from their WGSL passes on the GPU frame, and keeps the layouts on the CPU.
 #[test]
 fn gpu_render_writes_the_wgsl_finalize_outputs() {
@@ -277,7 +277,7 @@ fn gpu_render_writes_the_wgsl_finalize_outputs() {
         )
         .expect("gpu frame");
     let dir = common::out_dir("gpu_finalize_render");
-    let paths = stereolab::gpu::sirds::write_all(r, &frame, &scene, &dir).expect("writes");
+    let paths = stereolab::gpu::output::write_all(r, &frame, &scene, &dir).expect("writes");
     assert_eq!(paths.len(), outputs.len(), "{paths:?}");
     let fin = GpuFinalize::new(r).expect("compiles");
     let mut differs_from_cpu = Vec::new();

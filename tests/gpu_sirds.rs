@@ -182,19 +182,19 @@ fn gpu_strips_reject_too_few_iterations_like_the_cpu() {
     assert!(gpu.to_string().contains("sirds.iterations"), "{gpu}");
 }
 
-/// `render --backend gpu` writes the GPU strips' SIRDS (`gpu::sirds::write_all`), not the CPU's.
+/// `render --backend gpu` writes the GPU strips' SIRDS (`gpu::output::write_all`), not the CPU's.
 #[test]
 fn gpu_render_writes_the_wgsl_sirds() {
     let Some(r) = gpu() else { return };
     let s = scene(SPHERE); // center start, bilinear: a few pixels differ from the CPU
     let f = frame(&s);
     let dir = crate::common::out_dir("gpu_sirds_render");
-    let paths = stereolab::gpu::sirds::write_all(r, &f, &s, &dir).expect("writes");
+    let paths = stereolab::gpu::output::write_all(r, &f, &s, &dir).expect("writes");
     assert_eq!(paths.len(), 2, "{paths:?}");
     let png = image::open(dir.join("sirds.png")).expect("png").to_rgba8();
     let written: Vec<[u8; 4]> = png.pixels().map(|p| p.0).collect();
     let strips = GpuStrips::new(r).expect("compiles");
-    let gpu_sirds = stereolab::gpu::sirds::from_frame(r, &strips, &f, &s).expect("gpu");
+    let gpu_sirds = stereolab::gpu::sirds_frame::from_frame(r, &strips, &f, &s).expect("gpu");
     let cpu_sirds = stereolab::effects::sirds::from_frame(&f, &s).expect("cpu");
     assert_eq!(written, gpu_sirds.pixels);
     assert_ne!(

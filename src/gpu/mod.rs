@@ -22,10 +22,12 @@ pub mod device;
 pub mod effects;
 pub mod finalize_bench;
 pub mod fullscreen;
+pub mod output;
 pub mod parity;
 pub mod raster;
 mod readback;
 pub mod sirds;
+pub mod sirds_frame;
 
 pub use device::GpuRenderer;
 pub use effects::GpuFinalize;

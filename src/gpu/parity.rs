@@ -43,7 +43,7 @@ pub fn compare_scene(
     let gpu = r.render(&GpuScene::upload(r, scene)?, plan)?;
     let mut rows = compare_frames(&cpu, &gpu, scene, out)?;
     rows.extend(compare_finalize(r, &cpu, scene, out)?);
-    rows.extend(super::sirds::compare_strips(r, &cpu, scene, out)?);
+    rows.extend(super::sirds_frame::compare_strips(r, &cpu, scene, out)?);
     Ok(rows)
 }
 
@@ -224,7 +224,7 @@ pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     ];
     rows.extend(pair_and_anaglyph(&r, &gpu_scene, scene, iters)?);
     rows.extend(super::finalize_bench::rows(&r, &cpu, scene, iters)?);
-    rows.extend(super::sirds::bench_rows(&r, iters)?);
+    rows.extend(super::sirds_frame::bench_rows(&r, iters)?);
     Ok(rows)
 }
 

@@ -5,7 +5,7 @@
 //!
 //! - texture A holds the image so far (the pattern at first), texture B is the render target;
 //! - each iteration draws the whole scene into B with the scissor rect = its strip (the CPU
-//!   clips the scene to the strip), depth LESS into one `Depth32Float`, the fragment reading A
+//!   traverses the strip alone the same way), depth LESS into one `Depth32Float`, the fragment reading A
 //!   at `x − toward·s` (shaders/sirds_strip.wgsl); then the strip is copied from B to A, so the
 //!   next iteration reads it;
 //! - the depth buffer is cleared once per frame: the scissor keeps every strip's depth writes
@@ -16,28 +16,22 @@
 //! - B is read back into RGBA pixels.
 //!
 //! The vertex inputs are the CPU's bit for bit (`x + toward·s·w/W` computed on the host with
-//! the same f32 expression, z through [`GL_TO_WGPU_DEPTH`]); what can differ is the rasterizer:
-//! coverage at edges (the CPU clips each triangle to the strip and row band and snaps the
-//! clipped vertices), depth rounding, and the perspective-correct interpolation of `s`
-//! (tests/gpu_sirds.rs measures it).
+//! the same f32 expression, z through [`GL_TO_WGPU_DEPTH`]), and both paths set the triangles
+//! up over the whole target and cut them to the strip with a scissor; what can differ is
+//! depth rounding and the perspective-correct interpolation of `s` (tests/gpu_sirds.rs
+//! measures it). Using the strips: [`sirds_frame`](super::sirds_frame).
 
-use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::mpsc;
 
 use glam::Vec4;
 
-use crate::compare::{Comparison, compare, framebuffer_from_image, write_diff_strip};
 use crate::effects::sirds::per_pixel::check_inputs;
 use crate::effects::sirds::per_vertex::{
     Filter, PerVertexOptions, StripGeometry, StripResult, plan_strips,
 };
-use crate::effects::sirds::{self, Algorithm, Disparity, Pattern, Sirds, pattern, scene_depth};
+use crate::effects::sirds::{Disparity, Pattern};
 use crate::error::Result;
-use crate::output::{Image, produce};
-use crate::plan::Output;
-use crate::render::Frame;
-use crate::scene::Scene;
 
 use super::device::GpuRenderer;
 use super::readback::{COLOR_FORMAT, padded_row_bytes};
@@ -542,199 +536,4 @@ fn read_texture(
     }
     t.readback.unmap();
     Ok(pixels)
-}
-
-/// The scene's SIRDS (output `sirds`) from `frame`'s depth pass, as
-/// [`sirds::from_frame`](crate::effects::sirds::from_frame) but with the strips on the GPU.
-/// The per-pixel algorithm (TIW: a serial chain of links along each row) has no WGSL mirror and
-/// runs on the CPU.
-///
-/// # Errors
-/// As `sirds::from_frame` and [`GpuStrips::run`].
-pub fn from_frame(
-    r: &GpuRenderer,
-    strips: &GpuStrips,
-    frame: &Frame,
-    scene: &Scene,
-) -> Result<Sirds> {
-    let s = &scene.sirds;
-    if s.algorithm != Algorithm::PerVertex {
-        return sirds::from_frame(frame, scene);
-    }
-    let (depth, range) = scene_depth(frame, scene)?;
-    let d = s.geometry.to_pixels()?;
-    let g = StripGeometry::new(scene, &frame.center, &range, &d, s.cross_eyed);
-    let res = strips.run(
-        r,
-        &g,
-        scene.width,
-        scene.height,
-        &d,
-        &s.pattern,
-        &s.per_vertex,
-    )?;
-    let mut pixels = res.pixels;
-    if s.guide_dots {
-        pattern::draw_guide_dots(&mut pixels, scene.width, scene.height, d.max_separation());
-    }
-    Ok(Sirds {
-        pixels,
-        width: scene.width,
-        height: scene.height,
-        depth,
-        disparity: d,
-        iterations: Some(res.iterations),
-    })
-}
-
-/// Writes every output of `frame` as `DIR/<name>.png` like
-/// [`output::write_all`](crate::output::write_all), but makes `sirds` with the GPU strips and
-/// the anaglyph, remap and occlusion outputs with their WGSL passes
-/// ([`produce_wgsl`](super::effects::produce_wgsl)) (`stereolab render --backend gpu`).
-///
-/// # Errors
-/// The folder cannot be created, or an output fails.
-pub fn write_all(
-    r: &GpuRenderer,
-    frame: &Frame,
-    scene: &Scene,
-    dir: &Path,
-) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| crate::Error::io(dir, e))?;
-    let strips = frame
-        .plan
-        .outputs
-        .contains(&Output::Sirds)
-        .then(|| GpuStrips::new(r))
-        .transpose()?;
-    let fin = super::effects::GpuFinalize::new(r)?;
-    frame
-        .plan
-        .outputs
-        .iter()
-        .map(|&o| {
-            let path = dir.join(format!("{}.png", o.name()));
-            let image = match (&strips, o) {
-                (Some(strips), Output::Sirds) => {
-                    Image::Rgba(from_frame(r, strips, frame, scene)?.to_rgba_image())
-                }
-                _ => match super::effects::produce_wgsl(r, &fin, o, frame, scene)? {
-                    Some(img) => Image::Rgba(img),
-                    None => produce(o, frame, scene)?,
-                },
-            };
-            image.save_png(&path)?;
-            Ok(path)
-        })
-        .collect()
-}
-
-/// Strip parity apart from raster parity: the SIRDS of the CPU frame's own depth pass made by
-/// the CPU strips and by the WGSL strips (same [`StripGeometry`], same strips), as a row
-/// `sirds (wgsl strips)`. Empty unless the plan makes a per-vertex `sirds`.
-///
-/// # Errors
-/// Either path fails, or a strip cannot be written.
-pub fn compare_strips(
-    r: &GpuRenderer,
-    frame: &Frame,
-    scene: &Scene,
-    out: Option<&Path>,
-) -> Result<Vec<Comparison>> {
-    if !frame.plan.outputs.contains(&Output::Sirds) || scene.sirds.algorithm != Algorithm::PerVertex
-    {
-        return Ok(Vec::new());
-    }
-    let cpu = sirds::from_frame(frame, scene)?.to_rgba_image();
-    let gpu = from_frame(r, &GpuStrips::new(r)?, frame, scene)?.to_rgba_image();
-    let (e, a) = (
-        framebuffer_from_image(&cpu, scene.background),
-        framebuffer_from_image(&gpu, scene.background),
-    );
-    let metrics = compare(&e, &a)?;
-    let strip = out
-        .map(|dir| write_diff_strip(&e, &a, dir, "sirds_wgsl_strips"))
-        .transpose()?;
-    Ok(vec![Comparison {
-        name: "sirds (wgsl strips)".into(),
-        metrics,
-        has_depth: false,
-        strip,
-    }])
-}
-
-/// Seed 002 Table 1's first row (512×512, 2,500 triangles, k = 10, left start, bilinear) as a
-/// whole frame on each path: the depth pass (GPU: including its readback, which the depth range
-/// needs), the strip geometry on the host, the strips (GPU: including the image's readback).
-/// The GPU row's error is the share of pixels that differ from the CPU's, in percent.
-///
-/// # Errors
-/// Either path fails.
-pub fn bench_rows(r: &GpuRenderer, iters: usize) -> Result<Vec<crate::bench::Row>> {
-    use crate::bench::{Row, median_ms};
-    use crate::effects::sirds::bench::{TABLE_1, table_scene};
-    use crate::effects::sirds::depth_range;
-    use crate::effects::sirds::per_vertex::per_vertex;
-    use crate::math::StereoRig;
-    use crate::plan::Shading;
-    use crate::render::render_view;
-
-    let (w, h, tris, k, paper_hz) = TABLE_1[0];
-    let s = table_scene(w, h, tris, k)?;
-    let center = StereoRig::center(&s.camera, s.aspect())?;
-    let d = s.sirds.geometry.to_pixels()?;
-    let opts = &s.sirds.per_vertex;
-    let cpu_frame = || -> Result<Vec<[u8; 4]>> {
-        let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
-        let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
-        let g = StripGeometry::new(&s, &center, &range, &d, false);
-        Ok(per_vertex(&g, w, h, &d, &s.sirds.pattern, opts, false)?.pixels)
-    };
-    let gpu_scene = super::GpuScene::upload(r, &s)?;
-    let strips = GpuStrips::new(r)?;
-    let gpu_frame = || -> Result<Vec<[u8; 4]>> {
-        let fb = r.render_view(&gpu_scene, &center, Shading::DepthOnly)?;
-        let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
-        let g = StripGeometry::new(&s, &center, &range, &d, false);
-        Ok(strips.run(r, &g, w, h, &d, &s.sirds.pattern, opts)?.pixels)
-    };
-    let (cpu, gpu) = (cpu_frame()?, gpu_frame()?);
-    let differ = cpu.iter().zip(&gpu).filter(|(a, b)| a != b).count();
-    let differ_percent = 100.0 * differ as f64 / cpu.len() as f64;
-    let mut failed = None;
-    let cpu_ms = median_ms(iters, || cpu_frame().map_err(|e| failed = Some(e)));
-    let gpu_ms = median_ms(iters, || gpu_frame().map_err(|e| failed = Some(e)));
-    if let Some(e) = failed {
-        return Err(e);
-    }
-    let row = |setting: String, error, ms: f64, note: String| Row {
-        area: "gpu parity".into(),
-        knob: "sirds strips, seed 002 Table 1".into(),
-        setting,
-        error,
-        error_unit: "% pixels differing from cpu".into(),
-        ms,
-        note,
-    };
-    let what = format!("{w}x{h} {tris} tris k={k}");
-    Ok(vec![
-        row(
-            format!("cpu {what}"),
-            Some(0.0),
-            cpu_ms,
-            format!(
-                "depth pass + strips; cpu/gpu time = {:.2}; paper {paper_hz} Hz",
-                cpu_ms / gpu_ms
-            ),
-        ),
-        row(
-            format!("{} {what}", r.short_name()),
-            Some(differ_percent),
-            gpu_ms,
-            format!(
-                "depth pass + readback + WGSL strips + readback: {:.0} Hz",
-                1e3 / gpu_ms
-            ),
-        ),
-    ])
 }
