@@ -253,8 +253,8 @@ fn chromadepth_pass_matches_the_cpu_in_every_mode() {
     }
 }
 
-/// `render --backend gpu` (`gpu::output::write_all`) writes the anaglyph, remap and occlusion
-/// outputs from their WGSL passes on the GPU frame, and keeps the layouts on the CPU.
+/// `render --backend gpu` (`gpu::output::write_all`) writes the anaglyph, remap, occlusion and
+/// parallax outputs from their WGSL passes on the GPU frame, and keeps the layouts on the CPU.
 #[test]
 fn gpu_render_writes_the_wgsl_finalize_outputs() {
     use stereolab::gpu::{GpuScene, effects::produce_wgsl};
@@ -268,6 +268,7 @@ fn gpu_render_writes_the_wgsl_finalize_outputs() {
         Output::Anaglyph(AnaglyphKind::DuboisRedCyan),
         Output::RemapLeft,
         Output::Occlusion,
+        Output::Parallax,
         Output::SideBySide,
     ];
     let frame = r

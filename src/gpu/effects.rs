@@ -191,8 +191,9 @@ impl GpuFinalize {
 }
 
 /// The output made by its WGSL mirror on the GPU, for the finalize outputs that have one
-/// (anaglyphs, remap, occlusion); `None` for every other output (layouts and the parallax
-/// image with its tiny-skia legend stay on the CPU). `stereolab render --backend gpu` uses it.
+/// (anaglyphs, remap, occlusion, parallax color; the parallax legend is tiny-skia's, drawn on
+/// the host at the GPU's color scale); `None` for every other output (layouts stay on the
+/// CPU). `stereolab render --backend gpu` uses it.
 ///
 /// # Errors
 /// A missing eye pass, or the pass fails.
@@ -221,6 +222,23 @@ pub fn produce_wgsl(
             fin.remap_color(r, eye(View::Right)?, eye(View::Left)?, mvps[1], mvps[0])?
         }
         Output::Occlusion => fin.occlusion_image(r, eye(View::Left)?, eye(View::Right)?, mvps)?,
+        Output::Parallax => {
+            let left = eye(View::Left)?;
+            let (values, area) = fin.parallax(r, left, &ParallaxRig::of_scene(scene)?)?;
+            // The same scale the pass used: the largest |p|, at least half a pixel.
+            let scale = values
+                .iter()
+                .filter(|p| !p.is_nan())
+                .fold(0.5f32, |m, p| m.max(p.abs()));
+            let scale = f64::from(scale);
+            let legend = crate::effects::legend::draw_legend(left.width, scale, &|p| {
+                crate::effects::parallax::parallax_color(p, scale)
+            })?;
+            let mut bytes = area.into_raw();
+            bytes.extend_from_slice(legend.data());
+            RgbaImage::from_raw(left.width, left.height + legend.height(), bytes)
+                .ok_or_else(|| Error::invalid("parallax", "image", "size mismatch"))?
+        }
         _ => return Ok(None),
     }))
 }
