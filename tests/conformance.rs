@@ -400,3 +400,68 @@ proptest! {
         prop_assert!(counts.iter().all(|&c| c <= 1), "a pixel was covered twice");
     }
 }
+
+/// Colors each fragment by its interpolated varyings, so that any difference in coverage,
+/// depth or interpolation shows in the bytes.
+struct Gradient {
+    clip: Vec<Vec4>,
+}
+
+impl Shader for Gradient {
+    fn varying_count(&self) -> usize {
+        2
+    }
+    fn vertex(&self, i: u32, out: &mut Varyings) -> Vec4 {
+        out[0] = (i % 7) as f32 / 6.0;
+        out[1] = (i % 5) as f32 / 4.0;
+        self.clip[i as usize]
+    }
+    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
+        let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0) as u8;
+        Some([q(f.varyings[0]), q(f.varyings[1]), q(f.depth), 255])
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Traversing a frame tile by tile (a column and row scissor per tile, as the strip
+    /// algorithm does) gives the bytes of the whole-frame pass: coverage, depth and varyings.
+    #[test]
+    fn tiles_give_the_bytes_of_the_whole_frame(
+        verts in proptest::collection::vec((-1.3f32..1.3, -1.3f32..1.3, -0.9f32..0.9, 0.5f32..3.0), 30),
+        tile_w in 5u32..40,
+        tile_h in 3u32..30,
+    ) {
+        use stereolab::raster::{Band, setup_triangles, traverse};
+        let clip: Vec<Vec4> = verts.iter().map(|&(x, y, z, w)| Vec4::new(x * w, y * w, z * w, w)).collect();
+        let tris: Vec<[u32; 3]> = (0..10).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+        let shader = Gradient { clip };
+        let opts = RasterOptions::default();
+        let mut whole = Framebuffer::new(W, H, [0, 0, 0, 255]).unwrap();
+        rasterize(&tris, shader.clip.len(), &shader, &mut whole, &opts);
+        let (setups, _) = setup_triangles(&tris, shader.clip.len(), &shader, W, H, &opts);
+        let mut tiled = Framebuffer::new(W, H, [0, 0, 0, 255]).unwrap();
+        for y0 in (0..H).step_by(tile_h as usize) {
+            for x0 in (0..W).step_by(tile_w as usize) {
+                let (tw, th) = (tile_w.min(W - x0), tile_h.min(H - y0));
+                let n = (tw * th) as usize;
+                let (mut color, mut depth) = (vec![[0, 0, 0, 255]; n], vec![1.0f32; n]);
+                let mut tile = Band { width: tw, x0, y0, color: &mut color, depth: &mut depth };
+                for t in &setups {
+                    traverse(t, &shader, &mut tile, &opts);
+                }
+                for r in 0..th {
+                    for c in 0..tw {
+                        let i = tiled.index(x0 + c, y0 + r);
+                        tiled.color[i] = color[(r * tw + c) as usize];
+                        tiled.depth[i] = depth[(r * tw + c) as usize];
+                    }
+                }
+            }
+        }
+        prop_assert_eq!(&tiled.color, &whole.color);
+        let bits = |d: &[f32]| d.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        prop_assert_eq!(bits(&tiled.depth), bits(&whole.depth));
+    }
+}
