@@ -10,9 +10,9 @@
 //!   next iteration reads it;
 //! - the depth buffer is cleared once per frame: the scissor keeps every strip's depth writes
 //!   inside the strip and strips are disjoint, so each strip starts from a cleared depth buffer
-//!   exactly as the CPU's fresh per-strip framebuffer does;
+//!   exactly as the CPU's fresh per-tile depth buffer does;
 //! - each strip draws only the triangles whose shifted bounds reach it (an index range per
-//!   strip), as the CPU culls before its vertex stage;
+//!   strip), as the CPU traverses only the triangles whose columns reach the strip;
 //! - B is read back into RGBA pixels.
 //!
 //! The vertex inputs are the CPU's bit for bit (`x + toward·s·w/W` computed on the host with
