@@ -135,6 +135,20 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
 /// # Errors
 /// The folder cannot be created, or an output fails.
 pub fn write_all(frame: &Frame, scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
+    write_all_with(frame, dir, |o| produce(o, frame, scene))
+}
+
+/// Writes every output of `frame`'s plan, made by `make`, as `DIR/<name>.png`, in plan order;
+/// returns the paths. [`write_all`] makes them with [`produce`]; the GPU backend with its
+/// WGSL passes.
+///
+/// # Errors
+/// The folder cannot be created, or an output fails.
+pub fn write_all_with(
+    frame: &Frame,
+    dir: &Path,
+    mut make: impl FnMut(Output) -> Result<Image>,
+) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     frame
         .plan
@@ -142,7 +156,7 @@ pub fn write_all(frame: &Frame, scene: &Scene, dir: &Path) -> Result<Vec<PathBuf
         .iter()
         .map(|&o| {
             let path = dir.join(format!("{}.png", o.name()));
-            produce(o, frame, scene)?.save_png(&path)?;
+            make(o)?.save_png(&path)?;
             Ok(path)
         })
         .collect()

@@ -187,6 +187,18 @@ pub struct AnaglyphOptions {
     pub swap_eyes: bool,
 }
 
+impl AnaglyphOptions {
+    /// The eyes in the order the matrices read them: `(ML's input, MR's input)`, that is
+    /// `(left, right)`, or `(right, left)` with `swap_eyes`.
+    pub fn eyes<'a, T>(&self, left: &'a T, right: &'a T) -> (&'a T, &'a T) {
+        if self.swap_eyes {
+            (right, left)
+        } else {
+            (left, right)
+        }
+    }
+}
+
 /// The IEC 61966-2-1 sRGB decoding of one channel in [0, 1]:
 /// `c ≤ 0.04045 ? c/12.92 : ((c + 0.055)/1.055)^2.4`.
 #[inline]
@@ -269,11 +281,7 @@ pub fn anaglyph(
     options: AnaglyphOptions,
 ) -> Result<RgbaImage> {
     check_same_size(left, right)?;
-    let (left, right) = if options.swap_eyes {
-        (right, left)
-    } else {
-        (left, right)
-    };
+    let (left, right) = options.eyes(left, right);
     let m = kind.matrices();
     let mut bytes = vec![0u8; left.color.len() * 4];
     // Rows in parallel (every pixel is independent, so the bytes do not depend on the thread

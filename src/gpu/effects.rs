@@ -84,11 +84,7 @@ impl GpuFinalize {
         options: AnaglyphOptions,
     ) -> Result<RgbaImage> {
         check_same_size(left, right)?;
-        let (left, right) = if options.swap_eyes {
-            (right, left)
-        } else {
-            (left, right)
-        };
+        let (left, right) = options.eyes(left, right);
         let m = kind.matrices();
         let mut params = Vec::with_capacity(28);
         for row in m.left.iter().chain(&m.right) {

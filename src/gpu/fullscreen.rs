@@ -11,6 +11,7 @@ use crate::framebuffer::Framebuffer;
 use super::device::GpuRenderer;
 use super::gpu_error;
 use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
+use super::resources::{texture_2d, write_texels};
 
 /// Vertex stage and helpers every full-screen shader gets.
 const PRELUDE_WGSL: &str = include_str!("shaders/fullscreen.wgsl");
@@ -273,35 +274,14 @@ fn upload_texture(
     height: u32,
     data: &[u8],
 ) -> wgpu::TextureView {
-    let size = wgpu::Extent3d {
+    let texture = texture_2d(
+        r,
+        "fullscreen input",
         width,
         height,
-        depth_or_array_layers: 1,
-    };
-    let texture = r.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("fullscreen input"),
-        size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
         format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    r.queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture: &texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        data,
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(4 * width),
-            rows_per_image: Some(height),
-        },
-        size,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
     );
+    write_texels(r, &texture, data);
     texture.create_view(&wgpu::TextureViewDescriptor::default())
 }

@@ -26,6 +26,7 @@ pub mod output;
 pub mod parity;
 pub mod raster;
 mod readback;
+mod resources;
 pub mod sirds;
 pub mod sirds_frame;
 

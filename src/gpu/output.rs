@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::Result;
-use crate::output::{Image, produce};
+use crate::output::{Image, produce, write_all_with};
 use crate::plan::Output;
 use crate::render::Frame;
 use crate::scene::Scene;
@@ -15,7 +15,7 @@ use super::sirds_frame::from_frame;
 
 /// Writes every output of `frame` as `DIR/<name>.png` like
 /// [`output::write_all`](crate::output::write_all), but makes `sirds` with the GPU strips and
-/// the anaglyph, remap and occlusion outputs with their WGSL passes
+/// the anaglyph, remap, occlusion and parallax outputs with their WGSL passes
 /// ([`produce_wgsl`](super::effects::produce_wgsl)) (`stereolab render --backend gpu`).
 ///
 /// # Errors
@@ -26,7 +26,6 @@ pub fn write_all(
     scene: &Scene,
     dir: &Path,
 ) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| crate::Error::io(dir, e))?;
     let strips = frame
         .plan
         .outputs
@@ -34,23 +33,15 @@ pub fn write_all(
         .then(|| GpuStrips::new(r))
         .transpose()?;
     let fin = super::effects::GpuFinalize::new(r)?;
-    frame
-        .plan
-        .outputs
-        .iter()
-        .map(|&o| {
-            let path = dir.join(format!("{}.png", o.name()));
-            let image = match (&strips, o) {
-                (Some(strips), Output::Sirds) => {
-                    Image::Rgba(from_frame(r, strips, frame, scene)?.to_rgba_image())
-                }
-                _ => match super::effects::produce_wgsl(r, &fin, o, frame, scene)? {
-                    Some(img) => Image::Rgba(img),
-                    None => produce(o, frame, scene)?,
-                },
-            };
-            image.save_png(&path)?;
-            Ok(path)
+    write_all_with(frame, dir, |o| {
+        Ok(match (&strips, o) {
+            (Some(strips), Output::Sirds) => {
+                Image::Rgba(from_frame(r, strips, frame, scene)?.to_rgba_image())
+            }
+            _ => match super::effects::produce_wgsl(r, &fin, o, frame, scene)? {
+                Some(img) => Image::Rgba(img),
+                None => produce(o, frame, scene)?,
+            },
         })
-        .collect()
+    })
 }

@@ -20,6 +20,7 @@ use crate::shade::BlinnPhong;
 
 use super::device::{GpuRenderer, PipelineKey};
 use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
+use super::resources::buffer_with;
 use super::{GL_TO_WGPU_DEPTH, gpu_error};
 
 /// The mirror of [`BlinnPhong`](crate::shade::BlinnPhong).
@@ -90,25 +91,6 @@ impl<'a> GpuScene<'a> {
             .collect();
         Ok(GpuScene { scene, meshes })
     }
-}
-
-/// A buffer initialized with `data`.
-fn buffer_with(
-    r: &GpuRenderer,
-    label: &str,
-    data: &[u8],
-    usage: wgpu::BufferUsages,
-) -> wgpu::Buffer {
-    let b = r.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: (data.len() as u64)
-            .next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT)
-            .max(4),
-        usage: usage | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    r.queue.write_buffer(&b, 0, data);
-    b
 }
 
 impl GpuRenderer {

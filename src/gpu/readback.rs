@@ -10,6 +10,7 @@ use crate::framebuffer::Framebuffer;
 
 use super::device::GpuRenderer;
 use super::gpu_error;
+use super::resources::texture_2d;
 
 /// The color format of every target: 8-bit RGBA, no sRGB conversion (DESIGN.md).
 pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -95,23 +96,8 @@ impl Target {
     /// A side the device does not support.
     fn new(r: &GpuRenderer, width: u32, height: u32, depth_kind: DepthKind) -> Result<Self> {
         r.check_target_size(width, height)?;
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
-        let texture = |label, format| {
-            r.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        };
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let texture = |label, format| texture_2d(r, label, width, height, format, usage);
         let color = texture("color target", COLOR_FORMAT);
         let depth = texture("depth target", depth_kind.format());
         let padded_row = padded_row_bytes(width);

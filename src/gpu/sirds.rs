@@ -35,6 +35,7 @@ use crate::error::Result;
 
 use super::device::GpuRenderer;
 use super::readback::{COLOR_FORMAT, padded_row_bytes};
+use super::resources::{buffer_with, texture_2d, write_texels};
 use super::{GL_TO_WGPU_DEPTH, gpu_error};
 
 /// The mirror of `StripShader`.
@@ -202,20 +203,15 @@ impl GpuStrips {
         let strips = plan_strips(width, d, opts)?;
         r.check_target_size(width, height)?;
         let wf = width as f32;
-        // Both shifted copies of the vertices, with per_vertex's own f32 expression so that the
+        // Both shifted copies of the vertices, from the function the CPU strips use, so that the
         // positions are the CPU's bit for bit.
-        let shifted = |toward: f32| -> Vec<Vec4> {
-            geometry
-                .clip()
-                .iter()
-                .zip(geometry.separation())
-                .map(|(c, s)| Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w))
-                .collect()
-        };
-        let right_clip = shifted(1.0);
-        let left_clip = strips.iter().any(|s| s.toward < 0.0).then(|| shifted(-1.0));
-        // Per strip, only the triangles that reach it (the CPU culls by the same bounds before
-        // its vertex stage): one index buffer, one range per strip.
+        let right_clip = geometry.shifted(1.0, width);
+        let left_clip = strips
+            .iter()
+            .any(|s| s.toward < 0.0)
+            .then(|| geometry.shifted(-1.0, width));
+        // Per strip, only the triangles that reach it (the CPU traverses only the triangles
+        // whose columns reach the strip): one index buffer, one range per strip.
         let x_right = x_bounds(&right_clip, geometry.triangles(), wf);
         let x_left = left_clip
             .as_ref()
@@ -280,7 +276,7 @@ impl GpuStrips {
         };
         let pattern_bytes: Vec<u8> = pattern.fill(width, height).into_iter().flatten().collect();
         for texture in [&t.a, &t.b] {
-            write_texture(r, texture, width, height, &pattern_bytes);
+            write_texels(r, texture, &pattern_bytes);
         }
         let a_view = t.a.create_view(&wgpu::TextureViewDescriptor::default());
         let b_view = t.b.create_view(&wgpu::TextureViewDescriptor::default());
@@ -379,23 +375,7 @@ impl GpuStrips {
 
 impl StripTargets {
     fn new(r: &GpuRenderer, width: u32, height: u32) -> StripTargets {
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
-        let texture = |label, format, usage| {
-            r.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |label, format, usage| texture_2d(r, label, width, height, format, usage);
         use wgpu::TextureUsages as U;
         let image = U::TEXTURE_BINDING | U::RENDER_ATTACHMENT | U::COPY_SRC | U::COPY_DST;
         let depth = texture(
@@ -420,7 +400,7 @@ impl StripTargets {
 }
 
 /// Window-space `[x_min, x_max]` of each triangle of `clip`; everything for a triangle with a
-/// vertex at or behind the eye (the clipper sorts it out). As per_vertex's `triangle_bounds`.
+/// vertex at or behind the eye (the clipper sorts it out).
 fn x_bounds(clip: &[Vec4], triangles: &[[u32; 3]], width: f32) -> Vec<[f32; 2]> {
     triangles
         .iter()
@@ -437,48 +417,6 @@ fn x_bounds(clip: &[Vec4], triangles: &[[u32; 3]], width: f32) -> Vec<[f32; 2]> 
             b
         })
         .collect()
-}
-
-/// A buffer initialized with `data`.
-fn buffer_with(
-    r: &GpuRenderer,
-    label: &str,
-    data: &[u8],
-    usage: wgpu::BufferUsages,
-) -> wgpu::Buffer {
-    let b = r.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: (data.len() as u64)
-            .next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT)
-            .max(4),
-        usage: usage | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    r.queue.write_buffer(&b, 0, data);
-    b
-}
-
-/// Writes tightly packed RGBA8 rows into `texture`.
-fn write_texture(r: &GpuRenderer, texture: &wgpu::Texture, width: u32, height: u32, data: &[u8]) {
-    r.queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        data,
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(4 * width),
-            rows_per_image: Some(height),
-        },
-        wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-    );
 }
 
 /// Copies B into the readback buffer, submits `encoder`, waits, and unpads the rows.

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use crate::compare::{Comparison, compare, framebuffer_from_image, write_diff_strip};
 use crate::effects::sirds::per_vertex::StripGeometry;
-use crate::effects::sirds::{self, Algorithm, Sirds, pattern, scene_depth};
+use crate::effects::sirds::{self, Algorithm, Sirds};
 use crate::error::Result;
 use crate::plan::Output;
 use crate::render::Frame;
@@ -28,32 +28,16 @@ pub fn from_frame(
     scene: &Scene,
 ) -> Result<Sirds> {
     let s = &scene.sirds;
-    if s.algorithm != Algorithm::PerVertex {
-        return sirds::from_frame(frame, scene);
-    }
-    let (depth, range) = scene_depth(frame, scene)?;
-    let d = s.geometry.to_pixels()?;
-    let g = StripGeometry::new(scene, &frame.center, &range, &d, s.cross_eyed);
-    let res = strips.run(
-        r,
-        &g,
-        scene.width,
-        scene.height,
-        &d,
-        &s.pattern,
-        &s.per_vertex,
-    )?;
-    let mut pixels = res.pixels;
-    if s.guide_dots {
-        pattern::draw_guide_dots(&mut pixels, scene.width, scene.height, d.max_separation());
-    }
-    Ok(Sirds {
-        pixels,
-        width: scene.width,
-        height: scene.height,
-        depth,
-        disparity: d,
-        iterations: Some(res.iterations),
+    sirds::from_frame_with(frame, scene, |g, d| {
+        strips.run(
+            r,
+            g,
+            scene.width,
+            scene.height,
+            d,
+            &s.pattern,
+            &s.per_vertex,
+        )
     })
 }
 

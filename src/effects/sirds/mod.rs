@@ -119,6 +119,31 @@ pub fn scene_depth(frame: &Frame, scene: &Scene) -> Result<(DepthMap, DepthRange
 /// As [`scene_depth`], [`per_pixel::per_pixel`] and [`per_vertex::per_vertex`].
 pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
     let s = &scene.sirds;
+    from_frame_with(frame, scene, |g, d| {
+        per_vertex::per_vertex(
+            g,
+            scene.width,
+            scene.height,
+            d,
+            &s.pattern,
+            &s.per_vertex,
+            false,
+        )
+    })
+}
+
+/// [`from_frame`] with the per-vertex strips made by `strips` from the strip geometry and the
+/// disparity (the CPU's [`per_vertex::per_vertex`], or the GPU's ping-pong); everything else
+/// (depth range, TIW, guide dots) is the same for both.
+///
+/// # Errors
+/// As [`from_frame`], and whatever `strips` returns.
+pub fn from_frame_with(
+    frame: &Frame,
+    scene: &Scene,
+    strips: impl FnOnce(&per_vertex::StripGeometry, &Disparity) -> Result<per_vertex::StripResult>,
+) -> Result<Sirds> {
+    let s = &scene.sirds;
     let (depth, range) = scene_depth(frame, scene)?;
     let d = s.geometry.to_pixels()?;
     let (mut pixels, iterations) = match s.algorithm {
@@ -135,15 +160,7 @@ pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
         }
         Algorithm::PerVertex => {
             let g = per_vertex::StripGeometry::new(scene, &frame.center, &range, &d, s.cross_eyed);
-            let r = per_vertex::per_vertex(
-                &g,
-                scene.width,
-                scene.height,
-                &d,
-                &s.pattern,
-                &s.per_vertex,
-                false,
-            )?;
+            let r = strips(&g, &d)?;
             (r.pixels, Some(r.iterations))
         }
     };

@@ -111,16 +111,6 @@ impl StripGeometry {
         g
     }
 
-    /// Number of triangles, background plane included.
-    pub fn triangle_count(&self) -> usize {
-        self.triangles.len()
-    }
-
-    /// Cyclopean clip positions (the GPU mirror uploads them).
-    pub fn clip(&self) -> &[Vec4] {
-        &self.clip
-    }
-
     /// Per-vertex separation in pixels.
     pub fn separation(&self) -> &[f32] {
         &self.separation
@@ -129,6 +119,18 @@ impl StripGeometry {
     /// Triangles (vertex indices), the background plane last.
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
+    }
+
+    /// Fig. 4's vertex shift for a `width`-pixel image: every clip position moved
+    /// `toward · s/2` pixels, i.e. `x + toward · s · w / W` in clip space (+1: right-going strips,
+    /// −1: left-going). The CPU and GPU strips both take their vertices from here.
+    pub fn shifted(&self, toward: f32, width: u32) -> Vec<Vec4> {
+        let wf = width as f32;
+        self.clip
+            .iter()
+            .zip(&self.separation)
+            .map(|(c, s)| Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w))
+            .collect()
     }
 }
 
@@ -342,15 +344,10 @@ pub fn per_vertex(
     // The same size checks as any framebuffer.
     crate::framebuffer::check_size(width, height)?;
     let strips = plan_strips(width, d, opts)?;
-    let (w, wf) = (width as usize, width as f32);
+    let w = width as usize;
     let raster = RasterOptions::default();
     let setups = |toward: f32| {
-        let clip: Vec<Vec4> = geometry
-            .clip
-            .iter()
-            .zip(&geometry.separation)
-            .map(|(c, s)| Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w))
-            .collect();
+        let clip = geometry.shifted(toward, width);
         let vertices = StripVertices {
             clip: &clip,
             separation: &geometry.separation,

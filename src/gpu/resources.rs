@@ -1,0 +1,68 @@
+//! Small constructors every GPU module needs: buffers filled at creation, 2D textures, and
+//! texel uploads. One copy of each, so that the passes differ only in what they draw.
+
+use super::device::GpuRenderer;
+
+/// A buffer initialized with `data` (size rounded up to wgpu's copy alignment, at least 4).
+pub(crate) fn buffer_with(
+    r: &GpuRenderer,
+    label: &str,
+    data: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let b = r.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: (data.len() as u64)
+            .next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT)
+            .max(4),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    r.queue.write_buffer(&b, 0, data);
+    b
+}
+
+/// A `width × height` 2D texture, one mip level, one sample.
+pub(crate) fn texture_2d(
+    r: &GpuRenderer,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    r.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// Writes tightly packed rows of 4-byte texels (`data`) into the whole of `texture`.
+pub(crate) fn write_texels(r: &GpuRenderer, texture: &wgpu::Texture, data: &[u8]) {
+    let size = texture.size();
+    r.queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        data,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(4 * size.width),
+            rows_per_image: Some(size.height),
+        },
+        size,
+    );
+}
