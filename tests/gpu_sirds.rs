@@ -3,8 +3,6 @@
 //! Compiled only with `--features gpu`; skips without an adapter, fails when `CI` is set (the
 //! helper of tests/gpu_parity.rs).
 
-use std::path::Path;
-
 use stereolab::effects::sirds::decode::{DecodeOptions, decode, round_trip};
 use stereolab::effects::sirds::per_vertex::{
     Filter, PerVertexOptions, Start, StripGeometry, per_vertex,
@@ -13,51 +11,13 @@ use stereolab::effects::sirds::{Pattern, scene_depth};
 use stereolab::gpu::parity::compare_scene;
 use stereolab::gpu::sirds::GpuStrips;
 use stereolab::plan::Plan;
-use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
 
 use crate::gpu_parity::gpu;
-
-const CAMERA: &str = r#"
-[image]
-width = 256
-height = 128
-
-[camera]
-eye = [0.0, 0.0, 5.0]
-target = [0.0, 0.0, 0.0]
-fov_y = 40.0
-near = 1.0
-far = 20.0
-"#;
-
-/// A sphere over the background plane (seed 002 §3).
-const SPHERE: &str = r#"
-[sirds]
-back = 7.0
-
-[[mesh]]
-kind = "sphere"
-size = 1.2
-detail = 32
-"#;
-
-/// Seed 002 Fig. 5: a plane receding from near on the left to far on the right.
-const RAMP: &str = r#"
-[[mesh]]
-kind = "plane"
-size = 20.0
-detail = 16
-rotate = [0.0, 35.0, 0.0]
-"#;
+use crate::sirds::{RAMP, SPHERE, frame, sized_scene};
 
 fn scene(body: &str) -> Scene {
-    let text = format!("outputs = [\"sirds\", \"sirds_depth\"]\n{CAMERA}{body}");
-    Scene::from_toml(&text, Path::new("test.toml"), Path::new("."), &[]).expect("valid scene")
-}
-
-fn frame(s: &Scene) -> Frame {
-    render(s, &Plan::new(&s.outputs)).expect("renders")
+    sized_scene(body, 256, 128)
 }
 
 /// Identical pixels (all four channels) as a share, and the largest channel difference.

@@ -21,10 +21,6 @@ use stereolab::scene::Scene;
 use crate::common;
 
 const CAMERA: &str = r#"
-[image]
-width = 320
-height = 96
-
 [camera]
 eye = [0.0, 0.0, 5.0]
 target = [0.0, 0.0, 0.0]
@@ -38,7 +34,7 @@ fn ramp() -> Scene {
     scene(RAMP)
 }
 
-const RAMP: &str = r#"
+pub(crate) const RAMP: &str = r#"
 [[mesh]]
 kind = "plane"
 size = 20.0
@@ -48,8 +44,10 @@ rotate = [0.0, 35.0, 0.0]
 
 /// A sphere over the background plane (seed 002 §3).
 fn sphere() -> Scene {
-    scene(
-        r#"
+    scene(SPHERE)
+}
+
+pub(crate) const SPHERE: &str = r#"
 [sirds]
 back = 7.0
 
@@ -57,16 +55,28 @@ back = 7.0
 kind = "sphere"
 size = 1.2
 detail = 32
-"#,
-    )
-}
+"#;
 
-fn scene(body: &str) -> Scene {
-    let text = format!("outputs = [\"sirds\", \"sirds_depth\"]\n{CAMERA}{body}");
+/// A `sirds` + `sirds_depth` scene of `body` (meshes, `[sirds]`) at `width × height`, seen by
+/// the tests' camera.
+pub(crate) fn sized_scene(body: &str, width: u32, height: u32) -> Scene {
+    let text = format!(
+        "outputs = [\"sirds\", \"sirds_depth\"]\n{}{body}",
+        camera(width, height)
+    );
     Scene::from_toml(&text, Path::new("test.toml"), Path::new("."), &[]).expect("valid scene")
 }
 
-fn frame(s: &Scene) -> Frame {
+fn scene(body: &str) -> Scene {
+    sized_scene(body, 320, 96)
+}
+
+/// The `[image]` and `[camera]` tables of the tests' scenes.
+fn camera(width: u32, height: u32) -> String {
+    format!("[image]\nwidth = {width}\nheight = {height}\n{CAMERA}")
+}
+
+pub(crate) fn frame(s: &Scene) -> Frame {
     render(s, &Plan::new(&s.outputs)).expect("renders")
 }
 
@@ -342,10 +352,7 @@ fn gradient(pixels: &[[u8; 4]], w: usize, x0: usize, x1: usize) -> f64 {
 fn center_start_stays_sharper_than_left_start() {
     // Seed 002 Fig. 7: sharpness degrades with distance from the initial strip. Bilinear copies
     // of black/white dots lose contrast at every copy; a center start copies half as often.
-    let text = format!(
-        "outputs = [\"sirds\"]\n{}{RAMP}",
-        CAMERA.replace("width = 320", "width = 960")
-    );
+    let text = format!("outputs = [\"sirds\"]\n{}{RAMP}", camera(960, 96));
     let mut s =
         Scene::from_toml(&text, Path::new("wide.toml"), Path::new("."), &[]).expect("scene");
     s.sirds.per_vertex.filter = Filter::Bilinear;
@@ -459,7 +466,10 @@ fn bad_inputs_get_clear_errors() {
             .contains("sirds.depth_near_in")
     );
     // Scene file fields.
-    let text = format!("outputs = [\"sirds\"]\n{CAMERA}[sirds]\nfilter = \"cubic\"\n");
+    let text = format!(
+        "outputs = [\"sirds\"]\n{}[sirds]\nfilter = \"cubic\"\n",
+        camera(320, 96)
+    );
     let e = Scene::from_toml(&text, Path::new("bad.toml"), Path::new("."), &[]).unwrap_err();
     assert!(e.to_string().contains("cubic"), "{e}");
 }
@@ -539,9 +549,7 @@ fn cli_depth_map_decode_and_animation() {
     let scene = dir.join("scene.toml");
     let text = format!(
         "outputs = [\"sirds\"]\n{}\n[[mesh]]\nkind = \"cube\"\nsize = 1.5\nrotate = [20.0, 0.0, 0.0]\n",
-        CAMERA
-            .replace("width = 320", "width = 200")
-            .replace("height = 96", "height = 48")
+        camera(200, 48)
     );
     std::fs::write(&scene, text).expect("write scene");
     let gif = dir.join("turn.gif");
