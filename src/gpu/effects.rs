@@ -126,11 +126,7 @@ impl GpuFinalize {
             p
         };
         let first = self.parallax.run(r, &[fb], &params(1.0))?;
-        let scale = first
-            .depth
-            .iter()
-            .filter(|p| !p.is_nan())
-            .fold(0.5f32, |m, p| m.max(p.abs()));
+        let scale = parallax_scale(&first.depth);
         let colored = self.parallax.run(r, &[fb], &params(scale))?;
         Ok((first.depth, image_of(&colored)))
     }
@@ -221,12 +217,8 @@ pub fn produce_wgsl(
         Output::Parallax => {
             let left = eye(View::Left)?;
             let (values, area) = fin.parallax(r, left, &ParallaxRig::of_scene(scene)?)?;
-            // The same scale the pass used: the largest |p|, at least half a pixel.
-            let scale = values
-                .iter()
-                .filter(|p| !p.is_nan())
-                .fold(0.5f32, |m, p| m.max(p.abs()));
-            let scale = f64::from(scale);
+            // The same scale the pass used.
+            let scale = f64::from(parallax_scale(&values));
             let legend = crate::effects::legend::draw_legend(left.width, scale, &|p| {
                 crate::effects::parallax::parallax_color(p, scale)
             })?;
@@ -237,6 +229,16 @@ pub fn produce_wgsl(
         }
         _ => return Ok(None),
     }))
+}
+
+/// The parallax color scale from the GPU's own parallax values (NaN on the background): the
+/// largest |p|, at least half a pixel, as
+/// [`color_scale`](crate::effects::parallax::color_scale) on the CPU.
+fn parallax_scale(values: &[f32]) -> f32 {
+    values
+        .iter()
+        .filter(|p| !p.is_nan())
+        .fold(0.5f32, |m, p| m.max(p.abs()))
 }
 
 /// remap.wgsl's parameters: `MVP_other · MVP_this⁻¹` composed in f64 and rounded to f32 (as

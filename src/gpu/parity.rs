@@ -248,17 +248,10 @@ fn pair_and_anaglyph(
             .ok_or_else(|| super::gpu_error("anaglyph", "no WGSL pass"))
     };
     let rgba = |i: Image| match i {
-        Image::Rgba(img) => Ok(img),
+        Image::Rgba(img) => Ok(framebuffer_from_image(&img, scene.background)),
         _ => Err(super::gpu_error("anaglyph", "not an RGBA image")),
     };
-    let (cpu_img, gpu_img) = (rgba(cpu_frame()?)?, rgba(gpu_frame()?)?);
-    let max_diff = cpu_img
-        .as_raw()
-        .iter()
-        .zip(gpu_img.as_raw())
-        .map(|(a, b)| a.abs_diff(*b))
-        .max()
-        .unwrap_or(0);
+    let max_diff = compare(&rgba(cpu_frame()?)?, &rgba(gpu_frame()?)?)?.max_channel_diff;
     let mut failed = None;
     let cpu_ms = median_ms(iters, || cpu_frame().map_err(|e| failed = Some(e)));
     let gpu_ms = median_ms(iters, || gpu_frame().map_err(|e| failed = Some(e)));
