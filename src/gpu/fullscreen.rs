@@ -14,7 +14,10 @@ use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
 use super::resources::{texture_2d, write_texels};
 
 /// Vertex stage and helpers every full-screen shader gets.
-const PRELUDE_WGSL: &str = include_str!("shaders/fullscreen.wgsl");
+const PRELUDE_WGSL: &str = concat!(
+    include_str!("shaders/common.wgsl"),
+    include_str!("shaders/fullscreen.wgsl")
+);
 /// The identity pass.
 const COPY_WGSL: &str = include_str!("shaders/copy.wgsl");
 

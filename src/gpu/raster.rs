@@ -24,9 +24,15 @@ use super::resources::buffer_with;
 use super::{GL_TO_WGPU_DEPTH, gpu_error};
 
 /// The mirror of [`BlinnPhong`](crate::shade::BlinnPhong).
-const BLINN_PHONG_WGSL: &str = include_str!("shaders/blinn_phong.wgsl");
+const BLINN_PHONG_WGSL: &str = concat!(
+    include_str!("shaders/common.wgsl"),
+    include_str!("shaders/blinn_phong.wgsl")
+);
 /// The mirror of [`ChromaDepthShader`](crate::effects::chromadepth::shader::ChromaDepthShader).
-const CHROMADEPTH_WGSL: &str = include_str!("shaders/chromadepth.wgsl");
+const CHROMADEPTH_WGSL: &str = concat!(
+    include_str!("shaders/common.wgsl"),
+    include_str!("shaders/chromadepth.wgsl")
+);
 /// The mirror of [`DepthOnly`](crate::shade::DepthOnly).
 const DEPTH_ONLY_WGSL: &str = include_str!("shaders/depth_only.wgsl");
 

@@ -34,46 +34,6 @@ fn flag(bit: u32) -> bool {
     return (u32(u.misc.w) & bit) != 0u;
 }
 
-// glam's `Mat4::transform_point3`: ((c0·x + c1·y) + c2·z) + c3.
-fn transform_point3(m: mat4x4<f32>, p: vec3<f32>) -> vec3<f32> {
-    var r = m[0] * p.x;
-    r = m[1] * p.y + r;
-    r = m[2] * p.z + r;
-    r = m[3] + r;
-    return r.xyz;
-}
-
-// glam's `Mat4 * Vec4`: ((c0·x + c1·y) + c2·z) + c3·w.
-fn mul_vec4(m: mat4x4<f32>, v: vec4<f32>) -> vec4<f32> {
-    var r = m[0] * v.x;
-    r = r + m[1] * v.y;
-    r = r + m[2] * v.z;
-    r = r + m[3] * v.w;
-    return r;
-}
-
-// glam's `Mat3 * Vec3`: (c0·x + c1·y) + c2·z.
-fn mul_vec3(m: mat3x3<f32>, v: vec3<f32>) -> vec3<f32> {
-    var r = m[0] * v.x;
-    r = r + m[1] * v.y;
-    r = r + m[2] * v.z;
-    return r;
-}
-
-// glam's `Vec3::dot`: (x·x' + y·y') + z·z'.
-fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
-    return (a.x * b.x + a.y * b.y) + a.z * b.z;
-}
-
-// glam's `Vec3::normalize_or_zero`.
-fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
-    let rcp = 1.0 / sqrt(dot3(v, v));
-    if rcp > 0.0 && rcp <= 3.4028235e38 {
-        return v * rcp;
-    }
-    return vec3<f32>(0.0);
-}
-
 // `Texgen::s`: A x + B y + C z + D (the plane has A = B = 0, so the order of summation is moot).
 fn texgen(p: vec3<f32>) -> f32 {
     return ((u.plane.x * p.x + u.plane.y * p.y) + u.plane.z * p.z) + u.plane.w;
@@ -97,12 +57,6 @@ fn sample_ramp(s_in: f32) -> vec3<f32> {
     let b = ramp[min(i1, last)].xyz;
     // glam's `Vec3::lerp`: a·(1 − t) + b·t.
     return a * (1.0 - t) + b * t;
-}
-
-// `to_rgba8`'s rounding, returned as k/255 so the Rgba8Unorm store writes exactly k.
-fn quantize(c: vec3<f32>) -> vec4<f32> {
-    let k = floor(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
-    return vec4<f32>(k / 255.0, 1.0);
 }
 
 @vertex

@@ -22,9 +22,3 @@ fn texel(pos: vec4<f32>) -> vec2<i32> {
     return vec2<i32>(pos.xy);
 }
 
-// `to_rgba8`'s rounding, (clamp(c, 0, 1)·255 + ½) truncated, returned as k/255 so that the
-// Rgba8Unorm store writes exactly k. Alpha is opaque.
-fn quantize(c: vec3<f32>) -> vec4<f32> {
-    let k = floor(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
-    return vec4<f32>(k / 255.0, 1.0);
-}
