@@ -8,7 +8,7 @@ mod clip;
 mod setup;
 
 pub use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
-pub use setup::{Band, Setup, SetupTriangle, WindowVertex, setup_triangle, snap, traverse};
+pub use setup::{Band, Plane, Setup, SetupTriangle, WindowVertex, setup_triangle, snap, traverse};
 
 use rayon::prelude::*;
 
@@ -73,32 +73,42 @@ pub fn rasterize<S: Shader>(
     let (setups, mut stats) =
         setup_triangles(triangles, vertex_count, shader, fb.width, fb.height, opts);
     let width = fb.width as usize;
+    let bins = bin_rows(&setups, BAND_ROWS as u32, fb.height);
     stats.fragments = fb
         .color
         .par_chunks_mut(width * BAND_ROWS)
         .zip(fb.depth.par_chunks_mut(width * BAND_ROWS))
+        .zip(&bins)
         .enumerate()
-        .map(|(b, (color, depth))| {
-            let y0 = (b * BAND_ROWS) as u32;
-            let y1 = y0 + (depth.len() / width) as u32 - 1;
+        .map(|(b, ((color, depth), bin))| {
             let mut band = Band {
                 width: fb.width,
                 x0: 0,
-                y0,
+                y0: (b * BAND_ROWS) as u32,
                 color,
                 depth,
             };
-            setups
-                .iter()
-                .filter(|t| {
-                    let (r0, r1) = t.rows();
-                    r0 <= y1 && r1 >= y0
-                })
+            bin.iter()
                 .map(|t| traverse(t, shader, &mut band, opts))
                 .sum::<usize>()
         })
         .sum();
     stats
+}
+
+/// The triangles of each band of `band_rows` rows (of a `height`-row target), in submission
+/// order: every band then walks its own short list instead of testing every triangle, which
+/// for thousands of small triangles read the whole setup array once per band.
+pub fn bin_rows(setups: &Setups, band_rows: u32, height: u32) -> Vec<Vec<&SetupTriangle>> {
+    let band_rows = band_rows.max(1);
+    let mut bins = vec![Vec::new(); height.div_ceil(band_rows) as usize];
+    for t in setups {
+        let (r0, r1) = t.rows();
+        for bin in &mut bins[(r0 / band_rows) as usize..=(r1 / band_rows) as usize] {
+            bin.push(t);
+        }
+    }
+    bins
 }
 
 /// Vertex stage, clipping, perspective divide and triangle setup for every triangle, in
@@ -111,7 +121,7 @@ pub fn setup_triangles<S: Shader>(
     width: u32,
     height: u32,
     opts: &RasterOptions,
-) -> (Vec<SetupTriangle>, RasterStats) {
+) -> (Setups, RasterStats) {
     // Vertex stage, once per vertex (a post-transform cache, like a GPU's), in parallel.
     let verts: Vec<ClipVertex> = (0..vertex_count as u32)
         .into_par_iter()
@@ -133,14 +143,44 @@ pub fn setup_triangles<S: Shader>(
         triangles: triangles.len(),
         ..Default::default()
     };
-    let mut setups = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
+    let mut setups = Vec::with_capacity(parts.len());
     for (part, s) in parts {
-        setups.extend(part);
+        setups.push(part);
         stats.non_finite += s.non_finite;
         stats.clipped += s.clipped;
         stats.culled += s.culled;
     }
-    (setups, stats)
+    (Setups(setups), stats)
+}
+
+/// Set-up triangles in submission order, kept in the chunks that were set up in parallel
+/// (concatenating them moved every triangle once more, for nothing).
+pub struct Setups(Vec<Vec<SetupTriangle>>);
+
+impl Setups {
+    /// Every triangle, in submission order.
+    pub fn iter(&self) -> impl Iterator<Item = &SetupTriangle> {
+        self.0.iter().flatten()
+    }
+
+    /// How many triangles.
+    pub fn len(&self) -> usize {
+        self.0.iter().map(Vec::len).sum()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl<'a> IntoIterator for &'a Setups {
+    type Item = &'a SetupTriangle;
+    type IntoIter = std::iter::Flatten<std::slice::Iter<'a, Vec<SetupTriangle>>>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter().flatten()
+    }
 }
 
 /// Triangles per setup task.

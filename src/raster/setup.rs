@@ -52,17 +52,22 @@ pub fn snap(coord: f32, bits: u32) -> i64 {
     ((coord - 0.5) * (1u32 << bits) as f32).round_ties_even() as i64
 }
 
-/// A linear function of window position, `a0 + dadx (x − x0) + dady (y − y0)`.
+/// A linear function of window position, `a0 + dadx (x − x0) + dady (y − y0)`, evaluated as
+/// `(a0 + dadx·fx) + dady·fy` (a SIMD evaluation must keep that order to give the same bits).
 #[derive(Clone, Copy, Debug)]
-struct Plane {
-    a0: f32,
-    dadx: f32,
-    dady: f32,
+pub struct Plane {
+    /// Value at the origin (vertex 0).
+    pub a0: f32,
+    /// Change per pixel to the right.
+    pub dadx: f32,
+    /// Change per pixel down.
+    pub dady: f32,
 }
 
 impl Plane {
+    /// The value at offset (`fx`, `fy`) from the origin.
     #[inline]
-    fn at(&self, fx: f32, fy: f32) -> f32 {
+    pub fn at(&self, fx: f32, fy: f32) -> f32 {
         self.a0 + self.dadx * fx + self.dady * fy
     }
 }
@@ -310,6 +315,99 @@ impl EdgeStep {
     }
 }
 
+impl SetupTriangle {
+    /// Calls `span(py, x_lo, x_hi)` for every row of the tile (columns `x0 .. x0 + width`, rows
+    /// `y0 .. y0 + rows`) in which the triangle covers pixels: exactly the covered pixels
+    /// `x_lo ..= x_hi` (never empty), top row first. Coverage as testing each pixel's edge
+    /// functions, found per row in integers (see [`EdgeStep`]).
+    pub fn spans(
+        &self,
+        x0: u32,
+        y0: u32,
+        width: u32,
+        rows: u32,
+        mut span: impl FnMut(u32, u32, u32),
+    ) {
+        let py0 = self.py0.max(y0 as i64);
+        let py1 = self.py1.min(y0 as i64 + rows as i64 - 1);
+        let cx0 = self.px0.max(x0 as i64);
+        let cx1 = self.px1.min(x0 as i64 + width as i64 - 1);
+        if py0 > py1 || cx0 > cx1 {
+            return;
+        }
+        let s = 1i64 << self.bits;
+        let last = self.px1 - self.px0;
+        // Edge i at pixel px0 + k of row py is c + dcdy·py·S − dcdx·(px0 + k)·S: solved for k
+        // exactly in integers, so only covered pixels are visited.
+        let mut edges: [EdgeStep; 3] = std::array::from_fn(|i| {
+            let e = self.c[i] + self.dcdy[i] * py0 * s - self.dcdx[i] * self.px0 * s;
+            EdgeStep::new(e, self.dcdx[i] * s, self.dcdy[i] * s)
+        });
+        for py in py0..=py1 {
+            let (mut k0, mut k1) = (0i64, last);
+            for e in &mut edges {
+                e.bound(&mut k0, &mut k1);
+                e.advance();
+            }
+            let (x_lo, x_hi) = ((self.px0 + k0).max(cx0), (self.px0 + k1).min(cx1));
+            if k0 <= k1 && x_lo <= x_hi {
+                span(py as u32, x_lo as u32, x_hi as u32);
+            }
+        }
+    }
+
+    /// Pixel column `x`'s center relative to the planes' origin (the `fx` of the `*_at`
+    /// functions). Through `i32`, which converts to `f32` in vector lanes; exact below 2²⁴.
+    #[inline]
+    pub fn fx(&self, x: u32) -> f32 {
+        x as i32 as f32 + 0.5 - self.x0
+    }
+
+    /// Pixel row `y`'s center relative to the planes' origin.
+    #[inline]
+    pub fn fy(&self, y: u32) -> f32 {
+        y as i32 as f32 + 0.5 - self.y0
+    }
+
+    /// The planes' origin: vertex 0's window position.
+    pub fn origin(&self) -> (f32, f32) {
+        (self.x0, self.y0)
+    }
+
+    /// The window-depth plane (before clamping).
+    pub fn depth_plane(&self) -> Plane {
+        self.z
+    }
+
+    /// The 1/w plane.
+    pub fn inv_w_plane(&self) -> Plane {
+        self.inv_w
+    }
+
+    /// Varying `k`'s plane (of `a/w` when set up perspective-correct).
+    pub fn varying_plane(&self, k: usize) -> Plane {
+        self.var[k]
+    }
+
+    /// Window depth at (`fx`, `fy`), clamped to [0, 1]: what the depth test compares.
+    #[inline]
+    pub fn depth_at(&self, fx: f32, fy: f32) -> f32 {
+        self.z.at(fx, fy).clamp(0.0, 1.0)
+    }
+
+    /// Varying `k` at (`fx`, `fy`), perspective-corrected when set up so (one reciprocal, one
+    /// multiply, as the fragment stage of [`traverse`]).
+    #[inline]
+    pub fn varying_at(&self, k: usize, fx: f32, fy: f32, perspective_correct: bool) -> f32 {
+        let w = if perspective_correct {
+            1.0 / self.inv_w.at(fx, fy)
+        } else {
+            1.0
+        };
+        self.var[k].at(fx, fy) * w
+    }
+}
+
 /// Traverses a set-up triangle over the rows of `band`: coverage from the edge functions, then
 /// depth test LESS, then the fragment stage. Returns the fragments written.
 pub fn traverse<S: Shader>(
@@ -318,15 +416,7 @@ pub fn traverse<S: Shader>(
     band: &mut Band,
     opts: &RasterOptions,
 ) -> usize {
-    let rows = (band.depth.len() / band.width.max(1) as usize) as i64;
-    let py0 = t.py0.max(band.y0 as i64);
-    let py1 = t.py1.min(band.y0 as i64 + rows - 1);
-    let cx0 = t.px0.max(band.x0 as i64);
-    let cx1 = t.px1.min(band.x0 as i64 + band.width as i64 - 1);
-    if py0 > py1 || cx0 > cx1 {
-        return 0;
-    }
-    let s = 1i64 << t.bits;
+    let rows = (band.depth.len() / band.width.max(1) as usize) as u32;
     let writes_color = shader.writes_color();
     // The shader's own count (a constant once inlined, so the loop below unrolls). `t` must
     // have been set up with the same varyings (planes past its count copy the depth plane).
@@ -337,48 +427,26 @@ pub fn traverse<S: Shader>(
     );
     let mut frag_var: Varyings = [0.0; MAX_VARYINGS];
     let mut fragments = 0;
-    let span = t.px1 - t.px0;
-    // Edge i at pixel px0 + k of row py is c + dcdy·py·S − dcdx·(px0 + k)·S: solved for k
-    // exactly in integers, so only covered pixels are visited (the same coverage as testing
-    // each pixel).
-    let mut edges: [EdgeStep; 3] = std::array::from_fn(|i| {
-        let e = t.c[i] + t.dcdy[i] * py0 * s - t.dcdx[i] * t.px0 * s;
-        EdgeStep::new(e, t.dcdx[i] * s, t.dcdy[i] * s)
-    });
-    for py in py0..=py1 {
-        let (mut k0, mut k1) = (0i64, span);
-        for e in &mut edges {
-            e.bound(&mut k0, &mut k1);
-            e.advance();
-        }
-        if k0 > k1 {
-            continue;
-        }
-        let fy = py as f32 + 0.5 - t.y0;
-        let (x_lo, x_hi) = ((t.px0 + k0).max(cx0), (t.px0 + k1).min(cx1));
-        if x_lo > x_hi {
-            continue;
-        }
+    let (bx0, by0, bw) = (band.x0, band.y0, band.width as usize);
+    t.spans(bx0, by0, band.width, rows, |py, x_lo, x_hi| {
+        let fy = t.fy(py);
         // Index of pixel (px, py) in the tile: row + px − x0.
-        let row = (py - band.y0 as i64) as usize * band.width as usize;
-        let x0 = band.x0 as i64;
+        let row = (py - by0) as usize * bw;
+        let (i_lo, i_hi) = (row + (x_lo - bx0) as usize, row + (x_hi - bx0) as usize);
         if !writes_color && opts.depth_test {
             // Depth only: a branch-free span the compiler vectorizes; z is the same expression
             // as below, so the bits are the same.
-            let depth = &mut band.depth[row + (x_lo - x0) as usize..=row + (x_hi - x0) as usize];
-            for (k, d) in depth.iter_mut().enumerate() {
-                let fx = (x_lo + k as i64) as f32 + 0.5 - t.x0;
-                let z = t.z.at(fx, fy).clamp(0.0, 1.0);
+            for (k, d) in band.depth[i_lo..=i_hi].iter_mut().enumerate() {
+                let z = t.depth_at(t.fx(x_lo + k as u32), fy);
                 let pass = z < *d;
                 *d = if pass { z } else { *d };
                 fragments += pass as usize;
             }
-            continue;
+            return;
         }
-        for px in x_lo..=x_hi {
-            let fx = px as f32 + 0.5 - t.x0;
-            let z = t.z.at(fx, fy).clamp(0.0, 1.0);
-            let idx = row + (px - x0) as usize;
+        for (px, idx) in (x_lo..=x_hi).zip(i_lo..=i_hi) {
+            let fx = t.fx(px);
+            let z = t.depth_at(fx, fy);
             if opts.depth_test && z >= band.depth[idx] {
                 continue;
             }
@@ -394,8 +462,8 @@ pub fn traverse<S: Shader>(
                     *out = plane.at(fx, fy) * w;
                 }
                 let f = Fragment {
-                    x: px as u32,
-                    y: py as u32,
+                    x: px,
+                    y: py,
                     depth: z,
                     varyings: &frag_var,
                     front_facing: t.front_facing,
@@ -411,6 +479,6 @@ pub fn traverse<S: Shader>(
             }
             fragments += 1;
         }
-    }
+    });
     fragments
 }

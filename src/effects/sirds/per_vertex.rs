@@ -10,6 +10,9 @@
 //! cost of one frame; every right-going pass draws the same shifted geometry, so triangle setup
 //! runs once per direction.
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
+
 use std::sync::atomic::{AtomicI32, Ordering};
 
 use glam::Vec4;
@@ -21,7 +24,7 @@ use super::pattern::Pattern;
 use super::per_pixel::check_inputs;
 use crate::error::{Error, Result};
 use crate::math::EyeMatrices;
-use crate::raster::{Band, RasterOptions, SetupTriangle, setup_triangles, traverse};
+use crate::raster::{RasterOptions, SetupTriangle, bin_rows, setup_triangles};
 use crate::scene::Scene;
 use crate::shade::{Fragment, Shader, Varyings};
 
@@ -223,23 +226,39 @@ pub(crate) fn plan_strips(
     Ok(strips)
 }
 
-/// Where a fragment at column `x` with separation `sep` samples the image (Fig. 4's texture
-/// coordinate `x ∓ d/2` of the unshifted vertex, in pixel-index units, centers at integers):
-/// the pixels `i0` and `i1` and the weight `t` of `i1` (nearest: `i0 == i1`, `t = 0`). `None`
-/// when a source falls outside `[lo, hi)`: the fragment is discarded and the pixel keeps what
-/// was there.
+/// Fig. 4's texture coordinate for a fragment at column `x` with separation `sep`: `x ∓ sep`,
+/// in pixel-index units (centers at integers).
 #[inline]
-fn source(x: u32, sep: f32, strip: &Strip, bilinear: bool) -> Option<(usize, usize, f32)> {
-    let p = x as f32 - strip.toward * sep;
-    let (lo, hi) = (strip.lo, strip.hi);
+fn source_coordinate(x: u32, sep: f32, toward: f32) -> f32 {
+    x as i32 as f32 - toward * sep
+}
+
+/// Whether a fragment sampling at `p` stays inside `[lo, hi)`: nearest reads pixel `⌊p + ½⌋`,
+/// bilinear pixels `⌊p⌋` and, when `p` is not whole, `⌊p⌋ + 1`. Outside (or NaN), the fragment
+/// is discarded and the pixel keeps what was there. Plain float comparisons (`lo`, `hi` whole),
+/// so a span of them vectorizes.
+#[inline]
+fn in_bounds(p: f32, lo: f32, hi: f32, bilinear: bool) -> bool {
+    if bilinear {
+        p >= lo && p <= hi - 1.0
+    } else {
+        let q = p + 0.5;
+        q >= lo && q < hi
+    }
+}
+
+/// The pixels a fragment at `p` (inside the bounds) reads, `i0` and `i1`, and the weight `t` of
+/// `i1` (nearest: `i0 == i1`, `t = 0`).
+#[inline]
+fn address(p: f32, bilinear: bool) -> (usize, usize, f32) {
     if bilinear {
         let i0 = floor(p);
         let t = p - i0 as f32;
         let i1 = if t > 0.0 { i0 + 1 } else { i0 };
-        (i0 >= lo && i1 < hi).then_some((i0 as usize, i1 as usize, t))
+        (i0 as usize, i1 as usize, t)
     } else {
-        let i = floor(p + 0.5);
-        (i >= lo && i < hi).then_some((i as usize, i as usize, 0.0))
+        let i = floor(p + 0.5) as usize;
+        (i, i, 0.0)
     }
 }
 
@@ -284,42 +303,151 @@ impl Shader for StripVertices<'_> {
     }
 }
 
-/// Fig. 4's fragment program over one band of rows: reads the band's current image `d` pixels
-/// toward the start. [`traverse`] calls only the fragment stage.
-struct StripSampler<'a> {
-    /// The band's rows as they stand (finished strips final).
-    image: &'a [[u8; 4]],
-    width: usize,
-    y0: u32,
-    strip: Strip,
-    bilinear: bool,
-    /// Per band pixel, the source it copied (bilinear: the left one of the two).
-    links: Option<&'a [AtomicI32]>,
-}
-
-impl Shader for StripSampler<'_> {
-    fn varying_count(&self) -> usize {
-        1
-    }
-
-    /// Never called: the vertices went through [`StripVertices`].
-    fn vertex(&self, _: u32, _: &mut Varyings) -> Vec4 {
-        Vec4::ZERO
-    }
-
-    #[inline]
-    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
-        let row_start = (f.y - self.y0) as usize * self.width;
-        let src = source(f.x, f.varyings[0], &self.strip, self.bilinear)?;
-        if let Some(links) = self.links {
-            links[row_start + f.x as usize].store(src.0 as i32, Ordering::Relaxed);
-        }
-        Some(sample(&self.image[row_start..row_start + self.width], src))
-    }
-}
-
 /// Rows per band: bands run in parallel. Fixed, so the bytes never depend on the thread count.
 pub const BAND_ROWS: u32 = 16;
+
+/// What a span of fragments needs besides its triangle: the direction (+1: copies from
+/// `x − d`, −1: from `x + d`), the allowed sources `[lo, hi)`, and the filter and
+/// interpolation.
+pub(super) struct SpanTarget {
+    toward: f32,
+    lo: f32,
+    hi: f32,
+    bilinear: bool,
+    perspective_correct: bool,
+}
+
+/// One direction's part of a band: columns `[x0, x1)`, drawn with `setups` (already filtered
+/// to the band's rows).
+struct Region<'a> {
+    x0: u32,
+    x1: u32,
+    target: SpanTarget,
+    setups: &'a [&'a SetupTriangle],
+}
+
+/// Whether this CPU runs the AVX2 loops ([`avx2`]); the bytes are the same either way.
+fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Fig. 4's vertex and fragment programs up to the texture read, for one band: per pixel, the
+/// source coordinate of the fragment that wins the depth test (NaN: no fragment, the pixel
+/// keeps the pattern). A discarded fragment writes no depth, as on a GPU.
+///
+/// Which fragment wins a pixel and where it samples depend on the geometry alone, never on the
+/// image it samples, so they are found once per band (deferred texturing) rather than once per
+/// strip; the strips then only read ([`resolve_row`]).
+fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, simd: bool) -> Vec<f32> {
+    let w = width as usize;
+    let mut sources = vec![f32::NAN; w * rows as usize];
+    let mut depth = vec![1.0f32; w * rows as usize];
+    for r in regions {
+        for t in r.setups {
+            t.spans(r.x0, y0, r.x1 - r.x0, rows, |py, x_lo, x_hi| {
+                let i = (py - y0) as usize * w + x_lo as usize;
+                let n = (x_hi - x_lo) as usize + 1;
+                let (d, p) = (&mut depth[i..i + n], &mut sources[i..i + n]);
+                #[cfg(target_arch = "x86_64")]
+                if simd {
+                    // SAFETY: `simd` is only set where `avx2_available()` said so.
+                    unsafe { avx2::span_sources(t, py, x_lo, d, p, &r.target) };
+                    return;
+                }
+                let _ = simd;
+                span_sources(t, py, x_lo, d, p, &r.target);
+            });
+        }
+    }
+    sources
+}
+
+/// One covered span of triangle `t` in row `y`, pixels `x_lo ..` (as many as `depth` holds):
+/// the fragment stage of [`traverse`](crate::raster::traverse) (same expressions, same order)
+/// up to the source coordinate; a fragment wins when it passes the depth test LESS and its
+/// source is in bounds.
+fn span_sources(
+    t: &SetupTriangle,
+    y: u32,
+    x_lo: u32,
+    depth: &mut [f32],
+    sources: &mut [f32],
+    target: &SpanTarget,
+) {
+    let fy = t.fy(y);
+    for (k, (d, p)) in depth.iter_mut().zip(sources).enumerate() {
+        let x = x_lo + k as u32;
+        let fx = t.fx(x);
+        let z = t.depth_at(fx, fy);
+        let sep = t.varying_at(0, fx, fy, target.perspective_correct);
+        let src = source_coordinate(x, sep, target.toward);
+        if z < *d && in_bounds(src, target.lo, target.hi, target.bilinear) {
+            *d = z;
+            *p = src;
+        }
+    }
+}
+
+/// Fig. 4's texture read for one strip's pixels `x0 .. x0 + out.len()` of one row: each pixel
+/// with a source takes its color from `row` as the earlier strips left it, the others keep
+/// `row`'s own. `row` is not written: the strip's old pixels stay readable, as a ping-pong
+/// pair of textures keeps them.
+fn resolve_row(row: &[[u8; 4]], sources: &[f32], x0: usize, out: &mut [[u8; 4]], bilinear: bool) {
+    for (k, o) in out.iter_mut().enumerate() {
+        let p = sources[x0 + k];
+        *o = if p.is_nan() {
+            row[x0 + k]
+        } else {
+            sample(row, address(p, bilinear))
+        };
+    }
+}
+
+/// Fig. 4's texture read for one strip of one band, row by row (see [`resolve_row`]), and
+/// with `links`, each pixel's source recorded.
+fn resolve_strip(
+    image: &mut [[u8; 4]],
+    sources: &[f32],
+    width: usize,
+    strip: &Strip,
+    bilinear: bool,
+    simd: bool,
+    links: Option<&[AtomicI32]>,
+) {
+    let (x0, sw) = (strip.x0 as usize, strip.width as usize);
+    let out = &mut vec![[0u8; 4]; sw][..];
+    for (row, src) in image
+        .chunks_exact_mut(width)
+        .zip(sources.chunks_exact(width))
+    {
+        #[cfg(target_arch = "x86_64")]
+        if simd {
+            // SAFETY: `simd` is only set where `avx2_available()` said so; `band_sources`
+            // stored only NaN or in-bounds sources.
+            unsafe { avx2::resolve_row(row, src, x0, out, bilinear) };
+        } else {
+            resolve_row(row, src, x0, out, bilinear);
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        resolve_row(row, src, x0, out, bilinear);
+        row[x0..x0 + sw].copy_from_slice(out);
+    }
+    if let Some(links) = links {
+        for (k, &p) in sources.iter().enumerate() {
+            let x = k % width;
+            if x >= x0 && x < x0 + sw && !p.is_nan() {
+                links[k].store(address(p, bilinear).0 as i32, Ordering::Relaxed);
+            }
+        }
+    }
+}
 
 /// Makes a SIRDS with the strip algorithm.
 ///
@@ -339,6 +467,31 @@ pub fn per_vertex(
     pattern: &Pattern,
     opts: &PerVertexOptions,
     record_links: bool,
+) -> Result<StripResult> {
+    let simd = avx2_available();
+    strips_with(
+        geometry,
+        width,
+        height,
+        d,
+        pattern,
+        opts,
+        record_links,
+        simd,
+    )
+}
+
+/// [`per_vertex`] with the AVX2 loops (`simd`, only where available) or the scalar ones.
+#[allow(clippy::too_many_arguments)]
+fn strips_with(
+    geometry: &StripGeometry,
+    width: u32,
+    height: u32,
+    d: &Disparity,
+    pattern: &Pattern,
+    opts: &PerVertexOptions,
+    record_links: bool,
+    simd: bool,
 ) -> Result<StripResult> {
     check_inputs(width, d, pattern)?;
     // The same size checks as any framebuffer.
@@ -363,12 +516,21 @@ pub fn per_vertex(
         .0
     };
     let right = setups(1.0);
-    let left = if strips.iter().any(|s| s.toward < 0.0) {
-        setups(-1.0)
-    } else {
-        Vec::new()
-    };
-    let widest = strips.iter().map(|s| s.width as usize).max().unwrap_or(0);
+    // Center start only.
+    let left = strips.iter().any(|s| s.toward < 0.0).then(|| setups(-1.0));
+    let right = bin_rows(&right, BAND_ROWS, height);
+    let left = left
+        .as_ref()
+        .map_or_else(Vec::new, |l| bin_rows(l, BAND_ROWS, height));
+    let bilinear = opts.filter == Filter::Bilinear;
+    // Each direction covers the columns of its strips: right-going from the start column on,
+    // left-going before it.
+    let split = strips
+        .iter()
+        .filter(|s| s.toward > 0.0)
+        .map(|s| s.x0)
+        .min()
+        .unwrap_or(width);
     let mut pixels = vec![[0u8, 0, 0, 255]; w * height as usize];
     let links: Vec<AtomicI32> = if record_links {
         (0..pixels.len()).map(|_| AtomicI32::new(-1)).collect()
@@ -381,61 +543,38 @@ pub fn per_vertex(
         .enumerate()
         .for_each(|(b, image)| {
             let y0 = b as u32 * BAND_ROWS;
-            let rows = image.len() / w;
-            let y1 = y0 + rows as u32 - 1;
-            for (r, row) in image.chunks_exact_mut(w).enumerate() {
-                pattern.fill_row(y0 + r as u32, row);
+            let rows = (image.len() / w) as u32;
+            let mut regions = Vec::with_capacity(2);
+            for (x0, x1, toward, list) in [(split, width, 1.0, &right), (0, split, -1.0, &left)] {
+                if let Some(s) = strips.iter().find(|s| s.toward == toward && x0 < x1) {
+                    regions.push(Region {
+                        x0,
+                        x1,
+                        target: SpanTarget {
+                            toward,
+                            lo: s.lo as f32,
+                            hi: s.hi as f32,
+                            bilinear,
+                            perspective_correct: raster.perspective_correct,
+                        },
+                        setups: &list[b],
+                    });
+                }
             }
-            let in_band = |list: &[SetupTriangle]| -> Vec<usize> {
-                (0..list.len())
-                    .filter(|&i| {
-                        let (r0, r1) = list[i].rows();
-                        r0 <= y1 && r1 >= y0
-                    })
-                    .collect()
-            };
-            let (right_here, left_here) = (in_band(&right), in_band(&left));
+            let sources = band_sources(&regions, width, y0, rows, simd);
+            // The pattern only where no fragment replaces it: a strip reads only finished
+            // strips (`d ≥ δ` > the strip width), so the pixels a fragment will overwrite are
+            // never read before.
+            for (r, (row, src)) in image
+                .chunks_exact_mut(w)
+                .zip(sources.chunks_exact(w))
+                .enumerate()
+            {
+                pattern.fill_row_where(y0 + r as u32, row, |x| src[x].is_nan());
+            }
             let band_links = record_links.then(|| &links[b * band_len..b * band_len + image.len()]);
-            let mut color = vec![[0u8; 4]; widest * rows];
-            let mut depth = vec![1.0f32; widest * rows];
             for strip in &strips {
-                let (x0, sw) = (strip.x0 as usize, strip.width as usize);
-                let (list, here) = if strip.toward > 0.0 {
-                    (&right, &right_here)
-                } else {
-                    (&left, &left_here)
-                };
-                let color = &mut color[..sw * rows];
-                let depth = &mut depth[..sw * rows];
-                for (r, c) in color.chunks_exact_mut(sw).enumerate() {
-                    c.copy_from_slice(&image[r * w + x0..r * w + x0 + sw]);
-                }
-                depth.fill(1.0);
-                let sampler = StripSampler {
-                    image,
-                    width: w,
-                    y0,
-                    strip: *strip,
-                    bilinear: opts.filter == Filter::Bilinear,
-                    links: band_links,
-                };
-                let mut tile = Band {
-                    width: strip.width,
-                    x0: strip.x0,
-                    y0,
-                    color,
-                    depth,
-                };
-                let (c0, c1) = (strip.x0, strip.x0 + strip.width - 1);
-                for &i in here {
-                    let (a, z) = list[i].columns();
-                    if a <= c1 && z >= c0 {
-                        traverse(&list[i], &sampler, &mut tile, &raster);
-                    }
-                }
-                for (r, c) in tile.color.chunks_exact(sw).enumerate() {
-                    image[r * w + x0..r * w + x0 + sw].copy_from_slice(c);
-                }
+                resolve_strip(image, &sources, w, strip, bilinear, simd, band_links);
             }
         });
     Ok(StripResult {
@@ -444,4 +583,65 @@ pub fn per_vertex(
         strip_width: strips.first().map_or(0, |s| s.width),
         links: record_links.then(|| links.into_iter().map(AtomicI32::into_inner).collect()),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::sirds::{bench::table_scene, depth_range};
+    use crate::math::StereoRig;
+    use crate::plan::Shading;
+    use crate::render::render_view;
+
+    /// The AVX2 loops only change the speed: for both starts and both filters, on an even and
+    /// an odd size (spans and strips that end mid-vector), they give the scalar loops' pixels
+    /// and links, byte for byte.
+    #[test]
+    fn avx2_strips_match_scalar_strips() {
+        if !avx2_available() {
+            // CI runs on AVX2 machines: there a missing AVX2 is a failure, not a skip.
+            assert!(
+                std::env::var_os("CI").is_none(),
+                "no AVX2 on this CI machine"
+            );
+            eprintln!("avx2_strips_match_scalar_strips: no AVX2 here, nothing to compare");
+            return;
+        }
+        for (w, h, tris) in [(512, 256, 2_500), (301, 77, 400)] {
+            let s = table_scene(w, h, tris, 10).expect("bench scene");
+            let center = StereoRig::center(&s.camera, s.aspect()).expect("camera");
+            let d = s.sirds.geometry.to_pixels().expect("geometry");
+            let (fb, _) = render_view(&s, &center, Shading::DepthOnly).expect("depth pass");
+            let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far).expect("range");
+            let g = StripGeometry::new(&s, &center, &range, &d, false);
+            for start in [Start::Left, Start::Center] {
+                for filter in [Filter::Nearest, Filter::Bilinear] {
+                    let opts = PerVertexOptions {
+                        start,
+                        filter,
+                        iterations: None,
+                    };
+                    let run = |simd| {
+                        strips_with(&g, w, h, &d, &s.sirds.pattern, &opts, true, simd)
+                            .expect("strips")
+                    };
+                    let (fast, plain) = (run(true), run(false));
+                    let differ = fast
+                        .pixels
+                        .iter()
+                        .zip(&plain.pixels)
+                        .filter(|(a, b)| a != b);
+                    assert_eq!(
+                        differ.count(),
+                        0,
+                        "{w}x{h} {start:?} {filter:?}: pixels differ"
+                    );
+                    assert_eq!(
+                        fast.links, plain.links,
+                        "{w}x{h} {start:?} {filter:?}: links"
+                    );
+                }
+            }
+        }
+    }
 }
