@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use rayon::prelude::*;
+
 use crate::error::{Error, Result};
 use crate::framebuffer::{Framebuffer, check_size};
 
@@ -143,29 +145,37 @@ impl DepthMap {
     pub fn auto_range(fb: &Framebuffer, near: f32, far: f32) -> Option<DepthRange> {
         // Covered pixels have depth < 1. Depths are clamped to [0, 1], where the bit patterns
         // as i32 order like the values (−0 sorts first and means 0): a branch-free integer
-        // min/max in 8 lanes, which the compiler vectorizes (a float fold stays scalar).
+        // min/max in 8 lanes, which the compiler vectorizes (a float fold stays scalar), over
+        // chunks in parallel (min and max do not care about the order).
         const ONE: i32 = 0x3f80_0000;
-        let (mut lo, mut hi) = ([i32::MAX; 8], [i32::MIN; 8]);
-        let chunks = fb.depth.chunks_exact(8);
-        let tail = chunks.remainder();
-        let mut visit = |lane: usize, d: f32| {
-            let b = d.to_bits() as i32;
-            let covered = b < ONE;
-            lo[lane] = lo[lane].min(if covered { b } else { i32::MAX });
-            hi[lane] = hi[lane].max(if covered { b } else { i32::MIN });
-        };
-        for c in chunks {
-            for (lane, &d) in c.iter().enumerate() {
+        let bounds = |depth: &[f32]| {
+            let (mut lo, mut hi) = ([i32::MAX; 8], [i32::MIN; 8]);
+            let chunks = depth.chunks_exact(8);
+            let tail = chunks.remainder();
+            let mut visit = |lane: usize, d: f32| {
+                let b = d.to_bits() as i32;
+                let covered = b < ONE;
+                lo[lane] = lo[lane].min(if covered { b } else { i32::MAX });
+                hi[lane] = hi[lane].max(if covered { b } else { i32::MIN });
+            };
+            for c in chunks {
+                for (lane, &d) in c.iter().enumerate() {
+                    visit(lane, d);
+                }
+            }
+            for (lane, &d) in tail.iter().enumerate() {
                 visit(lane, d);
             }
-        }
-        for (lane, &d) in tail.iter().enumerate() {
-            visit(lane, d);
-        }
-        let (lo, hi) = (
-            lo.into_iter().min().unwrap_or(i32::MAX),
-            hi.into_iter().max().unwrap_or(i32::MIN),
-        );
+            (
+                lo.into_iter().min().unwrap_or(i32::MAX),
+                hi.into_iter().max().unwrap_or(i32::MIN),
+            )
+        };
+        let (lo, hi) = fb
+            .depth
+            .par_chunks(1 << 16)
+            .map(bounds)
+            .reduce(|| (i32::MAX, i32::MIN), |a, b| (a.0.min(b.0), a.1.max(b.1)));
         if lo > hi {
             return None;
         }

@@ -109,14 +109,7 @@ impl Pattern {
     /// Row `y` of the pattern into `row` (columns `0..row.len()`): the same colors as
     /// [`Pattern::color`], with the pattern kind decided once per row.
     pub fn fill_row(&self, y: u32, row: &mut [[u8; 4]]) {
-        self.fill_row_where(y, row, |_| true);
-    }
-
-    /// [`Pattern::fill_row`] for the columns `x` where `wanted(x)` only (the strip algorithm
-    /// needs the pattern only where no fragment replaces it).
-    pub fn fill_row_where(&self, y: u32, row: &mut [[u8; 4]], wanted: impl Fn(usize) -> bool) {
-        let xs = row.iter_mut().enumerate().filter(|(x, _)| wanted(*x));
-        let xs = xs.map(|(x, p)| (p, x as u32));
+        let xs = row.iter_mut().zip(0u32..);
         match self {
             Pattern::BlackWhite { seed } => {
                 for (p, x) in xs {

@@ -396,14 +396,22 @@ fn span_sources(
 }
 
 /// Fig. 4's texture read for one strip's pixels `x0 .. x0 + out.len()` of one row: each pixel
-/// with a source takes its color from `row` as the earlier strips left it, the others keep
-/// `row`'s own. `row` is not written: the strip's old pixels stay readable, as a ping-pong
-/// pair of textures keeps them.
-fn resolve_row(row: &[[u8; 4]], sources: &[f32], x0: usize, out: &mut [[u8; 4]], bilinear: bool) {
+/// with a source takes its color from `row` as the earlier strips left it, the others the
+/// pattern (`pattern(x)`). `row` is not written: a ping-pong pair of textures keeps the strip's
+/// old pixels readable. Only finished strips are ever read (`d ≥ δ` > the strip width), so the
+/// pattern is needed only where no fragment lands.
+fn resolve_row(
+    row: &[[u8; 4]],
+    sources: &[f32],
+    x0: usize,
+    out: &mut [[u8; 4]],
+    bilinear: bool,
+    pattern: impl Fn(usize) -> [u8; 4],
+) {
     for (k, o) in out.iter_mut().enumerate() {
         let p = sources[x0 + k];
         *o = if p.is_nan() {
-            row[x0 + k]
+            pattern(x0 + k)
         } else {
             sample(row, address(p, bilinear))
         };
@@ -412,31 +420,34 @@ fn resolve_row(row: &[[u8; 4]], sources: &[f32], x0: usize, out: &mut [[u8; 4]],
 
 /// Fig. 4's texture read for one strip of one band, row by row (see [`resolve_row`]), and
 /// with `links`, each pixel's source recorded.
+#[allow(clippy::too_many_arguments)]
 fn resolve_strip(
     image: &mut [[u8; 4]],
     sources: &[f32],
-    width: usize,
+    (width, y0): (usize, u32),
     strip: &Strip,
     bilinear: bool,
     simd: bool,
+    pattern: &Pattern,
     links: Option<&[AtomicI32]>,
 ) {
     let (x0, sw) = (strip.x0 as usize, strip.width as usize);
     let out = &mut vec![[0u8; 4]; sw][..];
-    for (row, src) in image
+    let rows = image
         .chunks_exact_mut(width)
-        .zip(sources.chunks_exact(width))
-    {
+        .zip(sources.chunks_exact(width));
+    for (y, (row, src)) in (y0..).zip(rows) {
+        let pattern = |x: usize| pattern.color(x as u32, y);
         #[cfg(target_arch = "x86_64")]
         if simd {
             // SAFETY: `simd` is only set where `avx2_available()` said so; `band_sources`
             // stored only NaN or in-bounds sources.
-            unsafe { avx2::resolve_row(row, src, x0, out, bilinear) };
+            unsafe { avx2::resolve_row(row, src, x0, out, bilinear, pattern) };
         } else {
-            resolve_row(row, src, x0, out, bilinear);
+            resolve_row(row, src, x0, out, bilinear, pattern);
         }
         #[cfg(not(target_arch = "x86_64"))]
-        resolve_row(row, src, x0, out, bilinear);
+        resolve_row(row, src, x0, out, bilinear, pattern);
         row[x0..x0 + sw].copy_from_slice(out);
     }
     if let Some(links) = links {
@@ -562,19 +573,18 @@ fn strips_with(
                 }
             }
             let sources = band_sources(&regions, width, y0, rows, simd);
-            // The pattern only where no fragment replaces it: a strip reads only finished
-            // strips (`d ≥ δ` > the strip width), so the pixels a fragment will overwrite are
-            // never read before.
-            for (r, (row, src)) in image
-                .chunks_exact_mut(w)
-                .zip(sources.chunks_exact(w))
-                .enumerate()
-            {
-                pattern.fill_row_where(y0 + r as u32, row, |x| src[x].is_nan());
-            }
             let band_links = record_links.then(|| &links[b * band_len..b * band_len + image.len()]);
             for strip in &strips {
-                resolve_strip(image, &sources, w, strip, bilinear, simd, band_links);
+                resolve_strip(
+                    image,
+                    &sources,
+                    (w, y0),
+                    strip,
+                    bilinear,
+                    simd,
+                    pattern,
+                    band_links,
+                );
             }
         });
     Ok(StripResult {

@@ -116,7 +116,7 @@ pub(super) unsafe fn span_sources(
 
 /// One strip's pixels `x0 .. x0 + out.len()` of one row: each pixel with a source takes
 /// `row`'s color there (bilinear: the two neighbors mixed per channel and rounded), the others
-/// keep `row`'s own. `row` is not written (the strip's old pixels stay readable).
+/// the pattern. `row` is not written (the strip's old pixels stay readable).
 ///
 /// # Safety
 /// The CPU must support AVX2; every source in `sources` is NaN or inside `row` (as
@@ -128,6 +128,7 @@ pub(super) unsafe fn resolve_row(
     x0: usize,
     out: &mut [[u8; 4]],
     bilinear: bool,
+    pattern: impl Fn(usize) -> [u8; 4],
 ) {
     let n = out.len();
     assert!(x0 + n <= row.len() && x0 + n <= sources.len());
@@ -140,7 +141,6 @@ pub(super) unsafe fn resolve_row(
         // SAFETY: the mask covers lanes k .. min(k + 8, n), inside `row`, `sources` and `out`
         // (asserted); gathered indices are in bounds (NaN lanes gather pixel 0).
         unsafe {
-            let own = _mm256_maskload_epi32(base.add(x0 + k), mask);
             let p = _mm256_maskload_ps(sources.as_ptr().add(x0 + k), mask);
             let has = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_ORD_Q>(p, p));
             let color = if bilinear {
@@ -171,8 +171,15 @@ pub(super) unsafe fn resolve_row(
                 let i = _mm256_and_si256(floor_i32(_mm256_add_ps(p, half)), has);
                 _mm256_i32gather_epi32::<4>(base, i)
             };
-            let result = _mm256_blendv_epi8(own, color, has);
-            _mm256_maskstore_epi32(out.as_mut_ptr().add(k) as *mut i32, mask, result);
+            _mm256_maskstore_epi32(out.as_mut_ptr().add(k) as *mut i32, mask, color);
+            // Lanes without a source (the first strip, discarded fragments): the pattern.
+            let missing =
+                !_mm256_movemask_ps(_mm256_castsi256_ps(has)) & ((1 << (n - k).min(8)) - 1);
+            if missing != 0 {
+                for lane in (0..8).filter(|l| missing & (1 << l) != 0) {
+                    out[k + lane] = pattern(x0 + k + lane);
+                }
+            }
         }
         k += 8;
     }
