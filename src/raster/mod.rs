@@ -4,6 +4,8 @@
 //! subpixel grid → orient → edge functions with the top-left tie-break → depth test LESS →
 //! fragment stage. Nothing here knows about stereo.
 
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx2;
 mod clip;
 mod setup;
 
@@ -14,6 +16,19 @@ use rayon::prelude::*;
 
 use crate::framebuffer::Framebuffer;
 use crate::shade::{Shader, Varyings};
+
+/// Whether this CPU runs the AVX2 fragment loops (x86-64 with AVX2); the bytes are the same
+/// either way.
+pub fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        avx2::available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
 
 /// Rasterizer knobs. The defaults are what lavapipe does.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -184,7 +199,7 @@ impl<'a> IntoIterator for &'a Setups {
 }
 
 /// Triangles per setup task.
-const SETUP_CHUNK: usize = 1024;
+const SETUP_CHUNK: usize = 256;
 
 /// Clipping, perspective divide and setup of one chunk of triangles, in order.
 fn setup_chunk(

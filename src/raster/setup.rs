@@ -427,6 +427,7 @@ pub fn traverse<S: Shader>(
     );
     let mut frag_var: Varyings = [0.0; MAX_VARYINGS];
     let mut fragments = 0;
+    let simd = !writes_color && super::avx2_available();
     let (bx0, by0, bw) = (band.x0, band.y0, band.width as usize);
     t.spans(bx0, by0, band.width, rows, |py, x_lo, x_hi| {
         let fy = t.fy(py);
@@ -434,6 +435,13 @@ pub fn traverse<S: Shader>(
         let row = (py - by0) as usize * bw;
         let (i_lo, i_hi) = (row + (x_lo - bx0) as usize, row + (x_hi - bx0) as usize);
         if !writes_color && opts.depth_test {
+            #[cfg(target_arch = "x86_64")]
+            if simd {
+                // SAFETY: `simd` is only set where AVX2 is available.
+                fragments +=
+                    unsafe { super::avx2::depth_span(t, py, x_lo, &mut band.depth[i_lo..=i_hi]) };
+                return;
+            }
             // Depth only: a branch-free span the compiler vectorizes; z is the same expression
             // as below, so the bits are the same.
             for (k, d) in band.depth[i_lo..=i_hi].iter_mut().enumerate() {

@@ -24,7 +24,7 @@ use super::pattern::Pattern;
 use super::per_pixel::check_inputs;
 use crate::error::{Error, Result};
 use crate::math::EyeMatrices;
-use crate::raster::{RasterOptions, SetupTriangle, bin_rows, setup_triangles};
+use crate::raster::{RasterOptions, SetupTriangle, avx2_available, bin_rows, setup_triangles};
 use crate::scene::Scene;
 use crate::shade::{Fragment, Shader, Varyings};
 
@@ -163,6 +163,20 @@ pub(crate) struct Strip {
     pub(crate) hi: i64,
 }
 
+impl Strip {
+    /// Whether pixel `i` is not final while this strip runs: in this strip or one still to come
+    /// (right-going strips run left to right from the start column, then left-going ones right
+    /// to left).
+    #[inline]
+    pub(crate) fn unfinished(&self, i: usize) -> bool {
+        if self.toward > 0.0 {
+            i >= self.x0 as usize
+        } else {
+            i < (self.x0 + self.width) as usize
+        }
+    }
+}
+
 /// The strip width and strips for `width` pixels.
 ///
 /// # Errors
@@ -262,12 +276,12 @@ fn address(p: f32, bilinear: bool) -> (usize, usize, f32) {
     }
 }
 
-/// The color a fragment writes: the source pixel, or the two mixed linearly and rounded to
-/// the nearest level (alpha opaque).
+/// The color a fragment writes from the pixels `a` and `b` it reads: `a` for a whole-pixel
+/// source (`t = 0`), else the two mixed linearly and rounded to the nearest level (alpha
+/// opaque).
 #[inline]
-fn sample(row: &[[u8; 4]], (i0, i1, t): (usize, usize, f32)) -> [u8; 4] {
-    let (a, b) = (row[i0], row[i1]);
-    if i0 == i1 {
+fn mix(a: [u8; 4], b: [u8; 4], t: f32) -> [u8; 4] {
+    if t == 0.0 {
         return a;
     }
     let mix = |k: usize| (a[k] as f32 + (b[k] as f32 - a[k] as f32) * t + 0.5) as u8;
@@ -326,18 +340,6 @@ struct Region<'a> {
     setups: &'a [&'a SetupTriangle],
 }
 
-/// Whether this CPU runs the AVX2 loops ([`avx2`]); the bytes are the same either way.
-fn avx2_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 /// Fig. 4's vertex and fragment programs up to the texture read, for one band: per pixel, the
 /// source coordinate of the fragment that wins the depth test (NaN: no fragment, the pixel
 /// keeps the pattern). A discarded fragment writes no depth, as on a GPU.
@@ -346,6 +348,25 @@ fn avx2_available() -> bool {
 /// image it samples, so they are found once per band (deferred texturing) rather than once per
 /// strip; the strips then only read ([`resolve_row`]).
 fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, simd: bool) -> Vec<f32> {
+    #[cfg(target_arch = "x86_64")]
+    if simd {
+        // SAFETY: `simd` is only set where `avx2_available()` said so.
+        return unsafe { avx2::band_sources(regions, width, y0, rows) };
+    }
+    let _ = simd;
+    sources_with(regions, width, y0, rows, span_sources)
+}
+
+/// [`band_sources`] with `span` for each covered span (the scalar [`span_sources`] or its AVX2
+/// twin; inlined into each, so the AVX2 loop is inlined too).
+#[inline(always)]
+fn sources_with(
+    regions: &[Region],
+    width: u32,
+    y0: u32,
+    rows: u32,
+    span: impl Fn(&SetupTriangle, u32, u32, usize, &mut [f32], &mut [f32], &SpanTarget),
+) -> Vec<f32> {
     let w = width as usize;
     let mut sources = vec![f32::NAN; w * rows as usize];
     let mut depth = vec![1.0f32; w * rows as usize];
@@ -354,22 +375,18 @@ fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, simd: bool) 
             t.spans(r.x0, y0, r.x1 - r.x0, rows, |py, x_lo, x_hi| {
                 let i = (py - y0) as usize * w + x_lo as usize;
                 let n = (x_hi - x_lo) as usize + 1;
-                let (d, p) = (&mut depth[i..i + n], &mut sources[i..i + n]);
-                #[cfg(target_arch = "x86_64")]
-                if simd {
-                    // SAFETY: `simd` is only set where `avx2_available()` said so.
-                    unsafe { avx2::span_sources(t, py, x_lo, d, p, &r.target) };
-                    return;
-                }
-                let _ = simd;
-                span_sources(t, py, x_lo, d, p, &r.target);
+                // The span's pixels start the slices; what follows may be read and written
+                // back unchanged (a full vector past the span's end).
+                let (d, p) = (&mut depth[i..], &mut sources[i..]);
+                span(t, py, x_lo, n, d, p, &r.target);
             });
         }
     }
     sources
 }
 
-/// One covered span of triangle `t` in row `y`, pixels `x_lo ..` (as many as `depth` holds):
+/// One covered span of triangle `t` in row `y`, the `n` pixels from `x_lo` (the first `n` of
+/// `depth` and `sources`):
 /// the fragment stage of [`traverse`](crate::raster::traverse) (same expressions, same order)
 /// up to the source coordinate; a fragment wins when it passes the depth test LESS and its
 /// source is in bounds.
@@ -377,12 +394,13 @@ fn span_sources(
     t: &SetupTriangle,
     y: u32,
     x_lo: u32,
+    n: usize,
     depth: &mut [f32],
     sources: &mut [f32],
     target: &SpanTarget,
 ) {
     let fy = t.fy(y);
-    for (k, (d, p)) in depth.iter_mut().zip(sources).enumerate() {
+    for (k, (d, p)) in depth[..n].iter_mut().zip(&mut sources[..n]).enumerate() {
         let x = x_lo + k as u32;
         let fx = t.fx(x);
         let z = t.depth_at(fx, fy);
@@ -395,26 +413,48 @@ fn span_sources(
     }
 }
 
-/// Fig. 4's texture read for one strip's pixels `x0 .. x0 + out.len()` of one row: each pixel
-/// with a source takes its color from `row` as the earlier strips left it, the others the
-/// pattern (`pattern(x)`). `row` is not written: a ping-pong pair of textures keeps the strip's
-/// old pixels readable. Only finished strips are ever read (`d ≥ δ` > the strip width), so the
-/// pattern is needed only where no fragment lands.
-fn resolve_row(
+/// Fig. 4's texture read for pixel `x` of `strip` in one row: with a source, the color there
+/// as the image stood when the strip began, else the pattern (`pattern(x)`).
+///
+/// The image a strip reads is the previous iteration's (a ping-pong pair of textures): the
+/// earlier strips finished, this strip's pixels and those of strips not yet run still the
+/// pattern. Reads of those are answered from the pattern, so writing the strip in place is
+/// exact. (With `d ≥ δ` wider than the strip they do not happen, save for extrapolation
+/// slightly past a sliver's edge.)
+#[inline]
+fn resolve_pixel(
     row: &[[u8; 4]],
     sources: &[f32],
-    x0: usize,
-    out: &mut [[u8; 4]],
+    x: usize,
+    strip: &Strip,
+    bilinear: bool,
+    pattern: &impl Fn(usize) -> [u8; 4],
+) -> [u8; 4] {
+    let p = sources[x];
+    if p.is_nan() {
+        return pattern(x);
+    }
+    let (i0, i1, t) = address(p, bilinear);
+    let read = |i: usize| {
+        if strip.unfinished(i) {
+            pattern(i)
+        } else {
+            row[i]
+        }
+    };
+    mix(read(i0), read(i1), t)
+}
+
+/// [`resolve_pixel`] for every pixel of `strip` in one row, written in place.
+fn resolve_row(
+    row: &mut [[u8; 4]],
+    sources: &[f32],
+    strip: &Strip,
     bilinear: bool,
     pattern: impl Fn(usize) -> [u8; 4],
 ) {
-    for (k, o) in out.iter_mut().enumerate() {
-        let p = sources[x0 + k];
-        *o = if p.is_nan() {
-            pattern(x0 + k)
-        } else {
-            sample(row, address(p, bilinear))
-        };
+    for x in strip.x0 as usize..(strip.x0 + strip.width) as usize {
+        row[x] = resolve_pixel(row, sources, x, strip, bilinear, &pattern);
     }
 }
 
@@ -432,7 +472,6 @@ fn resolve_strip(
     links: Option<&[AtomicI32]>,
 ) {
     let (x0, sw) = (strip.x0 as usize, strip.width as usize);
-    let out = &mut vec![[0u8; 4]; sw][..];
     let rows = image
         .chunks_exact_mut(width)
         .zip(sources.chunks_exact(width));
@@ -442,13 +481,11 @@ fn resolve_strip(
         if simd {
             // SAFETY: `simd` is only set where `avx2_available()` said so; `band_sources`
             // stored only NaN or in-bounds sources.
-            unsafe { avx2::resolve_row(row, src, x0, out, bilinear, pattern) };
-        } else {
-            resolve_row(row, src, x0, out, bilinear, pattern);
+            unsafe { avx2::resolve_row(row, src, strip, bilinear, pattern) };
+            continue;
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        resolve_row(row, src, x0, out, bilinear, pattern);
-        row[x0..x0 + sw].copy_from_slice(out);
+        let _ = simd;
+        resolve_row(row, src, strip, bilinear, pattern);
     }
     if let Some(links) = links {
         for (k, &p) in sources.iter().enumerate() {

@@ -9,65 +9,47 @@
 
 use std::arch::x86_64::*;
 
-use super::SpanTarget;
-use crate::raster::{Plane, SetupTriangle};
+use super::{Region, SpanTarget, Strip};
+use crate::raster::SetupTriangle;
+use crate::raster::avx2::{clamp01, floor_i32, lane_ids, plane_at, tail_mask};
 
-/// Lane indices 0..8.
-#[target_feature(enable = "avx2")]
-fn lane_ids() -> __m256i {
-    _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)
-}
-
-/// Lanes `< remaining` set.
-#[target_feature(enable = "avx2")]
-fn tail_mask(remaining: usize) -> __m256i {
-    _mm256_cmpgt_epi32(_mm256_set1_epi32(remaining.min(8) as i32), lane_ids())
-}
-
-/// `plane.at(fx, fy)` per lane: `(a0 + dadx·fx) + dady·fy`.
-#[target_feature(enable = "avx2")]
-fn plane_at(p: &Plane, fx: __m256, fy: f32) -> __m256 {
-    let row = _mm256_set1_ps(p.dady * fy);
-    _mm256_add_ps(
-        _mm256_add_ps(
-            _mm256_set1_ps(p.a0),
-            _mm256_mul_ps(_mm256_set1_ps(p.dadx), fx),
-        ),
-        row,
-    )
-}
-
-/// `v.clamp(0, 1)` per lane, NaN kept (as `f32::clamp`).
-#[target_feature(enable = "avx2")]
-fn clamp01(v: __m256) -> __m256 {
-    let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
-    let v = _mm256_blendv_ps(v, zero, _mm256_cmp_ps::<_CMP_LT_OQ>(v, zero));
-    _mm256_blendv_ps(v, one, _mm256_cmp_ps::<_CMP_GT_OQ>(v, one))
-}
-
-/// `⌊v⌋` per lane for `|v| < 2³¹`: truncate, then step down where that rounded up.
-#[target_feature(enable = "avx2")]
-fn floor_i32(v: __m256) -> __m256i {
-    let i = _mm256_cvttps_epi32(v);
-    let above = _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_cvtepi32_ps(i), v);
-    _mm256_add_epi32(i, _mm256_castps_si256(above))
-}
-
-/// One covered span of triangle `t` in row `y`, pixels `x_lo ..` (as many as `depth` holds):
-/// depth test LESS, source coordinate, bounds test, and the winners' depth and source written.
+/// [`super::band_sources`] with [`span_sources`] inlined.
 ///
 /// # Safety
 /// The CPU must support AVX2.
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn span_sources(
+pub(super) unsafe fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32) -> Vec<f32> {
+    // SAFETY: this function runs only where AVX2 is available.
+    super::sources_with(
+        regions,
+        width,
+        y0,
+        rows,
+        |t, y, x, n, d, p, target| unsafe { span_sources(t, y, x, n, d, p, target) },
+    )
+}
+
+/// One covered span of triangle `t` in row `y`, the `n` pixels from `x_lo`: depth test LESS,
+/// source coordinate, bounds test, and the winners' depth and source written. `depth` and
+/// `sources` start at the span and may run on: where a whole vector fits, it is loaded and
+/// stored unmasked, the lanes past the span written back unchanged (a masked store is slower,
+/// and a masked load of one just stored cannot be forwarded).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn span_sources(
     t: &SetupTriangle,
     y: u32,
     x_lo: u32,
+    n: usize,
     depth: &mut [f32],
     sources: &mut [f32],
     target: &SpanTarget,
 ) {
-    let n = depth.len().min(sources.len());
+    let room = depth.len().min(sources.len());
+    let n = n.min(room);
     let (ox, _) = t.origin();
     let fy = t.fy(y);
     let (zp, wp, vp) = (t.depth_plane(), t.inv_w_plane(), t.varying_plane(0));
@@ -101,49 +83,58 @@ pub(super) unsafe fn span_sources(
                 _mm256_cmp_ps::<_CMP_LT_OQ>(q, hi),
             )
         };
-        // SAFETY: the mask covers lanes k .. min(k + 8, n), inside both slices.
+        // SAFETY: a full vector is used only where 8 lanes fit in both slices; otherwise the
+        // mask covers lanes k .. min(k + 8, n), inside both.
         unsafe {
             let (dp, sp) = (depth.as_mut_ptr().add(k), sources.as_mut_ptr().add(k));
-            let d = _mm256_maskload_ps(dp, mask);
-            let s = _mm256_maskload_ps(sp, mask);
-            let wins = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), inside);
-            _mm256_maskstore_ps(dp, mask, _mm256_blendv_ps(d, z, wins));
-            _mm256_maskstore_ps(sp, mask, _mm256_blendv_ps(s, src, wins));
+            if k + 8 <= room {
+                let (d, s) = (_mm256_loadu_ps(dp), _mm256_loadu_ps(sp));
+                let wins = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), inside);
+                let wins = _mm256_and_ps(wins, _mm256_castsi256_ps(mask));
+                _mm256_storeu_ps(dp, _mm256_blendv_ps(d, z, wins));
+                _mm256_storeu_ps(sp, _mm256_blendv_ps(s, src, wins));
+            } else {
+                let d = _mm256_maskload_ps(dp, mask);
+                let s = _mm256_maskload_ps(sp, mask);
+                let wins = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), inside);
+                _mm256_maskstore_ps(dp, mask, _mm256_blendv_ps(d, z, wins));
+                _mm256_maskstore_ps(sp, mask, _mm256_blendv_ps(s, src, wins));
+            }
         }
         k += 8;
     }
 }
 
-/// One strip's pixels `x0 .. x0 + out.len()` of one row: each pixel with a source takes
-/// `row`'s color there (bilinear: the two neighbors mixed per channel and rounded), the others
-/// the pattern. `row` is not written (the strip's old pixels stay readable).
+/// [`super::resolve_row`] eight pixels at a time: each pixel of `strip` with a source takes
+/// `row`'s color there (bilinear: the two neighbors mixed per channel and rounded), in place.
+/// Lanes without a source, or reading a pixel that is not final yet, go through
+/// [`super::resolve_pixel`] (the pattern answers for those).
 ///
 /// # Safety
 /// The CPU must support AVX2; every source in `sources` is NaN or inside `row` (as
 /// [`super::in_bounds`] ensured).
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn resolve_row(
-    row: &[[u8; 4]],
+    row: &mut [[u8; 4]],
     sources: &[f32],
-    x0: usize,
-    out: &mut [[u8; 4]],
+    strip: &Strip,
     bilinear: bool,
     pattern: impl Fn(usize) -> [u8; 4],
 ) {
-    let n = out.len();
+    let (x0, n) = (strip.x0 as usize, strip.width as usize);
     assert!(x0 + n <= row.len() && x0 + n <= sources.len());
-    let base = row.as_ptr() as *const i32;
     let half = _mm256_set1_ps(0.5);
     let byte = _mm256_set1_epi32(0xff);
     let mut k = 0;
     while k < n {
         let mask = tail_mask(n - k);
-        // SAFETY: the mask covers lanes k .. min(k + 8, n), inside `row`, `sources` and `out`
+        // SAFETY: the mask covers lanes k .. min(k + 8, n), inside `row` and `sources`
         // (asserted); gathered indices are in bounds (NaN lanes gather pixel 0).
-        unsafe {
+        let (color, i0, i1, has) = unsafe {
             let p = _mm256_maskload_ps(sources.as_ptr().add(x0 + k), mask);
             let has = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_ORD_Q>(p, p));
-            let color = if bilinear {
+            let base = row.as_ptr() as *const i32;
+            if bilinear {
                 let i0 = _mm256_and_si256(floor_i32(p), has);
                 let t = _mm256_sub_ps(p, _mm256_cvtepi32_ps(i0));
                 let mixes = _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_setzero_ps());
@@ -166,20 +157,28 @@ pub(super) unsafe fn resolve_row(
                 );
                 let mixed = _mm256_or_si256(rgb, _mm256_set1_epi32(0xff00_0000u32 as i32));
                 // A whole-pixel source copies that pixel, alpha included.
-                _mm256_blendv_epi8(a, mixed, _mm256_castps_si256(mixes))
+                let color = _mm256_blendv_epi8(a, mixed, _mm256_castps_si256(mixes));
+                (color, i0, i1, has)
             } else {
                 let i = _mm256_and_si256(floor_i32(_mm256_add_ps(p, half)), has);
-                _mm256_i32gather_epi32::<4>(base, i)
-            };
-            _mm256_maskstore_epi32(out.as_mut_ptr().add(k) as *mut i32, mask, color);
-            // Lanes without a source (the first strip, discarded fragments): the pattern.
-            let missing =
-                !_mm256_movemask_ps(_mm256_castsi256_ps(has)) & ((1 << (n - k).min(8)) - 1);
-            if missing != 0 {
-                for lane in (0..8).filter(|l| missing & (1 << l) != 0) {
-                    out[k + lane] = pattern(x0 + k + lane);
-                }
+                (_mm256_i32gather_epi32::<4>(base, i), i, i, has)
             }
+        };
+        // Reads of pixels not final yet: at or right of x0 going right, left of the strip's
+        // end going left.
+        let unfinished = if strip.toward > 0.0 {
+            _mm256_cmpgt_epi32(i1, _mm256_set1_epi32(x0 as i32 - 1))
+        } else {
+            _mm256_cmpgt_epi32(_mm256_set1_epi32((x0 + n) as i32), i0)
+        };
+        let plain = _mm256_andnot_si256(unfinished, has);
+        let lanes = (1 << (n - k).min(8)) - 1;
+        let special = !_mm256_movemask_ps(_mm256_castsi256_ps(plain)) & lanes;
+        // SAFETY: as above, the mask keeps the store inside `row`.
+        unsafe { _mm256_maskstore_epi32(row.as_mut_ptr().add(x0 + k) as *mut i32, mask, color) };
+        for lane in (0..8).filter(|l| special & (1 << l) != 0) {
+            let x = x0 + k + lane;
+            row[x] = super::resolve_pixel(row, sources, x, strip, bilinear, &pattern);
         }
         k += 8;
     }
