@@ -137,14 +137,21 @@ pub fn setup_triangles<S: Shader>(
     height: u32,
     opts: &RasterOptions,
 ) -> (Setups, RasterStats) {
-    // Vertex stage, once per vertex (a post-transform cache, like a GPU's), in parallel.
-    let verts: Vec<ClipVertex> = (0..vertex_count as u32)
+    // Vertex stage, once per vertex (a post-transform cache, like a GPU's), in parallel; with
+    // each vertex's outcode and window position, which every unclipped triangle sharing it
+    // reuses.
+    let verts: Vec<PostVertex> = (0..vertex_count as u32)
         .into_par_iter()
         .with_min_len(SETUP_CHUNK)
         .map(|i| {
             let mut var: Varyings = [0.0; crate::shade::MAX_VARYINGS];
             let pos = shader.vertex(i, &mut var);
-            ClipVertex { pos, var }
+            let clip = ClipVertex { pos, var };
+            PostVertex {
+                code: outcode(pos),
+                window: WindowVertex::from_clip(&clip, width, height),
+                clip,
+            }
         })
         .collect();
     let nvar = shader.varying_count().min(crate::shade::MAX_VARYINGS);
@@ -201,10 +208,18 @@ impl<'a> IntoIterator for &'a Setups {
 /// Triangles per setup task.
 const SETUP_CHUNK: usize = 256;
 
+/// A vertex after the vertex stage: clip position and varyings, outcode, window position.
+#[derive(Clone, Copy)]
+struct PostVertex {
+    clip: ClipVertex,
+    code: u8,
+    window: Option<WindowVertex>,
+}
+
 /// Clipping, perspective divide and setup of one chunk of triangles, in order.
 fn setup_chunk(
     triangles: &[[u32; 3]],
-    verts: &[ClipVertex],
+    verts: &[PostVertex],
     nvar: usize,
     width: u32,
     height: u32,
@@ -227,22 +242,31 @@ fn setup_chunk(
             stats.non_finite += 1; // an index past the vertex count: nothing sensible to draw
             continue;
         };
-        let t = [*a, *b, *c];
-        if t.iter().any(|v| !v.pos.is_finite()) {
+        if [a, b, c].iter().any(|v| !v.clip.pos.is_finite()) {
             stats.non_finite += 1;
             continue;
         }
-        let codes = [outcode(t[0].pos), outcode(t[1].pos), outcode(t[2].pos)];
-        if codes[0] & codes[1] & codes[2] != 0 {
+        if a.code & b.code & c.code != 0 {
             continue; // all three outside the same plane
         }
-        let n = if codes[0] | codes[1] | codes[2] == 0 {
-            poly[..3].copy_from_slice(&t);
-            3
-        } else {
-            stats.clipped += 1;
-            clip_triangle(t, nvar, &mut poly)
+        let mut add = |w: [WindowVertex; 3], var: [&Varyings; 3]| {
+            match setup_triangle(w, var, nvar, width, height, opts) {
+                Setup::Triangle(t) => setups.push(t),
+                Setup::Culled => return true,
+                Setup::Empty => {}
+            }
+            false
         };
+        if a.code | b.code | c.code == 0 {
+            // Inside: the cached window positions.
+            if let (Some(wa), Some(wb), Some(wc)) = (a.window, b.window, c.window) {
+                let culled = add([wa, wb, wc], [&a.clip.var, &b.clip.var, &c.clip.var]);
+                stats.culled += culled as usize;
+            }
+            continue;
+        }
+        stats.clipped += 1;
+        let n = clip_triangle([a.clip, b.clip, c.clip], nvar, &mut poly);
         for k in 0..n {
             win[k] = WindowVertex::from_clip(&poly[k], width, height);
         }
@@ -252,18 +276,7 @@ fn setup_chunk(
             let (Some(a), Some(b), Some(c)) = (win[0], win[k], win[k + 1]) else {
                 continue;
             };
-            match setup_triangle(
-                [a, b, c],
-                [&poly[0].var, &poly[k].var, &poly[k + 1].var],
-                nvar,
-                width,
-                height,
-                opts,
-            ) {
-                Setup::Triangle(t) => setups.push(t),
-                Setup::Culled => culled = true,
-                Setup::Empty => {}
-            }
+            culled |= add([a, b, c], [&poly[0].var, &poly[k].var, &poly[k + 1].var]);
         }
         stats.culled += culled as usize;
     }

@@ -49,7 +49,20 @@ impl WindowVertex {
 /// `round((c − 0.5) · 2^bits)`, rounding half to even as SSE `cvtps2dq` does.
 #[inline]
 pub fn snap(coord: f32, bits: u32) -> i64 {
-    ((coord - 0.5) * (1u32 << bits) as f32).round_ties_even() as i64
+    round_ties_even((coord - 0.5) * (1u32 << bits) as f32) as i64
+}
+
+/// `v.round_ties_even()` without the libm call it is on baseline x86-64 (no SSE4.1 `roundss`):
+/// adding and subtracting 1.5·2²³ rounds to a whole number in the FPU's ties-to-even mode,
+/// exactly, while `|v| < 2²²`; larger values (and NaN) take the library path.
+#[inline]
+fn round_ties_even(v: f32) -> f32 {
+    const MAGIC: f32 = 12_582_912.0; // 1.5 · 2²³
+    if v.abs() < 4_194_304.0 {
+        (v + MAGIC) - MAGIC
+    } else {
+        v.round_ties_even()
+    }
 }
 
 /// A linear function of window position, `a0 + dadx (x − x0) + dady (y − y0)`, evaluated as
@@ -154,19 +167,13 @@ pub fn setup_triangle(
         c[i] -= 1;
     }
     let s = 1i64 << bits;
-    let ceil_div = |a: i64| a.div_euclid(s) + (a.rem_euclid(s) != 0) as i64;
+    // Floor and ceiling division by the power of two S: shifts, not `idiv`.
+    let floor_div = |a: i64| a >> bits;
+    let ceil_div = |a: i64| (a >> bits) + (a & (s - 1) != 0) as i64;
     let px0 = ceil_div(xs[0].min(xs[1]).min(xs[2])).max(0);
     let py0 = ceil_div(ys[0].min(ys[1]).min(ys[2])).max(0);
-    let px1 = xs[0]
-        .max(xs[1])
-        .max(xs[2])
-        .div_euclid(s)
-        .min(width as i64 - 1);
-    let py1 = ys[0]
-        .max(ys[1])
-        .max(ys[2])
-        .div_euclid(s)
-        .min(height as i64 - 1);
+    let px1 = floor_div(xs[0].max(xs[1]).max(xs[2])).min(width as i64 - 1);
+    let py1 = floor_div(ys[0].max(ys[1]).max(ys[2])).min(height as i64 - 1);
     if px0 > px1 || py0 > py1 {
         return Setup::Empty;
     }
@@ -489,4 +496,46 @@ pub fn traverse<S: Shader>(
         }
     });
     fragments
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_ties_even;
+
+    /// The magic-number rounding snaps as `f32::round_ties_even` does: every quarter step
+    /// around zero, around the 2²² switch-over and the snapping range of a 16384-pixel
+    /// target at 8 subpixel bits, and every float between two ties.
+    #[test]
+    fn magic_rounding_matches_round_ties_even() {
+        let check = |v: f32| {
+            assert_eq!(
+                round_ties_even(v) as i64,
+                v.round_ties_even() as i64,
+                "v = {v}"
+            );
+        };
+        for centre in [0.0f32, 4_194_304.0, -4_194_304.0, 2_097_152.0, -2_097_152.0] {
+            for k in -4096..=4096 {
+                check(centre + k as f32 * 0.25);
+            }
+        }
+        let mut v = 1.5f32;
+        while v < 2.5 {
+            check(v);
+            check(-v);
+            v = f32::from_bits(v.to_bits() + 1);
+        }
+        // Only the integer reaches the rasterizer, so −0.3 → +0 (not −0) is the same snap.
+        for v in [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            1e30,
+            -1e30,
+            -0.0,
+            -0.3,
+        ] {
+            check(v);
+        }
+    }
 }
