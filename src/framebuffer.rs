@@ -1,5 +1,7 @@
 //! Color + depth render targets, and the pair of eye framebuffers.
 
+use rayon::prelude::*;
+
 use crate::error::{Error, Result};
 
 /// Largest image side we accept.
@@ -38,11 +40,17 @@ impl Framebuffer {
     pub fn new(width: u32, height: u32, clear_color: [u8; 4]) -> Result<Self> {
         check_size(width, height)?;
         let n = width as usize * height as usize;
+        // Filled in parallel: a few MB each, written once per frame.
+        let (mut color, mut depth) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        rayon::join(
+            || color.par_extend(rayon::iter::repeat_n(clear_color, n)),
+            || depth.par_extend(rayon::iter::repeat_n(1.0f32, n)),
+        );
         Ok(Framebuffer {
             width,
             height,
-            color: vec![clear_color; n],
-            depth: vec![1.0; n],
+            color,
+            depth,
         })
     }
 

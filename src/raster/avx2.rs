@@ -4,11 +4,23 @@
 
 use std::arch::x86_64::*;
 
-use super::{Plane, SetupTriangle};
+use super::{Band, Plane, SetupTriangle};
 
 /// Whether this CPU runs the AVX2 loops; the bytes are the same either way.
 pub fn available() -> bool {
-    is_x86_feature_detected!("avx2")
+    is_x86_feature_detected!("avx2") && is_x86_feature_detected!("popcnt")
+}
+
+/// `v` unchanged, opaque to the optimizer. A lane blend of a loaded vector stored back where it
+/// came from is what a masked store does, and LLVM rewrites it into one; but a masked store
+/// cannot forward to the next overlapping load (the next triangle's span in the same row),
+/// which then waits for it to retire: that cost a quarter of the depth pass.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) fn opaque(mut v: __m256) -> __m256 {
+    // SAFETY: an empty instruction sequence; it only hides the value's origin.
+    unsafe { std::arch::asm!("/* {0} */", inout(ymm_reg) v, options(pure, nomem, nostack)) };
+    v
 }
 
 /// Lane indices 0..8.
@@ -52,37 +64,145 @@ pub(crate) fn floor_i32(v: __m256) -> __m256i {
     _mm256_add_epi32(i, _mm256_castps_si256(above))
 }
 
-/// The depth-only span of triangle `t` in row `y`, pixels `x_lo ..` (as many as `depth`
-/// holds): depth test LESS with depth writes. Returns the fragments that passed.
+/// Calls `f(y, x, mask)` for every vector of eight pixels (`x .. x + 8` of row `y`) holding
+/// pixels of `t` covered within the tile (columns `x0 .. x0 + width`, rows `y0 .. y0 + rows`),
+/// `mask` marking the covered lanes. A triangle at most eight columns wide there takes one
+/// vector per row, its coverage from the edge functions in `i32` lanes ([`SmallBox`]: the
+/// per-row span search and its branches cost more than the pixels of a small triangle);
+/// larger ones go span by span ([`SetupTriangle::spans`]). Both give the same coverage.
+///
+/// [`SmallBox`]: super::SmallBox
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) fn covered_vectors(
+    t: &SetupTriangle,
+    (x0, y0, width, rows): (u32, u32, u32, u32),
+    mut f: impl FnMut(u32, u32, __m256i),
+) {
+    if let Some(b) = t.small_box(x0, y0, width, rows, 8) {
+        let lanes = lane_ids();
+        let in_box = _mm256_cmpgt_epi32(_mm256_set1_epi32(b.columns as i32), lanes);
+        let edge = |i: usize| {
+            _mm256_add_epi32(
+                _mm256_set1_epi32(b.e[i]),
+                _mm256_mullo_epi32(_mm256_set1_epi32(b.dx[i]), lanes),
+            )
+        };
+        let (mut e0, mut e1, mut e2) = (edge(0), edge(1), edge(2));
+        let (d0, d1, d2) = (
+            _mm256_set1_epi32(b.dy[0]),
+            _mm256_set1_epi32(b.dy[1]),
+            _mm256_set1_epi32(b.dy[2]),
+        );
+        let below = _mm256_set1_epi32(-1);
+        for y in b.y0..=b.y1 {
+            let inside = _mm256_and_si256(
+                _mm256_cmpgt_epi32(e0, below),
+                _mm256_and_si256(_mm256_cmpgt_epi32(e1, below), _mm256_cmpgt_epi32(e2, below)),
+            );
+            let covered = _mm256_and_si256(inside, in_box);
+            if _mm256_movemask_ps(_mm256_castsi256_ps(covered)) != 0 {
+                f(y, b.x, covered);
+            }
+            e0 = _mm256_add_epi32(e0, d0);
+            e1 = _mm256_add_epi32(e1, d1);
+            e2 = _mm256_add_epi32(e2, d2);
+        }
+        return;
+    }
+    t.spans(x0, y0, width, rows, |y, x_lo, x_hi| {
+        let n = (x_hi - x_lo) as usize + 1;
+        for k in (0..n).step_by(8) {
+            f(y, x_lo + k as u32, tail_mask(n - k));
+        }
+    });
+}
+
+/// Loads eight values from `p`: unmasked when `full` (eight fit), else the `mask` lanes.
+///
+/// # Safety
+/// `p` points at eight readable values when `full`, else at the `mask` lanes.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) unsafe fn load(p: *const f32, mask: __m256i, full: bool) -> __m256 {
+    // SAFETY: as the caller promises.
+    unsafe {
+        if full {
+            _mm256_loadu_ps(p)
+        } else {
+            _mm256_maskload_ps(p, mask)
+        }
+    }
+}
+
+/// Stores eight values at `p`: unmasked when `full` (the lanes outside `mask` must then hold
+/// what was loaded there), else the `mask` lanes. A masked store is slow, and a masked load of
+/// one just stored cannot be forwarded, hence the full form wherever eight fit.
+///
+/// # Safety
+/// As [`load`], writable.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) unsafe fn store(p: *mut f32, mask: __m256i, full: bool, v: __m256) {
+    // SAFETY: as the caller promises.
+    unsafe {
+        if full {
+            _mm256_storeu_ps(p, v)
+        } else {
+            _mm256_maskstore_ps(p, mask, v)
+        }
+    }
+}
+
+/// [`traverse`](super::traverse) of a depth-only pass for every triangle of `bin` over `band`:
+/// depth test LESS with depth writes, eight pixels at a time. Returns the fragments that passed.
 ///
 /// # Safety
 /// The CPU must support AVX2.
-#[target_feature(enable = "avx2")]
-pub(crate) unsafe fn depth_span(t: &SetupTriangle, y: u32, x_lo: u32, depth: &mut [f32]) -> usize {
-    let n = depth.len();
-    let (ox, _) = t.origin();
-    let fy = t.fy(y);
-    let zp = t.depth_plane();
-    let half = _mm256_set1_ps(0.5);
+#[target_feature(enable = "avx2,popcnt")]
+pub(crate) unsafe fn depth_band(bin: &[&SetupTriangle], band: &mut Band) -> usize {
+    let rows = (band.depth.len() / band.width.max(1) as usize) as u32;
+    let (x0, y0, w) = (band.x0, band.y0, band.width as usize);
     let mut passed = 0;
-    let mut k = 0;
-    while k < n {
-        let mask = tail_mask(n - k);
-        let x = _mm256_add_epi32(_mm256_set1_epi32((x_lo as usize + k) as i32), lane_ids());
-        let fx = _mm256_sub_ps(
-            _mm256_add_ps(_mm256_cvtepi32_ps(x), half),
-            _mm256_set1_ps(ox),
-        );
-        let z = clamp01(plane_at(&zp, fx, fy));
-        // SAFETY: the mask covers lanes k .. min(k + 8, n), inside `depth`.
-        unsafe {
-            let dp = depth.as_mut_ptr().add(k);
-            let d = _mm256_maskload_ps(dp, mask);
-            let pass = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
-            _mm256_maskstore_ps(dp, mask, _mm256_blendv_ps(d, z, pass));
-            passed += _mm256_movemask_ps(pass).count_ones() as usize;
-        }
-        k += 8;
+    for t in bin {
+        covered_vectors(t, (x0, y0, band.width, rows), |y, x, mask| {
+            let i = (y - y0) as usize * w + (x - x0) as usize;
+            // SAFETY: this function runs only where AVX2 is available.
+            passed += unsafe { depth_vector(t, y, x, mask, &mut band.depth[i..]) };
+        });
     }
     passed
+}
+
+/// One vector of a depth-only pass: pixels `x .. x + 8` of row `y` where `mask` is set, depth
+/// test LESS with depth writes into `depth` (starting at pixel `x`). Returns how many passed.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[target_feature(enable = "avx2,popcnt")]
+#[inline]
+pub(crate) unsafe fn depth_vector(
+    t: &SetupTriangle,
+    y: u32,
+    x: u32,
+    mask: __m256i,
+    depth: &mut [f32],
+) -> usize {
+    let full = depth.len() >= 8;
+    let (ox, _) = t.origin();
+    let xs = _mm256_add_epi32(_mm256_set1_epi32(x as i32), lane_ids());
+    let fx = _mm256_sub_ps(
+        _mm256_add_ps(_mm256_cvtepi32_ps(xs), _mm256_set1_ps(0.5)),
+        _mm256_set1_ps(ox),
+    );
+    let z = clamp01(plane_at(&t.depth_plane(), fx, t.fy(y)));
+    // SAFETY: eight lanes fit when `full`; otherwise `mask` covers only the span's pixels,
+    // inside `depth`.
+    unsafe {
+        let dp = depth.as_mut_ptr();
+        let d = opaque(load(dp, mask, full));
+        let pass = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
+        store(dp, mask, full, _mm256_blendv_ps(d, z, pass));
+        _mm256_movemask_ps(pass).count_ones() as usize
+    }
 }

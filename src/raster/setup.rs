@@ -240,6 +240,27 @@ impl SetupTriangle {
     }
 }
 
+/// A small triangle's box (see [`SetupTriangle::small_box`]): pixel `(x + j, y)` is covered
+/// when `e[i] + dx[i]·j + dy[i]·(y − y0) ≥ 0` for all three edges, exactly the coverage of
+/// [`SetupTriangle::spans`].
+#[derive(Clone, Copy, Debug)]
+pub struct SmallBox {
+    /// First column.
+    pub x: u32,
+    /// Columns in the box (at most the lanes asked for).
+    pub columns: u32,
+    /// First and last row.
+    pub y0: u32,
+    /// Last row.
+    pub y1: u32,
+    /// Edge functions at `(x, y0)`.
+    pub e: [i32; 3],
+    /// Their change per column.
+    pub dx: [i32; 3],
+    /// Their change per row.
+    pub dy: [i32; 3],
+}
+
 /// A tile of a framebuffer: columns `x0 .. x0 + width`, rows `y0 .. y0 + color.len() / width`
 /// (a band of whole rows when `x0 = 0` and `width` is the target's). Traversal touches only
 /// the tile's pixels, as a scissor rectangle would.
@@ -363,6 +384,52 @@ impl SetupTriangle {
         }
     }
 
+    /// The triangle's box within a tile (columns `x0 .. x0 + width`, rows `y0 .. y0 + rows`)
+    /// when it is at most `lanes` columns wide and its edge functions fit in `i32` there: a
+    /// vector of `lanes` pixels then covers a whole row, tested for coverage at once (llvmpipe's
+    /// small-triangle path). `None` otherwise, or when the box is empty.
+    pub fn small_box(
+        &self,
+        x0: u32,
+        y0: u32,
+        width: u32,
+        rows: u32,
+        lanes: u32,
+    ) -> Option<SmallBox> {
+        let py0 = self.py0.max(y0 as i64);
+        let py1 = self.py1.min(y0 as i64 + rows as i64 - 1);
+        let cx0 = self.px0.max(x0 as i64);
+        let cx1 = self.px1.min(x0 as i64 + width as i64 - 1);
+        if py0 > py1 || cx0 > cx1 || cx1 - cx0 >= lanes as i64 {
+            return None;
+        }
+        let s = 1i64 << self.bits;
+        let fits = |v: i64| v.unsigned_abs() < (1 << 30);
+        let mut e = [0i32; 3];
+        let mut dx = [0i32; 3];
+        let mut dy = [0i32; 3];
+        for i in 0..3 {
+            let at = |px: i64, py: i64| self.c[i] + self.dcdy[i] * py * s - self.dcdx[i] * px * s;
+            // Linear, so its extremes over the box (every lane included) lie at the corners.
+            let last = cx0 + lanes as i64 - 1;
+            let corners = [at(cx0, py0), at(last, py0), at(cx0, py1), at(last, py1)];
+            let (m, d) = (-self.dcdx[i] * s, self.dcdy[i] * s);
+            if !corners.into_iter().all(fits) || !fits(m) || !fits(d) {
+                return None;
+            }
+            (e[i], dx[i], dy[i]) = (corners[0] as i32, m as i32, d as i32);
+        }
+        Some(SmallBox {
+            x: cx0 as u32,
+            columns: (cx1 - cx0 + 1) as u32,
+            y0: py0 as u32,
+            y1: py1 as u32,
+            e,
+            dx,
+            dy,
+        })
+    }
+
     /// Pixel column `x`'s center relative to the planes' origin (the `fx` of the `*_at`
     /// functions). Through `i32`, which converts to `f32` in vector lanes; exact below 2²⁴.
     #[inline]
@@ -434,7 +501,6 @@ pub fn traverse<S: Shader>(
     );
     let mut frag_var: Varyings = [0.0; MAX_VARYINGS];
     let mut fragments = 0;
-    let simd = !writes_color && super::avx2_available();
     let (bx0, by0, bw) = (band.x0, band.y0, band.width as usize);
     t.spans(bx0, by0, band.width, rows, |py, x_lo, x_hi| {
         let fy = t.fy(py);
@@ -442,13 +508,6 @@ pub fn traverse<S: Shader>(
         let row = (py - by0) as usize * bw;
         let (i_lo, i_hi) = (row + (x_lo - bx0) as usize, row + (x_hi - bx0) as usize);
         if !writes_color && opts.depth_test {
-            #[cfg(target_arch = "x86_64")]
-            if simd {
-                // SAFETY: `simd` is only set where AVX2 is available.
-                fragments +=
-                    unsafe { super::avx2::depth_span(t, py, x_lo, &mut band.depth[i_lo..=i_hi]) };
-                return;
-            }
             // Depth only: a branch-free span the compiler vectorizes; z is the same expression
             // as below, so the bits are the same.
             for (k, d) in band.depth[i_lo..=i_hi].iter_mut().enumerate() {

@@ -579,7 +579,9 @@ fn strips_with(
         .map(|s| s.x0)
         .min()
         .unwrap_or(width);
-    let mut pixels = vec![[0u8, 0, 0, 255]; w * height as usize];
+    // Every pixel is written by its strip; this only makes the buffer (filled in parallel).
+    let mut pixels = Vec::with_capacity(w * height as usize);
+    pixels.par_extend(rayon::iter::repeat_n([0u8, 0, 0, 255], w * height as usize));
     let links: Vec<AtomicI32> = if record_links {
         (0..pixels.len()).map(|_| AtomicI32::new(-1)).collect()
     } else {

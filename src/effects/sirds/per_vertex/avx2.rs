@@ -64,6 +64,23 @@ unsafe fn span_sources(
         let xf = _mm256_cvtepi32_ps(x);
         let fx = _mm256_sub_ps(_mm256_add_ps(xf, half), _mm256_set1_ps(ox));
         let z = clamp01(plane_at(&zp, fx, fy));
+        let full = k + 8 <= room;
+        let (dp, sp) = (depth[k..].as_mut_ptr(), sources[k..].as_mut_ptr());
+        // SAFETY: a full vector is used only where 8 lanes fit in both slices; otherwise the
+        // mask covers lanes k .. min(k + 8, n), inside both.
+        let d = unsafe {
+            if full {
+                _mm256_loadu_ps(dp)
+            } else {
+                _mm256_maskload_ps(dp, mask)
+            }
+        };
+        let nearer = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
+        if _mm256_movemask_ps(nearer) == 0 {
+            // Hidden everywhere (the background plane behind the scene): nothing to write.
+            k += 8;
+            continue;
+        }
         let w = if target.perspective_correct {
             _mm256_div_ps(one, plane_at(&wp, fx, fy))
         } else {
@@ -83,20 +100,15 @@ unsafe fn span_sources(
                 _mm256_cmp_ps::<_CMP_LT_OQ>(q, hi),
             )
         };
-        // SAFETY: a full vector is used only where 8 lanes fit in both slices; otherwise the
-        // mask covers lanes k .. min(k + 8, n), inside both.
+        let wins = _mm256_and_ps(nearer, inside);
+        // SAFETY: as above.
         unsafe {
-            let (dp, sp) = (depth.as_mut_ptr().add(k), sources.as_mut_ptr().add(k));
-            if k + 8 <= room {
-                let (d, s) = (_mm256_loadu_ps(dp), _mm256_loadu_ps(sp));
-                let wins = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), inside);
-                let wins = _mm256_and_ps(wins, _mm256_castsi256_ps(mask));
+            if full {
+                let s = _mm256_loadu_ps(sp);
                 _mm256_storeu_ps(dp, _mm256_blendv_ps(d, z, wins));
                 _mm256_storeu_ps(sp, _mm256_blendv_ps(s, src, wins));
             } else {
-                let d = _mm256_maskload_ps(dp, mask);
                 let s = _mm256_maskload_ps(sp, mask);
-                let wins = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), inside);
                 _mm256_maskstore_ps(dp, mask, _mm256_blendv_ps(d, z, wins));
                 _mm256_maskstore_ps(sp, mask, _mm256_blendv_ps(s, src, wins));
             }
