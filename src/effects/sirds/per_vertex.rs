@@ -354,19 +354,6 @@ fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, simd: bool) 
         return unsafe { avx2::band_sources(regions, width, y0, rows) };
     }
     let _ = simd;
-    sources_with(regions, width, y0, rows, span_sources)
-}
-
-/// [`band_sources`] with `span` for each covered span (the scalar [`span_sources`] or its AVX2
-/// twin; inlined into each, so the AVX2 loop is inlined too).
-#[inline(always)]
-fn sources_with(
-    regions: &[Region],
-    width: u32,
-    y0: u32,
-    rows: u32,
-    span: impl Fn(&SetupTriangle, u32, u32, usize, &mut [f32], &mut [f32], &SpanTarget),
-) -> Vec<f32> {
     let w = width as usize;
     let mut sources = vec![f32::NAN; w * rows as usize];
     let mut depth = vec![1.0f32; w * rows as usize];
@@ -375,18 +362,15 @@ fn sources_with(
             t.spans(r.x0, y0, r.x1 - r.x0, rows, |py, x_lo, x_hi| {
                 let i = (py - y0) as usize * w + x_lo as usize;
                 let n = (x_hi - x_lo) as usize + 1;
-                // The span's pixels start the slices; what follows may be read and written
-                // back unchanged (a full vector past the span's end).
-                let (d, p) = (&mut depth[i..], &mut sources[i..]);
-                span(t, py, x_lo, n, d, p, &r.target);
+                let (d, p) = (&mut depth[i..i + n], &mut sources[i..i + n]);
+                span_sources(t, py, x_lo, d, p, &r.target);
             });
         }
     }
     sources
 }
 
-/// One covered span of triangle `t` in row `y`, the `n` pixels from `x_lo` (the first `n` of
-/// `depth` and `sources`):
+/// One covered span of triangle `t` in row `y`, pixels `x_lo ..` (as many as `depth` holds):
 /// the fragment stage of [`traverse`](crate::raster::traverse) (same expressions, same order)
 /// up to the source coordinate; a fragment wins when it passes the depth test LESS and its
 /// source is in bounds.
@@ -394,13 +378,12 @@ fn span_sources(
     t: &SetupTriangle,
     y: u32,
     x_lo: u32,
-    n: usize,
     depth: &mut [f32],
     sources: &mut [f32],
     target: &SpanTarget,
 ) {
     let fy = t.fy(y);
-    for (k, (d, p)) in depth[..n].iter_mut().zip(&mut sources[..n]).enumerate() {
+    for (k, (d, p)) in depth.iter_mut().zip(sources).enumerate() {
         let x = x_lo + k as u32;
         let fx = t.fx(x);
         let z = t.depth_at(fx, fy);

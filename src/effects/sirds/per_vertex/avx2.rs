@@ -11,109 +11,92 @@ use std::arch::x86_64::*;
 
 use super::{Region, SpanTarget, Strip};
 use crate::raster::SetupTriangle;
-use crate::raster::avx2::{clamp01, floor_i32, lane_ids, plane_at, tail_mask};
+use crate::raster::avx2::{
+    clamp01, covered_vectors, floor_i32, lane_ids, load, opaque, plane_at, store, tail_mask,
+};
 
-/// [`super::band_sources`] with [`span_sources`] inlined.
+/// [`super::band_sources`] eight pixels at a time ([`covered_vectors`]: small triangles a
+/// vector per row).
 ///
 /// # Safety
 /// The CPU must support AVX2.
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32) -> Vec<f32> {
-    // SAFETY: this function runs only where AVX2 is available.
-    super::sources_with(
-        regions,
-        width,
-        y0,
-        rows,
-        |t, y, x, n, d, p, target| unsafe { span_sources(t, y, x, n, d, p, target) },
-    )
+    let w = width as usize;
+    let mut sources = vec![f32::NAN; w * rows as usize];
+    let mut depth = vec![1.0f32; w * rows as usize];
+    for r in regions {
+        for t in r.setups {
+            covered_vectors(t, (r.x0, y0, r.x1 - r.x0, rows), |y, x, mask| {
+                let i = (y - y0) as usize * w + x as usize;
+                // SAFETY: this function runs only where AVX2 is available.
+                unsafe {
+                    sources_vector(t, y, x, mask, &mut depth[i..], &mut sources[i..], &r.target)
+                };
+            });
+        }
+    }
+    sources
 }
 
-/// One covered span of triangle `t` in row `y`, the `n` pixels from `x_lo`: depth test LESS,
-/// source coordinate, bounds test, and the winners' depth and source written. `depth` and
-/// `sources` start at the span and may run on: where a whole vector fits, it is loaded and
-/// stored unmasked, the lanes past the span written back unchanged (a masked store is slower,
-/// and a masked load of one just stored cannot be forwarded).
+/// Pixels `x .. x + 8` of row `y` where `mask` is set, for triangle `t`: depth test LESS,
+/// source coordinate, bounds test, and the winners' depth and source written into `depth` and
+/// `sources` (both starting at pixel `x`). Hidden vectors stop after the depth test.
 ///
 /// # Safety
 /// The CPU must support AVX2.
 #[target_feature(enable = "avx2")]
 #[inline]
-unsafe fn span_sources(
+unsafe fn sources_vector(
     t: &SetupTriangle,
     y: u32,
-    x_lo: u32,
-    n: usize,
+    x: u32,
+    mask: __m256i,
     depth: &mut [f32],
     sources: &mut [f32],
     target: &SpanTarget,
 ) {
-    let room = depth.len().min(sources.len());
-    let n = n.min(room);
+    let full = depth.len().min(sources.len()) >= 8;
     let (ox, _) = t.origin();
     let fy = t.fy(y);
-    let (zp, wp, vp) = (t.depth_plane(), t.inv_w_plane(), t.varying_plane(0));
-    let (half, one) = (_mm256_set1_ps(0.5), _mm256_set1_ps(1.0));
-    let toward = _mm256_set1_ps(target.toward);
+    let half = _mm256_set1_ps(0.5);
+    let xf = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x as i32), lane_ids()));
+    let fx = _mm256_sub_ps(_mm256_add_ps(xf, half), _mm256_set1_ps(ox));
+    let z = clamp01(plane_at(&t.depth_plane(), fx, fy));
+    let (dp, sp) = (depth.as_mut_ptr(), sources.as_mut_ptr());
+    // SAFETY: eight lanes fit in both when `full`; otherwise `mask` covers only covered
+    // pixels, inside both.
+    let d = opaque(unsafe { load(dp, mask, full) });
+    let nearer = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
+    if _mm256_movemask_ps(nearer) == 0 {
+        return; // hidden everywhere (the background plane behind the scene)
+    }
+    let w = if target.perspective_correct {
+        _mm256_div_ps(_mm256_set1_ps(1.0), plane_at(&t.inv_w_plane(), fx, fy))
+    } else {
+        _mm256_set1_ps(1.0)
+    };
+    let sep = _mm256_mul_ps(plane_at(&t.varying_plane(0), fx, fy), w);
+    let src = _mm256_sub_ps(xf, _mm256_mul_ps(_mm256_set1_ps(target.toward), sep));
     let (lo, hi) = (_mm256_set1_ps(target.lo), _mm256_set1_ps(target.hi));
-    let hi_last = _mm256_set1_ps(target.hi - 1.0);
-    let mut k = 0;
-    while k < n {
-        let mask = tail_mask(n - k);
-        let x = _mm256_add_epi32(_mm256_set1_epi32((x_lo as usize + k) as i32), lane_ids());
-        let xf = _mm256_cvtepi32_ps(x);
-        let fx = _mm256_sub_ps(_mm256_add_ps(xf, half), _mm256_set1_ps(ox));
-        let z = clamp01(plane_at(&zp, fx, fy));
-        let full = k + 8 <= room;
-        let (dp, sp) = (depth[k..].as_mut_ptr(), sources[k..].as_mut_ptr());
-        // SAFETY: a full vector is used only where 8 lanes fit in both slices; otherwise the
-        // mask covers lanes k .. min(k + 8, n), inside both.
-        let d = unsafe {
-            if full {
-                _mm256_loadu_ps(dp)
-            } else {
-                _mm256_maskload_ps(dp, mask)
-            }
-        };
-        let nearer = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
-        if _mm256_movemask_ps(nearer) == 0 {
-            // Hidden everywhere (the background plane behind the scene): nothing to write.
-            k += 8;
-            continue;
-        }
-        let w = if target.perspective_correct {
-            _mm256_div_ps(one, plane_at(&wp, fx, fy))
-        } else {
-            one
-        };
-        let sep = _mm256_mul_ps(plane_at(&vp, fx, fy), w);
-        let src = _mm256_sub_ps(xf, _mm256_mul_ps(toward, sep));
-        let inside = if target.bilinear {
-            _mm256_and_ps(
-                _mm256_cmp_ps::<_CMP_GE_OQ>(src, lo),
-                _mm256_cmp_ps::<_CMP_LE_OQ>(src, hi_last),
-            )
-        } else {
-            let q = _mm256_add_ps(src, half);
-            _mm256_and_ps(
-                _mm256_cmp_ps::<_CMP_GE_OQ>(q, lo),
-                _mm256_cmp_ps::<_CMP_LT_OQ>(q, hi),
-            )
-        };
-        let wins = _mm256_and_ps(nearer, inside);
-        // SAFETY: as above.
-        unsafe {
-            if full {
-                let s = _mm256_loadu_ps(sp);
-                _mm256_storeu_ps(dp, _mm256_blendv_ps(d, z, wins));
-                _mm256_storeu_ps(sp, _mm256_blendv_ps(s, src, wins));
-            } else {
-                let s = _mm256_maskload_ps(sp, mask);
-                _mm256_maskstore_ps(dp, mask, _mm256_blendv_ps(d, z, wins));
-                _mm256_maskstore_ps(sp, mask, _mm256_blendv_ps(s, src, wins));
-            }
-        }
-        k += 8;
+    let inside = if target.bilinear {
+        _mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_GE_OQ>(src, lo),
+            _mm256_cmp_ps::<_CMP_LE_OQ>(src, _mm256_set1_ps(target.hi - 1.0)),
+        )
+    } else {
+        let q = _mm256_add_ps(src, half);
+        _mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_GE_OQ>(q, lo),
+            _mm256_cmp_ps::<_CMP_LT_OQ>(q, hi),
+        )
+    };
+    let wins = _mm256_and_ps(nearer, inside);
+    // SAFETY: as above.
+    unsafe {
+        let s = opaque(load(sp, mask, full));
+        store(dp, mask, full, _mm256_blendv_ps(d, z, wins));
+        store(sp, mask, full, _mm256_blendv_ps(s, src, wins));
     }
 }
 
