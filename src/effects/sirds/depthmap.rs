@@ -64,6 +64,57 @@ pub fn linearize(depth: f32, near: f32, far: f32) -> f32 {
     2.0 * near * far / ((far + near) - z_ndc * (far - near))
 }
 
+/// The smallest and largest bit pattern of the covered (`< 1`) depths, as `i32`: depths are
+/// clamped to [0, 1], where the bit patterns order like the values (−0 sorts first and means
+/// 0). `(i32::MAX, i32::MIN)` when nothing is covered.
+fn covered_bounds(depth: &[f32]) -> (i32, i32) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::raster::avx2_available() {
+        // SAFETY: AVX2 is available.
+        return unsafe { covered_bounds_avx2(depth) };
+    }
+    covered_bounds_lanes(depth)
+}
+
+/// [`covered_bounds_lanes`] compiled for AVX2 (`vpminsd`/`vpmaxsd`; baseline x86-64 has no
+/// 32-bit integer min/max and emulates each with three instructions).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn covered_bounds_avx2(depth: &[f32]) -> (i32, i32) {
+    covered_bounds_lanes(depth)
+}
+
+/// [`covered_bounds`] as a branch-free integer min/max in 8 lanes, which the compiler
+/// vectorizes (a float fold stays scalar).
+#[inline(always)]
+fn covered_bounds_lanes(depth: &[f32]) -> (i32, i32) {
+    const ONE: i32 = 0x3f80_0000;
+    let (mut lo, mut hi) = ([i32::MAX; 8], [i32::MIN; 8]);
+    let chunks = depth.chunks_exact(8);
+    let tail = chunks.remainder();
+    let mut visit = |lane: usize, d: f32| {
+        let b = d.to_bits() as i32;
+        let covered = b < ONE;
+        lo[lane] = lo[lane].min(if covered { b } else { i32::MAX });
+        hi[lane] = hi[lane].max(if covered { b } else { i32::MIN });
+    };
+    for c in chunks {
+        for (lane, &d) in c.iter().enumerate() {
+            visit(lane, d);
+        }
+    }
+    for (lane, &d) in tail.iter().enumerate() {
+        visit(lane, d);
+    }
+    (
+        lo.into_iter().min().unwrap_or(i32::MAX),
+        hi.into_iter().max().unwrap_or(i32::MIN),
+    )
+}
+
 impl DepthMap {
     /// A depth map from raw nearness values.
     ///
@@ -143,38 +194,11 @@ impl DepthMap {
     /// plane 10% of the covered span behind the farthest one (seed 002 §3: "a certain distance
     /// behind the geometry"), kept inside the far clip plane. `None` when nothing is covered.
     pub fn auto_range(fb: &Framebuffer, near: f32, far: f32) -> Option<DepthRange> {
-        // Covered pixels have depth < 1. Depths are clamped to [0, 1], where the bit patterns
-        // as i32 order like the values (−0 sorts first and means 0): a branch-free integer
-        // min/max in 8 lanes, which the compiler vectorizes (a float fold stays scalar), over
-        // chunks in parallel (min and max do not care about the order).
-        const ONE: i32 = 0x3f80_0000;
-        let bounds = |depth: &[f32]| {
-            let (mut lo, mut hi) = ([i32::MAX; 8], [i32::MIN; 8]);
-            let chunks = depth.chunks_exact(8);
-            let tail = chunks.remainder();
-            let mut visit = |lane: usize, d: f32| {
-                let b = d.to_bits() as i32;
-                let covered = b < ONE;
-                lo[lane] = lo[lane].min(if covered { b } else { i32::MAX });
-                hi[lane] = hi[lane].max(if covered { b } else { i32::MIN });
-            };
-            for c in chunks {
-                for (lane, &d) in c.iter().enumerate() {
-                    visit(lane, d);
-                }
-            }
-            for (lane, &d) in tail.iter().enumerate() {
-                visit(lane, d);
-            }
-            (
-                lo.into_iter().min().unwrap_or(i32::MAX),
-                hi.into_iter().max().unwrap_or(i32::MIN),
-            )
-        };
+        // Chunks in parallel (min and max do not care about the order).
         let (lo, hi) = fb
             .depth
             .par_chunks(1 << 16)
-            .map(bounds)
+            .map(covered_bounds)
             .reduce(|| (i32::MAX, i32::MIN), |a, b| (a.0.min(b.0), a.1.max(b.1)));
         if lo > hi {
             return None;
