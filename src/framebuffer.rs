@@ -40,12 +40,11 @@ impl Framebuffer {
     pub fn new(width: u32, height: u32, clear_color: [u8; 4]) -> Result<Self> {
         check_size(width, height)?;
         let n = width as usize * height as usize;
-        // Filled in parallel: a few MB each, written once per frame.
+        // Filled in parallel, each thread a run of whole rows in both buffers, the halves a
+        // rasterizer's bands are then likely to split the same way (the thread that draws a
+        // band finds it in its own cache).
         let (mut color, mut depth) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        rayon::join(
-            || color.par_extend(rayon::iter::repeat_n(clear_color, n)),
-            || depth.par_extend(rayon::iter::repeat_n(1.0f32, n)),
-        );
+        rayon::iter::repeat_n((clear_color, 1.0f32), n).unzip_into_vecs(&mut color, &mut depth);
         Ok(Framebuffer {
             width,
             height,
