@@ -76,3 +76,58 @@ fn sirds_bytes_do_not_depend_on_the_thread_count() {
     assert_eq!(one, sirds_bytes(3), "3 threads differ from 1");
     assert_eq!(one, sirds_bytes(4), "4 threads differ from 1");
 }
+
+/// The AVX2 loops change the speed only: the whole `render` of both SIRDS scenes (strips,
+/// depth pass, depth map) writes the same PNG bytes with them as with `STEREOLAB_SCALAR=1`.
+/// Each scene is also rendered with the other filter, so nearest and bilinear both run.
+#[test]
+fn scalar_and_avx2_loops_write_the_same_files() {
+    let run = |scene: &str, filter: &str, scalar: bool| {
+        let dir = crate::common::out_dir(&format!("simd-{scene}-{filter}-{scalar}"));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .args([
+                "render",
+                &asset(&format!("scenes/{scene}.toml")).to_string_lossy(),
+            ])
+            .args([
+                "--out",
+                &dir.to_string_lossy(),
+                "--set",
+                &format!("sirds.filter=\"{filter}\""),
+            ])
+            .env("STEREOLAB_SCALAR", if scalar { "1" } else { "0" })
+            .output()
+            .expect("run stereolab");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mut files: Vec<_> = std::fs::read_dir(&dir)
+            .expect("output folder")
+            .map(|e| e.expect("entry").path())
+            .collect();
+        files.sort();
+        assert!(
+            files.len() >= 2,
+            "{scene}: expected sirds and sirds_depth, got {files:?}"
+        );
+        files
+            .iter()
+            .map(|f| {
+                (
+                    f.file_name().map(|n| n.to_owned()),
+                    std::fs::read(f).expect("read"),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    for scene in ["sirds_sphere", "sirds_ramp"] {
+        for filter in ["nearest", "bilinear"] {
+            assert!(
+                run(scene, filter, false) == run(scene, filter, true),
+                "{scene} {filter}: the scalar and AVX2 loops wrote different files"
+            );
+        }
+    }
+}

@@ -14,14 +14,25 @@ pub use setup::{
     Band, Plane, Setup, SetupTriangle, SmallBox, WindowVertex, setup_triangle, snap, traverse,
 };
 
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 
 use crate::framebuffer::Framebuffer;
 use crate::shade::{Shader, Varyings};
 
-/// Whether this CPU runs the AVX2 fragment loops (x86-64 with AVX2); the bytes are the same
-/// either way.
+/// Whether the AVX2 fragment loops run: x86-64 with AVX2, unless turned off with
+/// [`set_simd`] or the environment variable `STEREOLAB_SCALAR=1`. The bytes are the same either
+/// way (unit tests hold each loop to its scalar twin); only the speed differs.
 pub fn avx2_available() -> bool {
+    static SCALAR_ENV: OnceLock<bool> = OnceLock::new();
+    let scalar = *SCALAR_ENV.get_or_init(|| {
+        std::env::var_os("STEREOLAB_SCALAR").is_some_and(|v| !v.is_empty() && v != "0")
+    });
+    if scalar || SIMD_OFF.load(Ordering::Relaxed) {
+        return false;
+    }
     #[cfg(target_arch = "x86_64")]
     {
         avx2::available()
@@ -30,6 +41,15 @@ pub fn avx2_available() -> bool {
     {
         false
     }
+}
+
+/// Set by [`set_simd`]`(false)`.
+static SIMD_OFF: AtomicBool = AtomicBool::new(false);
+
+/// Turns the AVX2 loops off (`false`) or back on where the CPU has them (`true`), for the
+/// whole process: the benchmark measures the scalar loops this way.
+pub fn set_simd(on: bool) {
+    SIMD_OFF.store(!on, Ordering::Relaxed);
 }
 
 /// Rasterizer knobs. The defaults are what lavapipe does.
