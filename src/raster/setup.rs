@@ -347,7 +347,7 @@ impl SetupTriangle {
     /// Calls `span(py, x_lo, x_hi)` for every row of the tile (columns `x0 .. x0 + width`, rows
     /// `y0 .. y0 + rows`) in which the triangle covers pixels: exactly the covered pixels
     /// `x_lo ..= x_hi` (never empty), top row first. Coverage as testing each pixel's edge
-    /// functions, found per row in integers (see [`EdgeStep`]).
+    /// functions, found per row in integers (see `EdgeStep`).
     pub fn spans(
         &self,
         x0: u32,

@@ -5,10 +5,21 @@
 //!
 //! Each iteration finishes one vertical strip: a pixel `x` copies the pixel `x − d`, and
 //! `d ≥ δ` (the front separation), so a strip narrower than `δ` reads only finished strips and
-//! never changes again (§3). We therefore traverse each iteration's strip only (a scissor on
-//! its columns), which is the same image as rendering the whole frame k times, for about the
-//! cost of one frame; every right-going pass draws the same shifted geometry, so triangle setup
-//! runs once per direction.
+//! never changes again (§3). Rendering each iteration's strip only (a scissor on its columns)
+//! therefore gives the image of rendering the whole frame k times.
+//!
+//! How the CPU does it, for about the cost of one frame (the GPU mirror in `gpu::sirds` renders
+//! the strips as the paper does):
+//! 1. Every right-going pass draws the same shifted geometry (every left-going one the other),
+//!    so triangle setup runs once per direction.
+//! 2. Which fragment wins a pixel, and where it samples, depend on the geometry alone, never on
+//!    the image sampled: one rasterization per band of rows finds each pixel's source
+//!    coordinate (deferred texturing, `band_sources`).
+//! 3. The strips then only read, in order (`resolve_strip`): each pixel takes the color at
+//!    its source, as the earlier strips left the image.
+//!
+//! Steps 2 and 3 run eight pixels at a time on AVX2 (`per_vertex/avx2.rs`), with the scalar
+//! loops' bytes; `STEREOLAB_SCALAR=1` runs the scalar ones.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -482,11 +493,10 @@ fn resolve_strip(
 
 /// Makes a SIRDS with the strip algorithm.
 ///
-/// Every right-going pass draws the same shifted geometry (and every left-going one the
-/// other), so triangle setup runs once per direction; each strip is then traversed with a
-/// scissor on its columns, in strip order, its fragments sampling the image the earlier strips
-/// finished, with its own depth buffer (each pixel belongs to one strip). Bands of
-/// [`BAND_ROWS`] rows run in parallel: rows never interact.
+/// Triangle setup once per direction; then, per band of [`BAND_ROWS`] rows (in parallel: rows
+/// never interact), the winning fragment's source per pixel (`band_sources`) and the strips
+/// in order, each reading the image the earlier strips finished (`resolve_strip`). The
+/// result is the paper's k render passes, byte for byte (see the module notes).
 ///
 /// # Errors
 /// As [`check_inputs`], and k too small for the front separation.
