@@ -194,10 +194,12 @@ impl DepthMap {
     /// plane 10% of the covered span behind the farthest one (seed 002 §3: "a certain distance
     /// behind the geometry"), kept inside the far clip plane. `None` when nothing is covered.
     pub fn auto_range(fb: &Framebuffer, near: f32, far: f32) -> Option<DepthRange> {
-        // Chunks in parallel (min and max do not care about the order).
+        // The rasterizer's bands in parallel (min and max do not care about the order): split
+        // as the depth pass split them, each thread tends to read what it just wrote.
+        let band = fb.width as usize * crate::raster::BAND_ROWS;
         let (lo, hi) = fb
             .depth
-            .par_chunks(1 << 16)
+            .par_chunks(band.max(1))
             .map(covered_bounds)
             .reduce(|| (i32::MAX, i32::MIN), |a, b| (a.0.min(b.0), a.1.max(b.1)));
         if lo > hi {
