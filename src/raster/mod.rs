@@ -132,6 +132,7 @@ pub fn rasterize<S: Shader>(
                 // SAFETY: `depth_only` is only set where AVX2 is available.
                 return unsafe { avx2::depth_band(bin, &mut band) };
             }
+            let _ = depth_only;
             bin.iter()
                 .map(|t| traverse(t, shader, &mut band, opts))
                 .sum::<usize>()
