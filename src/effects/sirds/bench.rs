@@ -50,7 +50,7 @@ fn scene(text: &str) -> Result<Scene> {
 }
 
 /// The Table 1 scene: a height-field grid of exactly `triangles` triangles facing the camera.
-pub fn table_scene(width: u32, height: u32, triangles: u32, k: u32) -> Result<Scene> {
+pub(crate) fn table_scene(width: u32, height: u32, triangles: u32, k: u32) -> Result<Scene> {
     scene(&format!(
         r#"outputs = ["sirds"]
 [image]
