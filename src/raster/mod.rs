@@ -314,18 +314,15 @@ fn setup_chunk(
 }
 
 /// For a test comparing the AVX2 loops with the scalar ones: whether there are AVX2 loops to
-/// compare. Without them it says so and the test passes, except under CI, which runs on
-/// AVX2 machines: there a missing AVX2 is a failure, not a skip.
+/// compare. Without them (a CPU without AVX2, or `STEREOLAB_SCALAR` set) it says so on stderr
+/// and the test has nothing to hold: every path that runs is then the scalar one, which the
+/// other tests cover. (Unlike lavapipe, which `.ci/run` installs, AVX2 is the hardware's.)
 #[cfg(test)]
 pub(crate) fn avx2_to_compare(test: &str) -> bool {
     if avx2_available() {
         return true;
     }
-    assert!(
-        std::env::var_os("CI").is_none(),
-        "{test}: no AVX2 on this CI machine"
-    );
-    eprintln!("{test}: no AVX2 here (or STEREOLAB_SCALAR set), nothing to compare");
+    eprintln!("{test}: NOT RUN: no AVX2 here (or STEREOLAB_SCALAR set), nothing to compare");
     false
 }
 
