@@ -156,23 +156,21 @@ pub(crate) unsafe fn store(p: *mut f32, mask: __m256i, full: bool, v: __m256) {
     }
 }
 
-/// [`traverse`](super::traverse) of a depth-only pass for every triangle of `bin` over `band`:
-/// depth test LESS with depth writes, eight pixels at a time. Returns the fragments that passed.
+/// [`traverse`](super::traverse) of one triangle in a depth-only pass over `band`: depth test
+/// LESS with depth writes, eight pixels at a time. Returns the fragments that passed.
 ///
 /// # Safety
-/// The CPU must support AVX2.
+/// The CPU must support AVX2 and POPCNT ([`available`]).
 #[target_feature(enable = "avx2,popcnt")]
-pub(crate) unsafe fn depth_band(bin: &[&SetupTriangle], band: &mut Band) -> usize {
+pub(crate) unsafe fn depth_triangle(t: &SetupTriangle, band: &mut Band) -> usize {
     let rows = (band.depth.len() / band.width.max(1) as usize) as u32;
     let (x0, y0, w) = (band.x0, band.y0, band.width as usize);
     let mut passed = 0;
-    for t in bin {
-        covered_vectors(t, (x0, y0, band.width, rows), |y, x, mask| {
-            let i = (y - y0) as usize * w + (x - x0) as usize;
-            // SAFETY: this function runs only where AVX2 is available.
-            passed += unsafe { depth_vector(t, y, x, mask, &mut band.depth[i..]) };
-        });
-    }
+    covered_vectors(t, (x0, y0, band.width, rows), |y, x, mask| {
+        let i = (y - y0) as usize * w + (x - x0) as usize;
+        // SAFETY: this function runs only where AVX2 is available.
+        passed += unsafe { depth_vector(t, y, x, mask, &mut band.depth[i..]) };
+    });
     passed
 }
 

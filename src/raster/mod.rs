@@ -111,7 +111,8 @@ pub fn rasterize<S: Shader>(
         setup_triangles(triangles, vertex_count, shader, fb.width, fb.height, opts);
     let width = fb.width as usize;
     let bins = bin_rows(&setups, BAND_ROWS as u32, fb.height);
-    // A depth-only pass runs whole bands in the AVX2 loop (the same bits as `traverse`).
+    // A depth-only pass runs its triangles through the AVX2 loop (the same bits as
+    // `traverse`, which stays the scalar reference).
     let depth_only = !shader.writes_color() && opts.depth_test && avx2_available();
     stats.fragments = fb
         .color
@@ -127,14 +128,16 @@ pub fn rasterize<S: Shader>(
                 color,
                 depth,
             };
-            #[cfg(target_arch = "x86_64")]
-            if depth_only {
-                // SAFETY: `depth_only` is only set where AVX2 is available.
-                return unsafe { avx2::depth_band(bin, &mut band) };
-            }
-            let _ = depth_only;
             bin.iter()
-                .map(|t| traverse(t, shader, &mut band, opts))
+                .map(|t| {
+                    #[cfg(target_arch = "x86_64")]
+                    if depth_only {
+                        // SAFETY: `depth_only` is only set where AVX2 is available.
+                        return unsafe { avx2::depth_triangle(t, &mut band) };
+                    }
+                    let _ = depth_only;
+                    traverse(t, shader, &mut band, opts)
+                })
                 .sum::<usize>()
         })
         .sum();
@@ -213,16 +216,6 @@ impl Setups {
     /// Every triangle, in submission order.
     pub fn iter(&self) -> impl Iterator<Item = &SetupTriangle> {
         self.0.iter().flatten()
-    }
-
-    /// How many triangles.
-    pub fn len(&self) -> usize {
-        self.0.iter().map(Vec::len).sum()
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
     }
 }
 

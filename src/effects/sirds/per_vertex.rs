@@ -24,8 +24,6 @@
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 
-use std::sync::atomic::{AtomicI32, Ordering};
-
 use glam::Vec4;
 use rayon::prelude::*;
 
@@ -359,17 +357,19 @@ struct Region<'a> {
 /// image it samples, so they are found once per band (deferred texturing) rather than once per
 /// strip; the strips then only read ([`resolve_row`]).
 fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, simd: bool) -> Vec<f32> {
-    #[cfg(target_arch = "x86_64")]
-    if simd {
-        // SAFETY: `simd` is only set where `avx2_available()` said so.
-        return unsafe { avx2::band_sources(regions, width, y0, rows) };
-    }
-    let _ = simd;
     let w = width as usize;
     let mut sources = vec![f32::NAN; w * rows as usize];
     let mut depth = vec![1.0f32; w * rows as usize];
     for r in regions {
         for t in r.setups {
+            #[cfg(target_arch = "x86_64")]
+            if simd {
+                let band = (width, y0, rows);
+                // SAFETY: `simd` is only set where `avx2_available()` said so.
+                unsafe { avx2::triangle_sources(t, r, band, &mut depth, &mut sources) };
+                continue;
+            }
+            let _ = simd;
             t.spans(r.x0, y0, r.x1 - r.x0, rows, |py, x_lo, x_hi| {
                 let i = (py - y0) as usize * w + x_lo as usize;
                 let n = (x_hi - x_lo) as usize + 1;
@@ -452,9 +452,7 @@ fn resolve_row(
     }
 }
 
-/// Fig. 4's texture read for one strip of one band, row by row (see [`resolve_row`]), and
-/// with `links`, each pixel's source recorded.
-#[allow(clippy::too_many_arguments)]
+/// Fig. 4's texture read for one strip of one band, row by row (see [`resolve_row`]).
 fn resolve_strip(
     image: &mut [[u8; 4]],
     sources: &[f32],
@@ -463,9 +461,7 @@ fn resolve_strip(
     bilinear: bool,
     simd: bool,
     pattern: &Pattern,
-    links: Option<&[AtomicI32]>,
 ) {
-    let (x0, sw) = (strip.x0 as usize, strip.width as usize);
     let rows = image
         .chunks_exact_mut(width)
         .zip(sources.chunks_exact(width));
@@ -480,14 +476,6 @@ fn resolve_strip(
         }
         let _ = simd;
         resolve_row(row, src, strip, bilinear, pattern);
-    }
-    if let Some(links) = links {
-        for (k, &p) in sources.iter().enumerate() {
-            let x = k % width;
-            if x >= x0 && x < x0 + sw && !p.is_nan() {
-                links[k].store(address(p, bilinear).0 as i32, Ordering::Relaxed);
-            }
-        }
     }
 }
 
@@ -575,16 +563,11 @@ fn strips_with(
     // Every pixel is written by its strip; this only makes the buffer (filled in parallel).
     let mut pixels = Vec::with_capacity(w * height as usize);
     pixels.par_extend(rayon::iter::repeat_n([0u8, 0, 0, 255], w * height as usize));
-    let links: Vec<AtomicI32> = if record_links {
-        (0..pixels.len()).map(|_| AtomicI32::new(-1)).collect()
-    } else {
-        Vec::new()
-    };
     let band_len = w * BAND_ROWS as usize;
-    pixels
+    let band_links: Vec<Vec<i32>> = pixels
         .par_chunks_mut(band_len)
         .enumerate()
-        .for_each(|(b, image)| {
+        .map(|(b, image)| {
             let y0 = b as u32 * BAND_ROWS;
             let rows = (image.len() / w) as u32;
             let mut regions = Vec::with_capacity(2);
@@ -605,25 +588,29 @@ fn strips_with(
                 }
             }
             let sources = band_sources(&regions, width, y0, rows, simd);
-            let band_links = record_links.then(|| &links[b * band_len..b * band_len + image.len()]);
             for strip in &strips {
-                resolve_strip(
-                    image,
-                    &sources,
-                    (w, y0),
-                    strip,
-                    bilinear,
-                    simd,
-                    pattern,
-                    band_links,
-                );
+                resolve_strip(image, &sources, (w, y0), strip, bilinear, simd, pattern);
             }
-        });
+            // Which pixel each one copied depends on its source alone, not on the strip.
+            let link = |p: f32| {
+                if p.is_nan() {
+                    -1
+                } else {
+                    address(p, bilinear).0 as i32
+                }
+            };
+            if record_links {
+                sources.into_iter().map(link).collect()
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
     Ok(StripResult {
         pixels,
         iterations: strips.len() as u32,
         strip_width: strips.first().map_or(0, |s| s.width),
-        links: record_links.then(|| links.into_iter().map(AtomicI32::into_inner).collect()),
+        links: record_links.then(|| band_links.concat()),
     })
 }
 

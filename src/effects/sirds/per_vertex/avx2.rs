@@ -1,6 +1,6 @@
 //! The strip pass's two per-pixel loops eight pixels at a time (AVX2), as llvmpipe runs its
-//! fragment stage: [`span_sources`] mirrors [`super::span_sources`], [`resolve_row`] mirrors
-//! [`super::resolve_row`].
+//! fragment stage: [`triangle_sources`] mirrors [`super::span_sources`], [`resolve_row`]
+//! mirrors [`super::resolve_row`].
 //!
 //! Each lane performs the scalar loop's IEEE operations in the same order (no fused
 //! multiply-add, which would round once instead of twice), so the bytes are the same as the
@@ -15,28 +15,26 @@ use crate::raster::avx2::{
     clamp01, covered_vectors, floor_i32, lane_ids, load, opaque, plane_at, store, tail_mask,
 };
 
-/// [`super::band_sources`] eight pixels at a time ([`covered_vectors`]: small triangles a
-/// vector per row).
+/// [`super::span_sources`] for every pixel of triangle `t` in region `r` of the band starting
+/// at row `y0` (`rows` rows of `width` pixels), eight pixels at a time ([`covered_vectors`]:
+/// small triangles a vector per row).
 ///
 /// # Safety
 /// The CPU must support AVX2.
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32) -> Vec<f32> {
+pub(super) unsafe fn triangle_sources(
+    t: &SetupTriangle,
+    r: &Region,
+    (width, y0, rows): (u32, u32, u32),
+    depth: &mut [f32],
+    sources: &mut [f32],
+) {
     let w = width as usize;
-    let mut sources = vec![f32::NAN; w * rows as usize];
-    let mut depth = vec![1.0f32; w * rows as usize];
-    for r in regions {
-        for t in r.setups {
-            covered_vectors(t, (r.x0, y0, r.x1 - r.x0, rows), |y, x, mask| {
-                let i = (y - y0) as usize * w + x as usize;
-                // SAFETY: this function runs only where AVX2 is available.
-                unsafe {
-                    sources_vector(t, y, x, mask, &mut depth[i..], &mut sources[i..], &r.target)
-                };
-            });
-        }
-    }
-    sources
+    covered_vectors(t, (r.x0, y0, r.x1 - r.x0, rows), |y, x, mask| {
+        let i = (y - y0) as usize * w + x as usize;
+        // SAFETY: this function runs only where AVX2 is available.
+        unsafe { sources_vector(t, y, x, mask, &mut depth[i..], &mut sources[i..], &r.target) };
+    });
 }
 
 /// Pixels `x .. x + 8` of row `y` where `mask` is set, for triangle `t`: depth test LESS,
