@@ -233,11 +233,6 @@ impl SetupTriangle {
     pub fn rows(&self) -> (u32, u32) {
         (self.py0 as u32, self.py1 as u32)
     }
-
-    /// First and last pixel column the triangle may cover.
-    pub fn columns(&self) -> (u32, u32) {
-        (self.px0 as u32, self.px1 as u32)
-    }
 }
 
 /// A small triangle's box (see [`SetupTriangle::small_box`]): pixel `(x + j, y)` is covered
@@ -249,7 +244,7 @@ pub struct SmallBox {
     pub x: u32,
     /// Columns in the box (at most the lanes asked for).
     pub columns: u32,
-    /// First and last row.
+    /// First row.
     pub y0: u32,
     /// Last row.
     pub y1: u32,
@@ -344,6 +339,16 @@ impl EdgeStep {
 }
 
 impl SetupTriangle {
+    /// The triangle's pixel bounds within a tile (columns `x0 .. x0 + width`, rows
+    /// `y0 .. y0 + rows`): first and last column, first and last row; `None` when they miss it.
+    fn clipped_box(&self, x0: u32, y0: u32, width: u32, rows: u32) -> Option<(i64, i64, i64, i64)> {
+        let py0 = self.py0.max(y0 as i64);
+        let py1 = self.py1.min(y0 as i64 + rows as i64 - 1);
+        let cx0 = self.px0.max(x0 as i64);
+        let cx1 = self.px1.min(x0 as i64 + width as i64 - 1);
+        (py0 <= py1 && cx0 <= cx1).then_some((cx0, cx1, py0, py1))
+    }
+
     /// Calls `span(py, x_lo, x_hi)` for every row of the tile (columns `x0 .. x0 + width`, rows
     /// `y0 .. y0 + rows`) in which the triangle covers pixels: exactly the covered pixels
     /// `x_lo ..= x_hi` (never empty), top row first. Coverage as testing each pixel's edge
@@ -356,13 +361,9 @@ impl SetupTriangle {
         rows: u32,
         mut span: impl FnMut(u32, u32, u32),
     ) {
-        let py0 = self.py0.max(y0 as i64);
-        let py1 = self.py1.min(y0 as i64 + rows as i64 - 1);
-        let cx0 = self.px0.max(x0 as i64);
-        let cx1 = self.px1.min(x0 as i64 + width as i64 - 1);
-        if py0 > py1 || cx0 > cx1 {
+        let Some((cx0, cx1, py0, py1)) = self.clipped_box(x0, y0, width, rows) else {
             return;
-        }
+        };
         let s = 1i64 << self.bits;
         let last = self.px1 - self.px0;
         // Edge i at pixel px0 + k of row py is c + dcdy·py·S − dcdx·(px0 + k)·S: solved for k
@@ -396,11 +397,8 @@ impl SetupTriangle {
         rows: u32,
         lanes: u32,
     ) -> Option<SmallBox> {
-        let py0 = self.py0.max(y0 as i64);
-        let py1 = self.py1.min(y0 as i64 + rows as i64 - 1);
-        let cx0 = self.px0.max(x0 as i64);
-        let cx1 = self.px1.min(x0 as i64 + width as i64 - 1);
-        if py0 > py1 || cx0 > cx1 || cx1 - cx0 >= lanes as i64 {
+        let (cx0, cx1, py0, py1) = self.clipped_box(x0, y0, width, rows)?;
+        if cx1 - cx0 >= lanes as i64 {
             return None;
         }
         let s = 1i64 << self.bits;
@@ -469,16 +467,22 @@ impl SetupTriangle {
         self.z.at(fx, fy).clamp(0.0, 1.0)
     }
 
+    /// The factor that turns an interpolated `a/w` back into `a` at (`fx`, `fy`): `w`, the
+    /// reciprocal of the interpolated `1/w` (1 for affine interpolation).
+    #[inline]
+    pub fn w_at(&self, fx: f32, fy: f32, perspective_correct: bool) -> f32 {
+        if perspective_correct {
+            1.0 / self.inv_w.at(fx, fy)
+        } else {
+            1.0
+        }
+    }
+
     /// Varying `k` at (`fx`, `fy`), perspective-corrected when set up so (one reciprocal, one
     /// multiply, as the fragment stage of [`traverse`]).
     #[inline]
     pub fn varying_at(&self, k: usize, fx: f32, fy: f32, perspective_correct: bool) -> f32 {
-        let w = if perspective_correct {
-            1.0 / self.inv_w.at(fx, fy)
-        } else {
-            1.0
-        };
-        self.var[k].at(fx, fy) * w
+        self.var[k].at(fx, fy) * self.w_at(fx, fy, perspective_correct)
     }
 }
 
@@ -527,11 +531,7 @@ pub fn traverse<S: Shader>(
             if writes_color {
                 // Perspective correction: divide the interpolated a/w by the interpolated 1/w
                 // (one reciprocal per fragment, one multiply per varying).
-                let w = if opts.perspective_correct {
-                    1.0 / t.inv_w.at(fx, fy)
-                } else {
-                    1.0
-                };
+                let w = t.w_at(fx, fy, opts.perspective_correct);
                 for (out, plane) in frag_var.iter_mut().zip(&t.var[..nvar]) {
                     *out = plane.at(fx, fy) * w;
                 }
