@@ -50,6 +50,17 @@ pub(crate) fn plane_at(p: &Plane, fx: __m256, fy: f32) -> __m256 {
     )
 }
 
+/// Columns `x .. x + 8` as floats, and each relative to `t`'s plane origin: the lanes of
+/// [`SetupTriangle::fx`].
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) fn columns(t: &SetupTriangle, x: u32) -> (__m256, __m256) {
+    let xf = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x as i32), lane_ids()));
+    let (ox, _) = t.origin();
+    let fx = _mm256_sub_ps(_mm256_add_ps(xf, _mm256_set1_ps(0.5)), _mm256_set1_ps(ox));
+    (xf, fx)
+}
+
 /// `v.clamp(0, 1)` per lane, NaN kept (as `f32::clamp`).
 #[target_feature(enable = "avx2")]
 pub(crate) fn clamp01(v: __m256) -> __m256 {
@@ -181,7 +192,7 @@ pub(crate) unsafe fn depth_triangle(t: &SetupTriangle, band: &mut Band) -> usize
 /// The CPU must support AVX2.
 #[target_feature(enable = "avx2,popcnt")]
 #[inline]
-pub(crate) unsafe fn depth_vector(
+unsafe fn depth_vector(
     t: &SetupTriangle,
     y: u32,
     x: u32,
@@ -189,12 +200,7 @@ pub(crate) unsafe fn depth_vector(
     depth: &mut [f32],
 ) -> usize {
     let full = depth.len() >= 8;
-    let (ox, _) = t.origin();
-    let xs = _mm256_add_epi32(_mm256_set1_epi32(x as i32), lane_ids());
-    let fx = _mm256_sub_ps(
-        _mm256_add_ps(_mm256_cvtepi32_ps(xs), _mm256_set1_ps(0.5)),
-        _mm256_set1_ps(ox),
-    );
+    let (_, fx) = columns(t, x);
     let z = clamp01(plane_at(&t.depth_plane(), fx, t.fy(y)));
     // SAFETY: eight lanes fit when `full`; otherwise `mask` covers only the span's pixels,
     // inside `depth`.

@@ -12,7 +12,7 @@ use std::arch::x86_64::*;
 use super::{Region, SpanTarget, Strip};
 use crate::raster::SetupTriangle;
 use crate::raster::avx2::{
-    clamp01, covered_vectors, floor_i32, lane_ids, load, opaque, plane_at, store, tail_mask,
+    clamp01, columns, covered_vectors, floor_i32, load, opaque, plane_at, store, tail_mask,
 };
 
 /// [`super::span_sources`] for every pixel of triangle `t` in region `r` of the band starting
@@ -55,11 +55,9 @@ unsafe fn sources_vector(
     target: &SpanTarget,
 ) {
     let full = depth.len().min(sources.len()) >= 8;
-    let (ox, _) = t.origin();
     let fy = t.fy(y);
     let half = _mm256_set1_ps(0.5);
-    let xf = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x as i32), lane_ids()));
-    let fx = _mm256_sub_ps(_mm256_add_ps(xf, half), _mm256_set1_ps(ox));
+    let (xf, fx) = columns(t, x);
     let z = clamp01(plane_at(&t.depth_plane(), fx, fy));
     let (dp, sp) = (depth.as_mut_ptr(), sources.as_mut_ptr());
     // SAFETY: eight lanes fit in both when `full`; otherwise `mask` covers only covered
