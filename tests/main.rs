@@ -16,5 +16,6 @@ mod gpu_sirds;
 mod grading;
 mod layout;
 mod rig;
+mod scene_hashes;
 mod sirds;
 mod stability;
