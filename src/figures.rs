@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
+use crate::effects::parallax::PARALLAX_BUDGET_PERCENT;
 use crate::error::{Error, Result};
-use crate::info::PARALLAX_BUDGET_PERCENT;
 use crate::math::{CameraMode, StereoRig};
 use crate::scene::Scene;
 
@@ -126,8 +126,29 @@ pub fn rig_top_view(scene: &Scene, mode: CameraMode, size: u32) -> Result<Pixmap
     Ok(pm)
 }
 
-/// Parallax in percent of image width against eye depth z from near to far, seed 004's
-/// `p(z) = d (1 − z0/z)` divided by the view width at z0; the ±3% budget shaded.
+/// The curve [`parallax_plot`] draws: `steps + 1` points `(z, p)` from near to far, `p` the
+/// screen parallax of a point at eye distance z in percent of the image width. It is the
+/// renderer's own `p(z) = d·(b − z0/z)` ([`ParallaxRig::parallax`](crate::effects::parallax::ParallaxRig::parallax),
+/// balance b and parallel axes included), never a copy of the formula.
+///
+/// # Errors
+/// Invalid camera or rig.
+pub fn parallax_curve(scene: &Scene, steps: usize) -> Result<Vec<(f64, f64)>> {
+    let rig = scene.parallax_rig()?;
+    let (near, far) = (rig.near, rig.far);
+    let steps = steps.max(1);
+    Ok((0..=steps)
+        .map(|i| {
+            let z = near + (far - near) * i as f64 / steps as f64;
+            let percent = 100.0 * rig.parallax(z) * rig.pixels_per_unit / f64::from(rig.width);
+            (z, percent)
+        })
+        .collect())
+}
+
+/// Parallax in percent of image width against eye depth z from near to far (the exercise
+/// slides' `p(z) = d (1 − z0/z)`, with the StereoGraphics guide's balance b:
+/// [`parallax_curve`]); the ±3% budget shaded.
 ///
 /// # Errors
 /// Invalid rig.
@@ -137,14 +158,15 @@ pub fn parallax_plot(scene: &Scene, width: u32, height: u32) -> Result<Pixmap> {
         .ok_or_else(|| Error::invalid("figure size", width, "must be > 0"))?;
     pm.fill(Color::WHITE);
     let (near, far) = (scene.camera.near, scene.camera.far);
-    // With balance b the zero-parallax plane moves to z0 / b: p(z) = d (1 − z0 / (b z)).
-    let p = |z: f32| {
-        100.0 * r.eye_separation * (1.0 - r.zero_parallax_distance / (scene.rig.user_balance * z))
-            / r.xrange
-    };
+    let steps = 400;
+    let curve: Vec<(f32, f32)> = parallax_curve(scene, steps)?
+        .into_iter()
+        .map(|(z, p)| (z as f32, p as f32))
+        .collect();
+    let (p_near, p_far) = (curve[0].1, curve[steps].1);
     let (lo, hi) = (
-        p(near).min(-2.0 * PARALLAX_BUDGET_PERCENT),
-        p(far).max(2.0 * PARALLAX_BUDGET_PERCENT),
+        p_near.min(-2.0 * PARALLAX_BUDGET_PERCENT),
+        p_far.max(2.0 * PARALLAX_BUDGET_PERCENT),
     );
     let (w, h) = (width as f32, height as f32);
     let to_px = |z: f32, v: f32| {
@@ -172,10 +194,8 @@ pub fn parallax_plot(scene: &Scene, width: u32, height: u32) -> Result<Pixmap> {
         1.0,
     );
     let mut pb = PathBuilder::new();
-    let steps = 400;
-    for i in 0..=steps {
-        let z = near + (far - near) * i as f32 / steps as f32;
-        let (x, y) = to_px(z, p(z).clamp(lo, hi));
+    for (i, &(z, p)) in curve.iter().enumerate() {
+        let (x, y) = to_px(z, p.clamp(lo, hi));
         if i == 0 {
             pb.move_to(x, y)
         } else {

@@ -2,12 +2,14 @@
 
 use std::fmt::Write as _;
 
+use crate::effects::parallax::{ParallaxBudget, budget_of};
 use crate::error::Result;
 use crate::math::{StereoRig, project_ndc};
+use crate::plan::{Shading, View};
+use crate::render::{Frame, render_view};
 use crate::scene::Scene;
 
-/// Seed 003: keep negative and positive parallax each within about 3% of the image width.
-pub const PARALLAX_BUDGET_PERCENT: f32 = 3.0;
+pub use crate::effects::parallax::PARALLAX_BUDGET_PERCENT;
 
 /// Horizontal and vertical parallax range over the scene's vertices, in percent of image width
 /// (horizontal) and height (vertical): `(x_right − x_left)` in NDC / 2 · 100.
@@ -93,7 +95,7 @@ pub fn describe(scene: &Scene) -> Result<String> {
             m.eye_world.x, m.eye_world.y, m.eye_world.z, f[0], f[1], f[2], f[3], f[4], f[5]
         );
     }
-    s.push_str(&crate::effects::parallax::scene_budget(scene)?.report());
+    s.push_str(&scene_budget(scene)?.report());
     let p = parallax_range(scene)?;
     if p.vertices == 0 {
         let _ = writeln!(s, "parallax: no vertex lies inside both frusta");
@@ -123,4 +125,31 @@ pub fn describe(scene: &Scene) -> Result<String> {
         );
     }
     Ok(s)
+}
+
+/// The budget of a scene: renders the left eye depth-only (all `p(z)` needs) and measures it.
+/// What `stereolab info` prints.
+///
+/// # Errors
+/// Invalid camera or rig, or an image size refused by [`crate::Framebuffer::new`].
+pub fn scene_budget(scene: &Scene) -> Result<ParallaxBudget> {
+    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let (fb, _) = render_view(scene, &eyes[0], Shading::DepthOnly)?;
+    budget_of(&fb, &scene.parallax_rig()?)
+}
+
+/// The budget lines of the render report, from the frame's left eye depth (or the right eye's
+/// when only that one was rendered); `None` when no eye pass ran.
+///
+/// # Errors
+/// As [`budget_of`].
+pub fn frame_budget_report(frame: &Frame, scene: &Scene) -> Result<Option<String>> {
+    let rig = scene.parallax_rig()?;
+    for (view, name) in [(View::Left, "left"), (View::Right, "right")] {
+        if let Some(fb) = frame.view(view) {
+            let b = budget_of(fb, &rig)?;
+            return Ok(Some(format!("  {name} eye {}", b.report())));
+        }
+    }
+    Ok(None)
 }

@@ -1,8 +1,33 @@
 //! stereolab: a deterministic CPU software rasterizer that teaches, and serves as the reference
 //! for, stereoscopic rendering.
 //!
-//! Data flow (see DESIGN.md): [`scene::Scene`] → [`plan::Plan`] → passes
-//! ([`render::render`], built on [`raster::rasterize`]) → [`effects`] → [`output`].
+//! # Data flow
+//!
+//! ```text
+//! scene.toml ─► Scene ─► Plan ─► passes ─────────────► effects ─────────► output
+//!               scene    plan    render (on raster)    anaglyph, remap,   PNG/PPM/GIF files,
+//!                                eye, ChromaDepth,     parallax, layouts, the render report
+//!                                SIRDS strips          ChromaDepth, SIRDS
+//! ```
+//!
+//! Start with [`Scene::load`], [`Plan::new`], [`render()`] and [`output::write_all`]; a
+//! rasterization pass is [`raster::rasterize`] with a [`shade::Shader`]. Every effect is a
+//! function of framebuffers, matrices and its own settings (never a `Scene`, `Frame`, `Plan` or
+//! `Output`), so each can be called, tested and read on its own.
+//!
+//! # Layers
+//!
+//! Modules import lower layers only; `tests/architecture.rs` reads the source and fails on an
+//! import that goes up or round in a cycle (`cargo test --test main architecture --
+//! --nocapture` prints the graph):
+//! [`error`] → [`math`], [`framebuffer`], [`shade`] → [`raster`] → [`effects`] → [`plan`] →
+//! [`scene`] → [`fixtures`] → [`render`] → [`output`] → [`info`], [`figures`], [`compare`] →
+//! `gpu` (feature `gpu`), [`exercise`] → [`grade`], [`bench`].
+//!
+//! The repository's `docs/ARCHITECTURE.md` has the conventions (coordinates, llvmpipe's
+//! rasterization rules, determinism), `docs/sources.md` the course's five source documents.
+//!
+#![doc = include_str!("../docs/formulas.md")]
 #![warn(missing_docs)]
 
 pub mod bench;
@@ -11,6 +36,7 @@ pub mod effects;
 pub mod error;
 pub mod exercise;
 pub mod figures;
+pub mod fixtures;
 pub mod framebuffer;
 #[cfg(feature = "gpu")]
 pub mod gpu;
@@ -26,3 +52,6 @@ pub mod shade;
 
 pub use error::{Error, Result};
 pub use framebuffer::{EyePair, Framebuffer};
+pub use plan::{Output, Plan};
+pub use render::{Frame, render};
+pub use scene::Scene;

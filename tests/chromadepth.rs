@@ -8,12 +8,12 @@ use proptest::prelude::*;
 use stereolab::Error;
 use stereolab::effects::chromadepth::glasses::{self, Eye, pixel_shift};
 use stereolab::effects::chromadepth::ramp::{self, Ramp, RampKind, Sampling};
-use stereolab::effects::chromadepth::shader::{render_center_with, texgen_map};
 use stereolab::effects::chromadepth::texgen::{Texgen, auto_range, eye_plane_specified_under};
-use stereolab::effects::chromadepth::{self as cd, ChromaDepthSettings, TexgenMode};
+use stereolab::effects::chromadepth::{ChromaDepthSettings, TexgenMode};
 use stereolab::math::StereoRig;
 use stereolab::output;
 use stereolab::plan::{Output, Pass, Plan, Shading, View};
+use stereolab::render::chromadepth::{render_center_with, texgen_map};
 use stereolab::render::render;
 use stereolab::scene::{Scene, terrain, terrain_data};
 
@@ -152,7 +152,8 @@ fn auto_range_is_the_bounding_sphere_center_distance_minus_and_plus_radius() {
     assert_eq!((n1, f2), (9.0, 11.0));
     // --set adjusts one end; the other stays automatic.
     let s = scene("", sphere, &["chromadepth.d1=9.5"]).expect("valid scene");
-    let t = cd::shader::resolve_texgen(&s, &c, &s.chromadepth).expect("valid range");
+    let t = stereolab::render::chromadepth::resolve_texgen(&s, &c, &s.chromadepth)
+        .expect("valid range");
     assert_eq!(t.d1, 9.5);
     assert!((t.d2 - 11.5).abs() < 1e-4);
 }
@@ -420,9 +421,15 @@ fn three_squares() -> Scene {
 fn glasses_disparity_order_matches_depth_order() {
     let s = three_squares();
     let frame = render(&s, &Plan::new(&[Output::ChromaDepth])).expect("renders");
-    let center = cd::produce(Output::ChromaDepth, &frame, &s.chromadepth).expect("center");
-    let left = cd::produce(Output::ChromaDepthLeft, &frame, &s.chromadepth).expect("left");
-    let right = cd::produce(Output::ChromaDepthRight, &frame, &s.chromadepth).expect("right");
+    let center =
+        stereolab::output::chromadepth::produce(Output::ChromaDepth, &frame, &s.chromadepth)
+            .expect("center");
+    let left =
+        stereolab::output::chromadepth::produce(Output::ChromaDepthLeft, &frame, &s.chromadepth)
+            .expect("left");
+    let right =
+        stereolab::output::chromadepth::produce(Output::ChromaDepthRight, &frame, &s.chromadepth)
+            .expect("right");
     // Each square is one color (camera-facing): find its columns on the middle row.
     let row = s.height / 2;
     let mean_x = |fb: &stereolab::Framebuffer, color: [u8; 4]| {
@@ -451,12 +458,19 @@ fn glasses_disparity_order_matches_depth_order() {
     // The anaglyph of the pair comes from the shared anaglyph module, kind chosen in the scene.
     let mut color = s.chromadepth.clone();
     color.anaglyph = "color".into();
-    let anaglyph = cd::produce(Output::ChromaDepthAnaglyph, &frame, &color).expect("ok");
+    let anaglyph =
+        stereolab::output::chromadepth::produce(Output::ChromaDepthAnaglyph, &frame, &color)
+            .expect("ok");
     for (i, p) in anaglyph.color.iter().enumerate() {
         assert_eq!(p[0], left.color[i][0]);
         assert_eq!(p[1..3], right.color[i][1..3]);
     }
-    let gray = cd::produce(Output::ChromaDepthAnaglyph, &frame, &s.chromadepth).expect("ok");
+    let gray = stereolab::output::chromadepth::produce(
+        Output::ChromaDepthAnaglyph,
+        &frame,
+        &s.chromadepth,
+    )
+    .expect("ok");
     let expected = stereolab::effects::anaglyph::anaglyph(
         &left,
         &right,
@@ -472,7 +486,7 @@ fn glasses_disparity_order_matches_depth_order() {
         "default is the gray anaglyph"
     );
     color.anaglyph = "plaid".into();
-    let err = cd::produce(Output::ChromaDepthAnaglyph, &frame, &color)
+    let err = stereolab::output::chromadepth::produce(Output::ChromaDepthAnaglyph, &frame, &color)
         .unwrap_err()
         .to_string();
     assert!(

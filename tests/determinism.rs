@@ -45,7 +45,8 @@ fn two_runs_and_one_vs_many_threads_give_identical_bytes() {
 
 /// SIRDS of a shipped scene (strip algorithm and TIW) under a pool of `threads` threads.
 fn sirds_bytes(threads: usize) -> Vec<Vec<[u8; 4]>> {
-    use stereolab::effects::sirds::{Algorithm, from_frame};
+    use stereolab::effects::sirds::Algorithm;
+    use stereolab::output::sirds::from_frame;
     let mut scene = Scene::load(&asset("scenes/sirds_sphere.toml"), &[]).unwrap();
     scene.set_size(300, 150).unwrap();
     let pool = rayon::ThreadPoolBuilder::new()

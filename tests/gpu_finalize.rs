@@ -9,7 +9,7 @@ use image::RgbaImage;
 use stereolab::Framebuffer;
 use stereolab::effects::anaglyph::{self, AnaglyphKind, AnaglyphOptions};
 use stereolab::effects::occlusion::occlusion_image;
-use stereolab::effects::parallax::{ParallaxRig, parallax_image, parallax_map};
+use stereolab::effects::parallax::{parallax_image, parallax_map};
 use stereolab::effects::remap::{Precision, remap_color};
 use stereolab::gpu::GpuFinalize;
 use stereolab::math::EyeMatrices;
@@ -118,7 +118,7 @@ fn wgsl_parallax_matches_the_cpu_map_and_colors_on_identical_depth() {
     let Some(r) = gpu() else { return };
     let fin = GpuFinalize::new(r).expect("finalize shaders compile");
     let (scene, [left, _], _) = wuson_eyes();
-    let rig = ParallaxRig::of_scene(&scene).expect("rig");
+    let rig = scene.parallax_rig().expect("rig");
     let cpu_map = parallax_map(&left, &rig).expect("cpu map");
     let (gpu_map, gpu_image) = fin.parallax(r, &left, &rig).expect("gpu");
     let mut worst = 0.0f64;

@@ -4,13 +4,12 @@
 //! helper of tests/gpu_parity.rs).
 
 use stereolab::effects::sirds::decode::{DecodeOptions, decode, round_trip};
-use stereolab::effects::sirds::per_vertex::{
-    Filter, PerVertexOptions, Start, StripGeometry, per_vertex,
-};
-use stereolab::effects::sirds::{Pattern, scene_depth};
+use stereolab::effects::sirds::{Filter, Pattern, PerVertexOptions, Start};
 use stereolab::gpu::parity::compare_scene;
 use stereolab::gpu::sirds::GpuStrips;
+use stereolab::output::sirds::scene_depth;
 use stereolab::plan::Plan;
+use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::scene::Scene;
 
 use crate::gpu_parity::gpu;
@@ -155,7 +154,7 @@ fn gpu_render_writes_the_wgsl_sirds() {
     let written: Vec<[u8; 4]> = png.pixels().map(|p| p.0).collect();
     let strips = GpuStrips::new(r).expect("compiles");
     let gpu_sirds = stereolab::gpu::sirds_frame::from_frame(r, &strips, &f, &s).expect("gpu");
-    let cpu_sirds = stereolab::effects::sirds::from_frame(&f, &s).expect("cpu");
+    let cpu_sirds = stereolab::output::sirds::from_frame(&f, &s).expect("cpu");
     assert_eq!(written, gpu_sirds.pixels);
     assert_ne!(
         gpu_sirds.pixels, cpu_sirds.pixels,

@@ -1,10 +1,12 @@
 //! One integration-test binary (tiny-skia's layout): `mod` per area.
 
+mod architecture;
 mod chromadepth;
 mod cli;
 mod common;
 mod conformance;
 mod determinism;
+mod figures;
 mod finalize;
 mod golden;
 #[cfg(feature = "gpu")]

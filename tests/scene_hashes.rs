@@ -27,7 +27,11 @@ fn fnv1a(bytes: impl IntoIterator<Item = u8>, mut h: u64) -> u64 {
 fn image_hash(img: &Image) -> (u32, u32, u64) {
     let seed = 0xcbf2_9ce4_8422_2325;
     match img {
-        Image::Rgba(i) => (i.width(), i.height(), fnv1a(i.as_raw().iter().copied(), seed)),
+        Image::Rgba(i) => (
+            i.width(),
+            i.height(),
+            fnv1a(i.as_raw().iter().copied(), seed),
+        ),
         Image::Gray16(i) => (
             i.width(),
             i.height(),
@@ -71,8 +75,12 @@ fn every_shipped_scene_renders_the_recorded_bytes() {
         std::fs::write(&file, &now).unwrap();
         return;
     }
-    let recorded = std::fs::read_to_string(&file)
-        .unwrap_or_else(|e| panic!("{}: {e} (run with UPDATE_HASHES=1 to create)", file.display()));
+    let recorded = std::fs::read_to_string(&file).unwrap_or_else(|e| {
+        panic!(
+            "{}: {e} (run with UPDATE_HASHES=1 to create)",
+            file.display()
+        )
+    });
     let differ: Vec<String> = recorded
         .lines()
         .zip(now.lines())

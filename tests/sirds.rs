@@ -8,13 +8,12 @@ use stereolab::effects::sirds::disparity::{
     separation_eye_distance, separation_view_angle, tan_phi_eye_distance,
 };
 use stereolab::effects::sirds::per_pixel::{PerPixelOptions, RowLinker, per_pixel};
-use stereolab::effects::sirds::per_vertex::{
-    Filter, PerVertexOptions, Start, StripGeometry, per_vertex,
-};
 use stereolab::effects::sirds::{
-    Algorithm, DepthMap, DisparityModel, Geometry, Pattern, from_frame, scene_depth,
+    Algorithm, DepthMap, DisparityModel, Filter, Geometry, Pattern, PerVertexOptions, Start,
 };
+use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::{Output, Pass, Plan, Shading, View};
+use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
 
@@ -191,7 +190,7 @@ fn both_models_agree_at_the_background_and_invert_exactly() {
 
 /// A sphere over a ramp, as a depth map (the benchmark's map at test size).
 fn sphere_over_ramp(w: u32, h: u32) -> DepthMap {
-    stereolab::effects::sirds::bench::sphere_over_ramp(w, h)
+    stereolab::fixtures::sphere_over_ramp(w, h)
 }
 
 #[test]

@@ -3,8 +3,8 @@
 
 use tiny_skia::{Color, Paint, Pixmap, Rect, Transform};
 
+use super::parallax::PARALLAX_BUDGET_PERCENT;
 use crate::error::{Error, Result};
-use crate::info::PARALLAX_BUDGET_PERCENT;
 
 /// Height of the legend strip in pixels.
 pub const LEGEND_HEIGHT: u32 = 40;

@@ -4,7 +4,6 @@
 pub mod anaglyph;
 pub mod chromadepth;
 pub mod eye_input;
-pub mod finalize_bench;
 pub mod layout;
 pub mod legend;
 pub mod occlusion;

@@ -12,9 +12,10 @@ use super::eye_input::check_depth;
 use super::legend::draw_legend;
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
-use crate::info::PARALLAX_BUDGET_PERCENT;
 use crate::math::{Camera, CameraMode, StereoRig};
-use crate::scene::Scene;
+
+/// Seed 003: keep negative and positive parallax each within about 3% of the image width.
+pub const PARALLAX_BUDGET_PERCENT: f32 = 3.0;
 
 /// The rig's numbers the parallax formula needs, resolved for one image size.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,14 +62,6 @@ impl ParallaxRig {
         })
     }
 
-    /// The rig of a scene at its image size.
-    ///
-    /// # Errors
-    /// As [`ParallaxRig::new`].
-    pub fn of_scene(scene: &Scene) -> Result<Self> {
-        ParallaxRig::new(&scene.rig, &scene.camera, scene.width, scene.height)
-    }
-
     /// Eye distance z of a window depth `d_w` (inverting `d_w = f/(f−n)·(1 − n/z)`, the
     /// depth `P_frustum` and `glDepthRange(0, 1)` produce): `z = n f / (f − d_w (f − n))`.
     #[inline]
@@ -80,7 +73,8 @@ impl ParallaxRig {
     /// Screen parallax of a point at eye distance z, world units at the zero-parallax plane:
     /// `p(z) = d·(b − z0/z)`. With seed 003's balance b = 1 this is seed 004's
     /// `p(z) = d·(1 − z0/z)`; b scales the frustum shift (`n·d/(2 z0)·b`), b = 0 is parallel
-    /// axes. Exact for off-axis and parallel rigs; for toe-in only on the center line.
+    /// axes. Exact for off-axis and parallel rigs; for toe-in a first-order approximation on the
+    /// center line (0.3% off at wuson's nearest depths; tests/figures.rs measures it).
     #[inline]
     pub fn parallax(&self, z: f64) -> f64 {
         self.eye_separation * (self.balance - self.zero_parallax_distance / z)
@@ -255,32 +249,4 @@ pub fn parallax_image(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> 
     bytes.extend_from_slice(legend.data());
     let h = fb.height + legend.height();
     Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))
-}
-
-/// The budget of a scene: renders the left eye depth-only (all `p(z)` needs) and measures it.
-/// What `stereolab info` prints.
-///
-/// # Errors
-/// Invalid camera or rig, or an image size refused by [`Framebuffer::new`].
-pub fn scene_budget(scene: &Scene) -> Result<ParallaxBudget> {
-    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
-    let (fb, _) = crate::render::render_view(scene, &eyes[0], crate::plan::Shading::DepthOnly)?;
-    budget_of(&fb, &ParallaxRig::of_scene(scene)?)
-}
-
-/// The budget lines of the render report, from the frame's left eye depth (or the right eye's
-/// when only that one was rendered); `None` when no eye pass ran.
-///
-/// # Errors
-/// As [`parallax_map`].
-pub fn frame_budget_report(frame: &crate::render::Frame, scene: &Scene) -> Result<Option<String>> {
-    use crate::plan::View;
-    let rig = ParallaxRig::of_scene(scene)?;
-    for (view, name) in [(View::Left, "left"), (View::Right, "right")] {
-        if let Some(fb) = frame.view(view) {
-            let b = budget_of(fb, &rig)?;
-            return Ok(Some(format!("  {name} eye {}", b.report())));
-        }
-    }
-    Ok(None)
 }

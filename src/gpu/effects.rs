@@ -216,7 +216,7 @@ pub fn produce_wgsl(
         Output::Occlusion => fin.occlusion_image(r, eye(View::Left)?, eye(View::Right)?, mvps)?,
         Output::Parallax => {
             let left = eye(View::Left)?;
-            let (values, area) = fin.parallax(r, left, &ParallaxRig::of_scene(scene)?)?;
+            let (values, area) = fin.parallax(r, left, &scene.parallax_rig()?)?;
             // The same scale the pass used.
             let scale = f64::from(parallax_scale(&values));
             let legend = crate::effects::legend::draw_legend(left.width, scale, &|p| {

@@ -20,7 +20,6 @@
 
 pub mod device;
 pub mod effects;
-pub mod finalize_bench;
 pub mod fullscreen;
 pub mod output;
 pub mod parity;

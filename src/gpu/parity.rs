@@ -3,11 +3,10 @@
 
 use std::path::Path;
 
-use crate::bench::{Row, median_ms};
 use crate::compare::{Comparison, compare, framebuffer_from_image, write_diff_strip};
 use crate::effects::anaglyph;
 use crate::effects::occlusion::occlusion_image;
-use crate::effects::parallax::{ParallaxRig, parallax_image};
+use crate::effects::parallax::parallax_image;
 use crate::effects::remap::{Precision, remap_color};
 use crate::error::Result;
 use crate::output::{Image, produce};
@@ -86,7 +85,7 @@ pub fn compare_finalize(
                 fin.occlusion_image(r, left, right, mvps)?,
             ),
             Output::Parallax => {
-                let rig = ParallaxRig::of_scene(scene)?;
+                let rig = scene.parallax_rig()?;
                 let full = parallax_image(left, &rig)?;
                 let cpu = image::imageops::crop_imm(&full, 0, 0, left.width, left.height);
                 (cpu.to_image(), fin.parallax(r, left, &rig)?.1)
@@ -161,126 +160,4 @@ pub fn compare_frames(
         });
     }
     Ok(rows)
-}
-
-/// The stereo pair of `scene` on the CPU path and on the GPU, whole frame including readback
-/// into framebuffers (meshes uploaded once, outside the timing), as a ratio in the same run.
-/// Without an adapter the row says so instead of timing anything.
-///
-/// # Errors
-/// Rendering fails on either path.
-pub fn bench_rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
-    let plan = Plan::new(&[Output::Left, Output::Right]);
-    let size = format!("{}x{}", scene.width, scene.height);
-    let row = |setting: String, error, ms, note: String| Row {
-        area: "gpu parity".into(),
-        knob: "backend".into(),
-        setting,
-        error,
-        error_unit: "% coverage vs cpu".into(),
-        ms,
-        note,
-    };
-    let r = match GpuRenderer::new() {
-        Ok(r) => r,
-        Err(e) => {
-            return Ok(vec![row(
-                "gpu".into(),
-                None,
-                f64::NAN,
-                format!("not measured: {e}"),
-            )]);
-        }
-    };
-    let gpu_scene = GpuScene::upload(&r, scene)?;
-    let cpu = render(scene, &plan)?;
-    let gpu = r.render(&gpu_scene, &plan)?;
-    let worst = compare_frames(&cpu, &gpu, scene, None)?
-        .iter()
-        .map(|c| c.metrics.coverage_mismatch_percent())
-        .fold(0.0, f64::max);
-    let mut failed = None;
-    let cpu_ms = median_ms(iters, || render(scene, &plan).map_err(|e| failed = Some(e)));
-    let gpu_ms = median_ms(iters, || {
-        r.render(&gpu_scene, &plan).map_err(|e| failed = Some(e))
-    });
-    if let Some(e) = failed {
-        return Err(e);
-    }
-    let ratio = cpu_ms / gpu_ms;
-    let mut rows = vec![
-        row(
-            "cpu".into(),
-            Some(0.0),
-            cpu_ms,
-            format!("stereo pair {size}, cpu/gpu time = {ratio:.2}"),
-        ),
-        row(
-            r.short_name(),
-            Some(worst),
-            gpu_ms,
-            format!("stereo pair {size} incl. readback; {}", r.adapter_name()),
-        ),
-    ];
-    rows.extend(pair_and_anaglyph(&r, &gpu_scene, scene, iters)?);
-    rows.extend(super::finalize_bench::rows(&r, &cpu, scene, iters)?);
-    rows.extend(super::sirds_frame::bench_rows(&r, iters)?);
-    Ok(rows)
-}
-
-/// The stereo pair + Dubois anaglyph frame as each backend's `render` makes it: the CPU path
-/// (passes + `anaglyph`), and the GPU path (passes, readback, then the WGSL anaglyph pass with
-/// its upload and readback, as `render --backend gpu` does), as a ratio in the same run.
-fn pair_and_anaglyph(
-    r: &GpuRenderer,
-    gpu_scene: &GpuScene,
-    scene: &Scene,
-    iters: usize,
-) -> Result<Vec<Row>> {
-    let output = Output::Anaglyph(anaglyph::AnaglyphKind::DuboisRedCyan);
-    let plan = Plan::new(&[output]);
-    let fin = GpuFinalize::new(r)?;
-    let cpu_frame = || -> Result<Image> { produce(output, &render(scene, &plan)?, scene) };
-    let gpu_frame = || -> Result<Image> {
-        let frame = r.render(gpu_scene, &plan)?;
-        super::effects::produce_wgsl(r, &fin, output, &frame, scene)?
-            .map(Image::Rgba)
-            .ok_or_else(|| super::gpu_error("anaglyph", "no WGSL pass"))
-    };
-    let rgba = |i: Image| match i {
-        Image::Rgba(img) => Ok(framebuffer_from_image(&img, scene.background)),
-        _ => Err(super::gpu_error("anaglyph", "not an RGBA image")),
-    };
-    let max_diff = compare(&rgba(cpu_frame()?)?, &rgba(gpu_frame()?)?)?.max_channel_diff;
-    let mut failed = None;
-    let cpu_ms = median_ms(iters, || cpu_frame().map_err(|e| failed = Some(e)));
-    let gpu_ms = median_ms(iters, || gpu_frame().map_err(|e| failed = Some(e)));
-    if let Some(e) = failed {
-        return Err(e);
-    }
-    let size = format!("{}x{}", scene.width, scene.height);
-    let row = |setting: String, ms: f64, note: String| Row {
-        area: "gpu parity".into(),
-        knob: "pair + anaglyph".into(),
-        setting,
-        error: Some(f64::from(max_diff)),
-        error_unit: "max level vs cpu".into(),
-        ms,
-        note,
-    };
-    Ok(vec![
-        row(
-            "cpu".into(),
-            cpu_ms,
-            format!(
-                "stereo pair + Dubois anaglyph {size}; cpu/gpu time = {:.2}",
-                cpu_ms / gpu_ms
-            ),
-        ),
-        row(
-            r.short_name(),
-            gpu_ms,
-            format!("{size}: passes + readback + WGSL anaglyph (upload, pass, readback)"),
-        ),
-    ])
 }

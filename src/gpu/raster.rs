@@ -7,13 +7,13 @@ use glam::Mat3;
 
 use crate::effects::chromadepth::TexgenMode;
 use crate::effects::chromadepth::ramp::{Ramp, Sampling};
-use crate::effects::chromadepth::shader::resolve_texgen;
 use crate::effects::chromadepth::texgen::Texgen;
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 use crate::math::{EyeMatrices, StereoRig};
 use crate::plan::{Pass, Plan, Shading, View};
 use crate::raster::{RasterOptions, RasterStats};
+use crate::render::chromadepth::resolve_texgen;
 use crate::render::{Frame, PassResult};
 use crate::scene::{Object, Scene};
 use crate::shade::BlinnPhong;
@@ -28,7 +28,7 @@ const BLINN_PHONG_WGSL: &str = concat!(
     include_str!("shaders/common.wgsl"),
     include_str!("shaders/blinn_phong.wgsl")
 );
-/// The mirror of [`ChromaDepthShader`](crate::effects::chromadepth::shader::ChromaDepthShader).
+/// The mirror of [`ChromaDepthShader`](crate::render::chromadepth::ChromaDepthShader).
 const CHROMADEPTH_WGSL: &str = concat!(
     include_str!("shaders/common.wgsl"),
     include_str!("shaders/chromadepth.wgsl")

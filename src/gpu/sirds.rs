@@ -1,5 +1,5 @@
 //! Seed 002's per-vertex strip algorithm as the paper built it, on the GPU: render-to-texture
-//! ping-pong (§4). A mirror of [`per_vertex`](crate::effects::sirds::per_vertex::per_vertex)
+//! ping-pong (§4). A mirror of [`per_vertex`](crate::render::sirds_strips::per_vertex)
 //! on the same [`StripGeometry`] and the same strips
 //! ([`plan_strips`](crate::effects::sirds::per_vertex)):
 //!
@@ -27,11 +27,11 @@ use std::sync::mpsc;
 use glam::Vec4;
 
 use crate::effects::sirds::per_pixel::check_inputs;
-use crate::effects::sirds::per_vertex::{
-    Filter, PerVertexOptions, StripGeometry, StripResult, plan_strips,
-};
 use crate::effects::sirds::{Disparity, Pattern};
 use crate::error::Result;
+use crate::render::sirds_strips::{
+    Filter, PerVertexOptions, StripGeometry, StripResult, plan_strips,
+};
 
 use super::device::GpuRenderer;
 use super::readback::{COLOR_FORMAT, padded_row_bytes};
@@ -182,7 +182,7 @@ impl GpuStrips {
     }
 
     /// Makes a SIRDS with the strip algorithm on the GPU, as
-    /// [`per_vertex`](crate::effects::sirds::per_vertex::per_vertex) does on the CPU (same
+    /// [`per_vertex`](crate::render::sirds_strips::per_vertex) does on the CPU (same
     /// strips, same starts and filters; `links` is never recorded).
     ///
     /// # Errors

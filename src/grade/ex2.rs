@@ -12,11 +12,11 @@ use super::fixture::Fixture;
 use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
 use crate::effects::chromadepth::ChromaDepthSettings;
 use crate::effects::chromadepth::ramp::{Ramp, RampKind, exact, hsv_to_rgb};
-use crate::effects::chromadepth::shader::ChromaDepthShader;
 use crate::effects::chromadepth::texgen::{Texgen, auto_range};
 use crate::framebuffer::Framebuffer;
 use crate::math::EyeMatrices;
 use crate::raster::rasterize;
+use crate::render::chromadepth::ChromaDepthShader;
 use crate::scene::Scene;
 use crate::shade::to_rgba8;
 

@@ -325,8 +325,30 @@ mod tests {
 
     use super::*;
     use crate::math::{look_at, perspective};
-    use crate::scene::Mesh;
     use crate::shade::DepthOnly;
+
+    /// `count` triangles of a bumpy height-field grid over [−1, 1]² (the raster layer knows no
+    /// meshes; this is the scene's `triangles` kind, positions and indices only).
+    fn grid(count: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let side = (count.div_ceil(2) as f32).sqrt().ceil() as u32;
+        let mut positions = Vec::new();
+        for j in 0..=side {
+            for i in 0..=side {
+                let (u, v) = (i as f32 / side as f32, j as f32 / side as f32);
+                let h = 0.15 * ((u * 9.0).sin() * (v * 7.0).cos());
+                positions.push(Vec3::new(u * 2.0 - 1.0, v * 2.0 - 1.0, h));
+            }
+        }
+        let triangles = (0..side * side)
+            .flat_map(|q| {
+                let a = q / side * (side + 1) + q % side;
+                let b = a + side + 1;
+                [[a, a + 1, b + 1], [a, b + 1, b]]
+            })
+            .take(count as usize)
+            .collect();
+        (positions, triangles)
+    }
 
     /// The AVX2 depth-only bands (one vector per row for small triangles, spans for the rest,
     /// unmasked loads and stores where eight fit) write the scalar `traverse`'s depth bits and
@@ -344,24 +366,17 @@ mod tests {
             (64, 64, 10_000, 20.0),
             (97, 203, 2, 80.0),
         ] {
-            let mesh = Mesh::triangle_grid(count);
+            let (positions, triangles) = grid(count);
             let view = look_at(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, Vec3::Y);
             let model = Mat4::from_rotation_y(f32::to_radians(tilt));
             let mvp = perspective(45.0, w as f32 / h as f32, 1.0, 10.0) * view * model;
             let shader = DepthOnly {
-                positions: &mesh.positions,
+                positions: &positions,
                 mvp,
             };
             let mut fast = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
-            let stats = rasterize(
-                &mesh.triangles,
-                mesh.positions.len(),
-                &shader,
-                &mut fast,
-                &opts,
-            );
-            let (setups, _) =
-                setup_triangles(&mesh.triangles, mesh.positions.len(), &shader, w, h, &opts);
+            let stats = rasterize(&triangles, positions.len(), &shader, &mut fast, &opts);
+            let (setups, _) = setup_triangles(&triangles, positions.len(), &shader, w, h, &opts);
             let mut plain = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
             let mut band = Band {
                 width: w,

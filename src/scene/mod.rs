@@ -16,6 +16,7 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 
 use crate::effects::anaglyph::AnaglyphOptions;
 use crate::effects::chromadepth::ChromaDepthSettings;
+use crate::effects::parallax::ParallaxRig;
 use crate::error::{Error, Result};
 use crate::framebuffer::check_size;
 use crate::math::{Camera, Separation, StereoRig, ZeroParallax};
@@ -196,6 +197,14 @@ impl Scene {
             },
             sirds: crate::effects::sirds::Settings::from_spec(&f.sirds, base_dir)?,
         })
+    }
+
+    /// The numbers the parallax formula `p(z)` needs, for this scene's rig at its image size.
+    ///
+    /// # Errors
+    /// As [`ParallaxRig::new`].
+    pub fn parallax_rig(&self) -> Result<ParallaxRig> {
+        ParallaxRig::new(&self.rig, &self.camera, self.width, self.height)
     }
 
     /// Width / height.

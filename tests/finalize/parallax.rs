@@ -2,9 +2,7 @@
 //! the plan, the scene table, and the real-model scene.
 
 use stereolab::effects::legend::LEGEND_HEIGHT;
-use stereolab::effects::parallax::{
-    ParallaxRig, budget_of, parallax_color, parallax_image, parallax_map,
-};
+use stereolab::effects::parallax::{budget_of, parallax_color, parallax_image, parallax_map};
 use stereolab::math::project_ndc;
 use stereolab::plan::{Output, Pass, Plan, Shading, View};
 use stereolab::scene::Scene;
@@ -67,7 +65,7 @@ fn measured_parallax_of_a_small_quad_is_p_of_z_off_axis() {
         // Off-axis has no vertical parallax: what remains is the centroid's sampling noise.
         assert!((cr[1] - cl[1]).abs() < 0.1, "vertical {}", cr[1] - cl[1]);
         // The per-pixel map reads the same p(z) back from the depth buffer.
-        let map = parallax_map(left, &ParallaxRig::of_scene(&s).expect("rig")).expect("map");
+        let map = parallax_map(left, &s.parallax_rig().expect("rig")).expect("map");
         for p in map.iter().flatten() {
             assert!((p - predicted).abs() < 1e-3, "map {p} vs {predicted}");
         }
@@ -147,7 +145,7 @@ fn budget_reports_share_beyond_three_percent_and_window_violations() {
     let s = scene(&rig, &meshes, &["parallax"]);
     let frame = render_outputs(&s, &[Output::Parallax]);
     let left = frame.view(View::Left).expect("left");
-    let b = budget_of(left, &ParallaxRig::of_scene(&s).expect("rig")).expect("budget");
+    let b = budget_of(left, &s.parallax_rig().expect("rig")).expect("budget");
     print!("{}", b.report());
     let (wall, near) = (rig.parallax_px(30.0), rig.parallax_px(3.0));
     assert!(
@@ -184,7 +182,7 @@ fn parallax_image_is_blue_in_front_red_behind_with_a_legend() {
     let s = scene(&rig, &meshes, &["parallax"]);
     let frame = render_outputs(&s, &[Output::Parallax]);
     let left = frame.view(View::Left).expect("left");
-    let img = parallax_image(left, &ParallaxRig::of_scene(&s).expect("rig")).expect("image");
+    let img = parallax_image(left, &s.parallax_rig().expect("rig")).expect("image");
     assert_eq!(img.height(), rig.height + LEGEND_HEIGHT);
     let corner = img.get_pixel(2, 2).0; // wall, behind the screen
     let center = img.get_pixel(rig.width / 2 + 5, rig.height / 2).0; // quad, in front
@@ -305,7 +303,7 @@ fn anaglyph_scene_renders_every_output_and_reports_the_budget() {
         let first = img.get_pixel(0, 0);
         assert!(img.pixels().any(|q| q != first), "{} is blank", p.display());
     }
-    let report = stereolab::effects::parallax::frame_budget_report(&frame, &s)
+    let report = stereolab::info::frame_budget_report(&frame, &s)
         .expect("budget")
         .expect("an eye was rendered");
     assert!(report.contains("beyond ±3%"), "{report}");

@@ -4,14 +4,12 @@
 //! - [`ramp`]: the 1D texture (HSV red–green–blue or red–white–blue), clamped at both ends.
 //! - [`texgen`]: the eye-linear plane `s = A x + B y + C z + D`, D1/D2 from the scene or from the
 //!   bounding sphere.
-//! - [`shader`]: the pass itself (per-vertex or per-pixel texgen, optionally lit).
+//! - the pass itself (per-vertex or per-pixel texgen, optionally lit) is
+//!   [`render::chromadepth`](crate::render::chromadepth).
 //! - [`glasses`]: each eye's view through the diffraction-grating lenses.
-//! - [`bench`]: the accuracy/time rows for `stereolab bench`.
 
-pub mod bench;
 pub mod glasses;
 pub mod ramp;
-pub mod shader;
 pub mod texgen;
 
 use serde::Deserialize;
@@ -19,8 +17,6 @@ use serde::Deserialize;
 use crate::effects::anaglyph::{self, AnaglyphKind, AnaglyphOptions};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
-use crate::plan::Output;
-use crate::render::Frame;
 use ramp::{DEFAULT_TEXELS, RampKind, Sampling};
 
 /// Where `s` is evaluated.
@@ -137,29 +133,36 @@ impl ChromaDepthSettings {
     }
 }
 
-/// Produces a ChromaDepth output from the frame's ChromaDepth pass: the image itself, one eye's
-/// view through the glasses, or both views as an anaglyph (`chromadepth.anaglyph`, default gray).
+/// Which image to make from the ChromaDepth pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChromaDepthView {
+    /// The ChromaDepth image itself (what the glasses look at).
+    Image,
+    /// The left eye's view through the glasses.
+    Left,
+    /// The right eye's view through the glasses.
+    Right,
+    /// Both views as an anaglyph (`chromadepth.anaglyph`, default gray).
+    Anaglyph,
+}
+
+/// Makes `view` from the ChromaDepth pass `fb`: the image itself, one eye's view through the
+/// glasses, or both views as an anaglyph.
 ///
 /// # Errors
-/// The frame has no ChromaDepth pass (a plan bug), or `output` is not a ChromaDepth output.
-pub fn produce(
-    output: Output,
-    frame: &Frame,
+/// An unknown `chromadepth.anaglyph` kind, or an anaglyph error.
+pub fn chromadepth_view(
+    fb: &Framebuffer,
+    view: ChromaDepthView,
     settings: &ChromaDepthSettings,
 ) -> Result<Framebuffer> {
-    let fb = frame
-        .passes
-        .iter()
-        .find(|p| Output::ChromaDepth.needs().contains(&p.pass))
-        .map(|p| &p.framebuffer)
-        .ok_or_else(|| Error::invalid("plan", output.name(), "the ChromaDepth pass was not run"))?;
     let shift = settings.max_shift_px(fb.width);
-    let view = |eye| glasses::glasses_view(fb, eye, shift);
-    Ok(match output {
-        Output::ChromaDepth => fb.clone(),
-        Output::ChromaDepthLeft => view(glasses::Eye::Left),
-        Output::ChromaDepthRight => view(glasses::Eye::Right),
-        Output::ChromaDepthAnaglyph => {
+    let eye = |eye| glasses::glasses_view(fb, eye, shift);
+    Ok(match view {
+        ChromaDepthView::Image => fb.clone(),
+        ChromaDepthView::Left => eye(glasses::Eye::Left),
+        ChromaDepthView::Right => eye(glasses::Eye::Right),
+        ChromaDepthView::Anaglyph => {
             let [left, right] = glasses::glasses_pair(fb, shift);
             let image = anaglyph::anaglyph(
                 &left,
@@ -172,13 +175,6 @@ pub fn produce(
                 *o = p.0;
             }
             out
-        }
-        other => {
-            return Err(Error::invalid(
-                "output",
-                other.name(),
-                "is not a ChromaDepth output",
-            ));
         }
     })
 }

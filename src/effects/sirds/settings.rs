@@ -8,8 +8,40 @@ use super::depthmap::DepthRange;
 use super::disparity::{DisparityModel, Geometry};
 use super::pattern::Pattern;
 use super::per_pixel::{MAX_OVERSAMPLE, PerPixelOptions};
-use super::per_vertex::{Filter, PerVertexOptions, Start};
 use crate::error::{Error, Result};
+
+/// Where the pattern strip sits (seed 002 Fig. 7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Start {
+    /// At the left edge; iterations propagate right (§3).
+    Left,
+    /// In the center; iterations propagate right in the right half, left in the left half (§4:
+    /// less blur far from the initial strip).
+    #[default]
+    Center,
+}
+
+/// How a fragment samples the previous image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Filter {
+    /// The nearest pixel: exact copies, separations rounded to whole pixels (discrete depth
+    /// layers, Fig. 5 bottom).
+    Nearest,
+    /// Linear between the two nearest pixels: smooth depth, some blur (Fig. 5 top).
+    #[default]
+    Bilinear,
+}
+
+/// Options of the strip algorithm.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct PerVertexOptions {
+    /// Left or center start.
+    pub start: Start,
+    /// Nearest or bilinear sampling.
+    pub filter: Filter,
+    /// Iterations k (the strip width is ⌈W / k⌉); `None`: the fewest the geometry allows.
+    pub iterations: Option<u32>,
+}
 
 /// Which algorithm turns depth into an autostereogram.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]

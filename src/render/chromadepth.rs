@@ -3,9 +3,9 @@
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
-use super::ramp::{Ramp, Sampling};
-use super::texgen::{Texgen, auto_range};
-use super::{ChromaDepthSettings, TexgenMode};
+use crate::effects::chromadepth::ramp::{Ramp, Sampling};
+use crate::effects::chromadepth::texgen::{Texgen, auto_range};
+use crate::effects::chromadepth::{ChromaDepthSettings, TexgenMode};
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 use crate::math::EyeMatrices;

@@ -1,6 +1,12 @@
 //! `stereolab bench`: one row per measurement — area, knob, setting, error against the most
 //! accurate setting, milliseconds — printed and optionally written as CSV.
 
+mod chromadepth;
+mod finalize;
+#[cfg(feature = "gpu")]
+mod gpu;
+mod sirds;
+
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
@@ -113,17 +119,17 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         rows.extend(perspective_correction(iters)?);
     }
     if want("chromadepth") {
-        rows.extend(crate::effects::chromadepth::bench::rows(&scene, iters)?);
+        rows.extend(chromadepth::rows(&scene, iters)?);
     }
     if want("finalize") {
-        rows.extend(crate::effects::finalize_bench::rows(&scene, iters)?);
+        rows.extend(finalize::rows(&scene, iters)?);
     }
     if want("sirds") {
-        rows.extend(crate::effects::sirds::bench::rows(iters)?);
+        rows.extend(sirds::rows(iters)?);
     }
     #[cfg(feature = "gpu")]
     if want("gpu") {
-        rows.extend(crate::gpu::parity::bench_rows(&scene, iters)?);
+        rows.extend(gpu::rows(&scene, iters)?);
     }
     Ok(rows)
 }

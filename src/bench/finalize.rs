@@ -3,13 +3,13 @@
 
 use glam::Mat4;
 
-use super::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
-use super::occlusion::occlusion_image;
-use super::parallax::{ParallaxRig, parallax_image};
-use super::remap::{
+use super::{Row, median_ms};
+use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
+use crate::effects::occlusion::occlusion_image;
+use crate::effects::parallax::parallax_image;
+use crate::effects::remap::{
     Precision, Remapper, Visibility, remap_color, remap_coordinates, visibility_map,
 };
-use crate::bench::{Row, median_ms};
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 use crate::plan::{Output, Plan, Shading, View};
@@ -82,7 +82,7 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         time(&mut || remap_color(right, left, &mvp[1], &mvp[0], Precision::F64).map(drop));
     let occlusion_ms =
         time(&mut || occlusion_image(left, right, [&mvp[0], &mvp[1]], Precision::F64).map(drop));
-    let rig = ParallaxRig::of_scene(scene)?;
+    let rig = scene.parallax_rig()?;
     let parallax_ms = time(&mut || parallax_image(left, &rig).map(drop));
     if let Some(e) = err {
         return Err(e);

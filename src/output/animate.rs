@@ -7,9 +7,9 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame};
-use indicatif::{ProgressBar, ProgressStyle};
 
-use super::from_frame;
+use super::sirds::from_frame;
+use crate::effects::sirds::Pattern;
 use crate::error::{Error, Result};
 use crate::plan::{Output, Plan};
 use crate::render::render;
@@ -24,8 +24,6 @@ pub struct AnimationOptions {
     pub fixed_seed: bool,
     /// Milliseconds per frame.
     pub delay_ms: u32,
-    /// Show a progress bar on the terminal.
-    pub progress: bool,
 }
 
 impl Default for AnimationOptions {
@@ -34,7 +32,6 @@ impl Default for AnimationOptions {
             frames: 36,
             fixed_seed: false,
             delay_ms: 80,
-            progress: true,
         }
     }
 }
@@ -42,10 +39,16 @@ impl Default for AnimationOptions {
 /// Renders `opts.frames` SIRDS of `scene` turning once about the vertical axis through its
 /// bounding-box center and writes them to `path` as a looping GIF. The depth range comes from
 /// the bounding sphere (unless the scene fixes it), so it stays the same in every frame.
+/// `on_frame(done, total)` is called after each frame (the CLI draws its progress bar there).
 ///
 /// # Errors
 /// No frames, an empty scene, a render error, or the file cannot be written.
-pub fn animate(scene: &Scene, opts: &AnimationOptions, path: &Path) -> Result<()> {
+pub fn animate(
+    scene: &Scene,
+    opts: &AnimationOptions,
+    path: &Path,
+    mut on_frame: impl FnMut(u32, u32),
+) -> Result<()> {
     if opts.frames == 0 {
         return Err(Error::invalid("--frames", 0, "must be at least 1"));
     }
@@ -74,15 +77,6 @@ pub fn animate(scene: &Scene, opts: &AnimationOptions, path: &Path) -> Result<()
     );
     let models: Vec<Mat4> = scene.objects.iter().map(|o| o.model).collect();
     let plan = Plan::new(&[Output::Sirds]);
-    let bar = if opts.progress {
-        ProgressBar::new(opts.frames as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
     let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
     let mut gif = GifEncoder::new_with_speed(BufWriter::new(file), 10);
     let gif_error = |e: image::ImageError| Error::io(path, std::io::Error::other(e.to_string()));
@@ -98,10 +92,10 @@ pub fn animate(scene: &Scene, opts: &AnimationOptions, path: &Path) -> Result<()
         }
         if !opts.fixed_seed {
             let seed = match &seed_pattern {
-                super::Pattern::BlackWhite { seed }
-                | super::Pattern::Gray { seed }
-                | super::Pattern::Color { seed } => seed.wrapping_add(i as u64),
-                super::Pattern::Image(_) => 0,
+                Pattern::BlackWhite { seed } | Pattern::Gray { seed } | Pattern::Color { seed } => {
+                    seed.wrapping_add(i as u64)
+                }
+                Pattern::Image(_) => 0,
             };
             s.sirds.pattern = seed_pattern.reseeded(seed);
         }
@@ -110,8 +104,7 @@ pub fn animate(scene: &Scene, opts: &AnimationOptions, path: &Path) -> Result<()
         let delay = Delay::from_numer_denom_ms(opts.delay_ms, 1);
         gif.encode_frame(Frame::from_parts(sirds.to_rgba_image(), 0, 0, delay))
             .map_err(gif_error)?;
-        bar.inc(1);
+        on_frame(i + 1, opts.frames);
     }
-    bar.finish_and_clear();
     Ok(())
 }

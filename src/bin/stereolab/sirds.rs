@@ -1,15 +1,16 @@
 //! `stereolab sirds`: autostereograms from a scene or a depth-map image, animations, decoding.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::animate::{AnimationOptions, animate};
-use super::decode::{DecodeOptions, decode, depth_from_separation};
-use super::{DepthMap, Settings, SirdsSpec, from_depth_map, from_frame};
-use crate::error::{Error, Result};
-use crate::plan::{Output, Plan};
-use crate::render::render;
-use crate::scene::Scene;
+use indicatif::{ProgressBar, ProgressStyle};
+use stereolab::effects::sirds::decode::{DecodeOptions, decode, depth_from_separation};
+use stereolab::effects::sirds::{DepthMap, Settings, SirdsSpec, from_depth_map};
+use stereolab::output::animate::{AnimationOptions, animate};
+use stereolab::output::sirds::{from_frame, save, stream_depth_map};
+use stereolab::plan::{Output, Plan};
+use stereolab::render::render;
+use stereolab::scene::Scene;
+use stereolab::{Error, Result};
 
 /// Arguments of `stereolab sirds`.
 #[derive(clap::Args, Debug)]
@@ -61,89 +62,17 @@ fn settings_from_sets(sets: &[String]) -> Result<Settings> {
     Settings::from_spec(&spec, Path::new("."))
 }
 
-/// Writes RGBA pixels as PNG, or as binary PPM (P6, no compression) for `.ppm`/`.pnm`.
-///
-/// # Errors
-/// The file cannot be written.
-pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<()> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    if ext == "ppm" || ext == "pnm" {
-        let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
-        let mut write = || -> std::io::Result<()> {
-            write!(w, "P6\n{width} {height}\n255\n")?;
-            let mut row = Vec::with_capacity(width as usize * 3);
-            for line in pixels.chunks_exact(width.max(1) as usize) {
-                row.clear();
-                row.extend(line.iter().flat_map(|p| [p[0], p[1], p[2]]));
-                w.write_all(&row)?;
-            }
-            w.flush()
-        };
-        write().map_err(|e| Error::io(path, e))
-    } else {
-        let bytes = pixels.iter().flatten().copied().collect();
-        let img = image::RgbaImage::from_raw(width, height, bytes).expect("buffer size matches");
-        img.save(path)
-            .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
-    }
-}
-
-/// TIW from a depth-map file straight into a PPM, a chunk of rows at a time: the depth map is
-/// never held as floats, nor the image as RGBA (a 4096×3072 map would need 100 MB for both).
-fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u32, u32)> {
-    let img = image::open(depth)
-        .map_err(|e| Error::parse(depth, None, format!("cannot read depth map: {e}")))?;
-    let (width, height) = (img.width(), img.height());
-    crate::framebuffer::check_size(width, height).map_err(|e| e.in_file(depth))?;
-    let (samples, max): (Vec<u16>, f32) = match img {
-        image::DynamicImage::ImageLuma8(g) => {
-            (g.into_raw().into_iter().map(u16::from).collect(), 255.0)
-        }
-        image::DynamicImage::ImageLuma16(g) => (g.into_raw(), 65535.0),
-        other => (other.to_luma16().into_raw(), 65535.0),
-    };
-    let invert = settings.cross_eyed;
-    let w = width as usize;
-    let depth_row = |y: u32, row: &mut Vec<f32>| {
-        let line = &samples[y as usize * w..(y as usize + 1) * w];
-        row.extend(line.iter().map(|&v| {
-            let z = v as f32 / max;
-            if invert { 1.0 - z } else { z }
-        }));
-    };
-    let file = std::fs::File::create(out).map_err(|e| Error::io(out, e))?;
-    let mut writer = std::io::BufWriter::with_capacity(1 << 20, file);
-    write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| Error::io(out, e))?;
-    let mut bytes = Vec::new();
-    super::per_pixel::per_pixel_streamed(
-        width,
-        height,
-        depth_row,
-        &settings.geometry.to_pixels()?,
-        &settings.pattern,
-        &settings.per_pixel,
-        |rows| {
-            bytes.resize(rows.len() * 3, 0);
-            for (b, p) in bytes.chunks_exact_mut(3).zip(rows) {
-                b.copy_from_slice(&p[..3]);
-            }
-            writer.write_all(&bytes).map_err(|e| Error::io(out, e))
-        },
-    )?;
-    writer.flush().map_err(|e| Error::io(out, e))?;
-    Ok((width, height))
-}
-
-/// Runs `stereolab sirds`; returns what to print.
+/// Runs `stereolab sirds`.
 ///
 /// # Errors
 /// Any input, render or write error.
-pub fn run(args: &SirdsArgs) -> Result<String> {
+pub fn run(args: &SirdsArgs) -> Result<()> {
+    print!("{}", report(args)?);
+    Ok(())
+}
+
+/// What `stereolab sirds` prints, after doing the work.
+fn report(args: &SirdsArgs) -> Result<String> {
     if let Some(path) = &args.decode {
         let settings = settings_from_sets(&args.sets)?;
         let img = image::open(path)
@@ -219,7 +148,15 @@ pub fn run(args: &SirdsArgs) -> Result<String> {
             fixed_seed: args.fixed_seed,
             ..AnimationOptions::default()
         };
-        animate(&scene, &opts, &args.out)?;
+        let bar = ProgressBar::new(u64::from(frames));
+        bar.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        animate(&scene, &opts, &args.out, |done, _| {
+            bar.set_position(u64::from(done))
+        })?;
+        bar.finish_and_clear();
         return Ok(format!(
             "animated {frames} frames of {}\n  wrote {}\n",
             scene_path.display(),

@@ -3,75 +3,18 @@
 
 use std::path::Path;
 
-use super::decode::{DecodeOptions, decode, round_trip};
-use super::per_pixel::{PerPixelOptions, per_pixel};
-use super::per_vertex::{Filter, PerVertexOptions, Start, StripGeometry, per_vertex};
-use super::{Algorithm, DepthMap, Pattern, depth_range, from_frame, scene_depth};
-use crate::bench::{Row, median_ms};
+use super::{Row, median_ms};
+use crate::effects::sirds::decode::{DecodeOptions, decode, round_trip};
+use crate::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
+use crate::effects::sirds::{Algorithm, Filter, Pattern, PerVertexOptions, Start, depth_range};
 use crate::error::Result;
+use crate::fixtures::{TABLE_1, scene_from_text, sphere_over_ramp, table_scene};
 use crate::math::StereoRig;
+use crate::output::sirds::{from_frame, scene_depth};
 use crate::plan::{Output, Plan, Shading};
+use crate::render::sirds_strips::{StripGeometry, per_vertex};
 use crate::render::{render, render_view};
 use crate::scene::Scene;
-
-/// Seed 002 Table 1: (width, height, triangles, k, frame rate in Hz on a GeForce4 Ti 4600).
-pub const TABLE_1: [(u32, u32, u32, u32, f64); 6] = [
-    (512, 512, 2_500, 10, 60.1),
-    (512, 512, 5_000, 10, 40.2),
-    (512, 512, 10_000, 10, 25.6),
-    (1024, 512, 1_000, 20, 26.2),
-    (1024, 512, 2_500, 20, 17.3),
-    (1024, 512, 5_000, 20, 12.4),
-];
-
-/// A sphere over a ramp as a depth map: the ramp falls from `z = 0.5` at the left edge to 0 at
-/// the right, the sphere (radius 0.35 of the shorter side, centered) rises to `z = 1`.
-pub fn sphere_over_ramp(width: u32, height: u32) -> DepthMap {
-    let (w, h) = (width as f32, height as f32);
-    let radius = 0.35 * w.min(h);
-    let z = (0..height)
-        .flat_map(|y| (0..width).map(move |x| (x, y)))
-        .map(|(x, y)| {
-            let ramp = 0.5 * (1.0 - (x as f32 + 0.5) / w);
-            let (dx, dy) = (x as f32 + 0.5 - w * 0.5, y as f32 + 0.5 - h * 0.5);
-            let r2 = (dx * dx + dy * dy) / (radius * radius);
-            if r2 < 1.0 {
-                ramp.max(0.5 + 0.5 * (1.0 - r2).sqrt())
-            } else {
-                ramp
-            }
-        })
-        .collect();
-    DepthMap { width, height, z }
-}
-
-fn scene(text: &str) -> Result<Scene> {
-    Scene::from_toml(text, Path::new("bench"), Path::new("."), &[])
-}
-
-/// The Table 1 scene: a height-field grid of exactly `triangles` triangles facing the camera.
-pub(crate) fn table_scene(width: u32, height: u32, triangles: u32, k: u32) -> Result<Scene> {
-    scene(&format!(
-        r#"outputs = ["sirds"]
-[image]
-width = {width}
-height = {height}
-[camera]
-eye = [0.0, 0.0, 2.8]
-target = [0.0, 0.0, 0.0]
-fov_y = 45.0
-near = 1.0
-far = 10.0
-[sirds]
-start = "left"
-filter = "bilinear"
-iterations = {k}
-[[mesh]]
-kind = "triangles"
-count = {triangles}
-"#
-    ))
-}
 
 /// Seed 002 Table 1: depth pass + SIRDS (strip algorithm, left start, bilinear, k as in the
 /// paper) per frame, and the rate as a multiple of the paper's.
@@ -126,7 +69,7 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
 /// Every accuracy knob on the Fig. 5 ramp at 512×256: time to make the SIRDS from the depth
 /// pass, and the decoded separation's RMS error (share within ±1 px in the note).
 fn knobs(iters: usize) -> Result<Vec<Row>> {
-    let mut base = scene(
+    let mut base = scene_from_text(
         r#"outputs = ["sirds"]
 [image]
 width = 512
@@ -205,7 +148,7 @@ rotate = [0.0, 35.0, 0.0]
 /// `pamstereogram` is done with hyperfine, see the issue note).
 fn large_depth_map(iters: usize) -> Result<Vec<Row>> {
     let depth = sphere_over_ramp(4096, 3072);
-    let d = super::Geometry::default().to_pixels()?;
+    let d = crate::effects::sirds::Geometry::default().to_pixels()?;
     let pattern = Pattern::BlackWhite { seed: 1 };
     let mut rows = Vec::new();
     for hidden_surface in [false, true] {

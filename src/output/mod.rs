@@ -1,10 +1,14 @@
 //! Turns a rendered [`Frame`] into the images the scene asked for, and writes them.
 
+pub mod animate;
+pub mod chromadepth;
+pub mod sirds;
+
 use std::path::{Path, PathBuf};
 
-use crate::effects::parallax::{ParallaxRig, parallax_image};
+use crate::effects::parallax::parallax_image;
 use crate::effects::remap::{Precision, remap_color};
-use crate::effects::{anaglyph, chromadepth, layout, occlusion};
+use crate::effects::{anaglyph, layout, occlusion};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::plan::{Output, View};
@@ -115,18 +119,9 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             [&frame.eyes[0].mvp, &frame.eyes[1].mvp],
             Precision::default(),
         )?),
-        Output::Parallax => Image::Rgba(parallax_image(
-            eye(View::Left)?,
-            &ParallaxRig::of_scene(scene)?,
-        )?),
-        Output::Sirds => {
-            Image::Rgba(crate::effects::sirds::from_frame(frame, scene)?.to_rgba_image())
-        }
-        Output::SirdsDepth => Image::Gray16(
-            crate::effects::sirds::scene_depth(frame, scene)?
-                .0
-                .to_image(),
-        ),
+        Output::Parallax => Image::Rgba(parallax_image(eye(View::Left)?, &scene.parallax_rig()?)?),
+        Output::Sirds => Image::Rgba(sirds::from_frame(frame, scene)?.to_rgba_image()),
+        Output::SirdsDepth => Image::Gray16(sirds::scene_depth(frame, scene)?.0.to_image()),
     })
 }
 

@@ -1,4 +1,11 @@
-//! Runs a plan's passes over a scene: the eye (and center) framebuffers.
+//! The passes: runs a plan's rasterizations over a scene and returns their framebuffers.
+//!
+//! - [`render`]: the eye passes (Blinn-Phong color or depth only) and the center pass;
+//! - [`chromadepth`]: the ChromaDepth pass (texgen into the ramp);
+//! - [`sirds_strips`]: the SIRDS paper's per-vertex strip passes.
+
+pub mod chromadepth;
+pub mod sirds_strips;
 
 use std::time::{Duration, Instant};
 
@@ -102,7 +109,7 @@ pub fn render_view(
     shading: Shading,
 ) -> Result<(Framebuffer, RasterStats)> {
     if shading == Shading::ChromaDepth {
-        return crate::effects::chromadepth::shader::render_center(scene, m);
+        return chromadepth::render_center(scene, m);
     }
     let mut fb = Framebuffer::new(scene.width, scene.height, scene.background)?;
     let mut total = RasterStats::default();

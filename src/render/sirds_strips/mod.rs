@@ -27,48 +27,14 @@ mod avx2;
 use glam::Vec4;
 use rayon::prelude::*;
 
-use super::depthmap::DepthRange;
-use super::disparity::Disparity;
-use super::pattern::Pattern;
-use super::per_pixel::check_inputs;
+use crate::effects::sirds::per_pixel::check_inputs;
+use crate::effects::sirds::{DepthRange, Disparity, Pattern};
+pub use crate::effects::sirds::{Filter, PerVertexOptions, Start};
 use crate::error::{Error, Result};
 use crate::math::EyeMatrices;
 use crate::raster::{RasterOptions, SetupTriangle, avx2_available, bin_rows, setup_triangles};
 use crate::scene::Scene;
 use crate::shade::{Fragment, Shader, Varyings};
-
-/// Where the pattern strip sits (seed 002 Fig. 7).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Start {
-    /// At the left edge; iterations propagate right (§3).
-    Left,
-    /// In the center; iterations propagate right in the right half, left in the left half (§4:
-    /// less blur far from the initial strip).
-    #[default]
-    Center,
-}
-
-/// How a fragment samples the previous image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Filter {
-    /// The nearest pixel: exact copies, separations rounded to whole pixels (discrete depth
-    /// layers, Fig. 5 bottom).
-    Nearest,
-    /// Linear between the two nearest pixels: smooth depth, some blur (Fig. 5 top).
-    #[default]
-    Bilinear,
-}
-
-/// Options of the strip algorithm.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct PerVertexOptions {
-    /// Left or center start.
-    pub start: Start,
-    /// Nearest or bilinear sampling.
-    pub filter: Filter,
-    /// Iterations k (the strip width is ⌈W / k⌉); `None`: the fewest the geometry allows.
-    pub iterations: Option<u32>,
-}
 
 /// The scene as the strip passes see it: cyclopean clip positions, each vertex's separation,
 /// and the triangles, the background plane last (drawn last, most of it fails the depth test).
@@ -617,7 +583,8 @@ fn strips_with(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::effects::sirds::{bench::table_scene, depth_range};
+    use crate::effects::sirds::depth_range;
+    use crate::fixtures::table_scene;
     use crate::math::StereoRig;
     use crate::plan::Shading;
     use crate::render::render_view;

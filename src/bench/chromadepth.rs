@@ -5,14 +5,14 @@ use std::path::Path;
 
 use glam::{DMat4, DVec3};
 
-use super::glasses::glasses_pair;
-use super::ramp::{self, FAR_HUE_DEGREES, Ramp, RampKind, Sampling};
-use super::shader::{render_center_with, resolve_texgen, texgen_map};
-use super::{ChromaDepthSettings, TexgenMode};
-use crate::bench::{Row, median_ms};
+use super::{Row, median_ms};
+use crate::effects::chromadepth::glasses::glasses_pair;
+use crate::effects::chromadepth::ramp::{self, FAR_HUE_DEGREES, Ramp, RampKind, Sampling};
+use crate::effects::chromadepth::{ChromaDepthSettings, TexgenMode};
 use crate::error::{Error, Result};
 use crate::math::StereoRig;
 use crate::plan::Shading;
+use crate::render::chromadepth::{render_center_with, resolve_texgen, texgen_map};
 use crate::render::render_view;
 use crate::scene::{Scene, terrain};
 

@@ -1,0 +1,306 @@
+//! The `gpu` group: the CPU path beside the wgpu path (lavapipe without a GPU), as ratios in
+//! the same run: the stereo pair, pair + anaglyph, each WGSL finalize pass beside its CPU
+//! function on identical eye framebuffers, and the SIRDS strips of the paper's Table 1 row 1.
+
+use super::{Row, median_ms};
+use crate::compare::{compare, framebuffer_from_image};
+use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
+use crate::effects::occlusion::occlusion_image;
+use crate::effects::parallax::parallax_image;
+use crate::effects::remap::{Precision, remap_color};
+use crate::error::Result;
+use crate::plan::View;
+use crate::render::Frame;
+use crate::scene::Scene;
+
+use crate::gpu::parity::compare_frames;
+use crate::gpu::sirds::GpuStrips;
+use crate::gpu::{GpuFinalize, GpuRenderer, GpuScene, gpu_error};
+use crate::output::{Image, produce};
+use crate::plan::{Output, Plan, Shading};
+use crate::render::render;
+use crate::render::sirds_strips::StripGeometry;
+
+/// One effect: its name, the CPU function and the GPU function, each returning an image.
+type Effect<'a> = (
+    &'static str,
+    Box<dyn Fn() -> Result<image::RgbaImage> + 'a>,
+    Box<dyn Fn() -> Result<image::RgbaImage> + 'a>,
+);
+
+/// Dubois anaglyph, remap (left from right), parallax color and occlusion on `frame`'s eyes:
+/// per effect a CPU row and a GPU row (error: the largest channel difference against the CPU,
+/// 8-bit levels). Remap and occlusion use `Precision::F32Composed` on both sides (the GPU's
+/// arithmetic); the CPU parallax image includes its tiny-skia legend, the GPU's does not.
+///
+/// # Errors
+/// An effect fails on either path.
+fn finalize_rows(r: &GpuRenderer, frame: &Frame, scene: &Scene, iters: usize) -> Result<Vec<Row>> {
+    let (Some(left), Some(right)) = (frame.view(View::Left), frame.view(View::Right)) else {
+        return Ok(Vec::new());
+    };
+    let fin = GpuFinalize::new(r)?;
+    let mvps = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
+    let rig = scene.parallax_rig()?;
+    let kind = AnaglyphKind::DuboisRedCyan;
+    let opts = AnaglyphOptions::default();
+    let crop = |img: image::RgbaImage| {
+        image::imageops::crop_imm(&img, 0, 0, left.width, left.height).to_image()
+    };
+    let effects: Vec<Effect> = vec![
+        (
+            "anaglyph dubois",
+            Box::new(|| anaglyph(left, right, kind, opts)),
+            Box::new(|| fin.anaglyph(r, left, right, kind, opts)),
+        ),
+        (
+            "remap_left",
+            Box::new(|| remap_color(left, right, mvps[0], mvps[1], Precision::F32Composed)),
+            Box::new(|| fin.remap_color(r, left, right, mvps[0], mvps[1])),
+        ),
+        (
+            "parallax",
+            Box::new(|| parallax_image(left, &rig)),
+            Box::new(|| fin.parallax(r, left, &rig).map(|(_, img)| img)),
+        ),
+        (
+            "occlusion",
+            Box::new(|| occlusion_image(left, right, mvps, Precision::F32Composed)),
+            Box::new(|| fin.occlusion_image(r, left, right, mvps)),
+        ),
+    ];
+    let size = format!("{}x{}", left.width, left.height);
+    let mut rows = Vec::new();
+    for (name, cpu, gpu) in effects {
+        let (c, g) = (cpu()?, gpu()?);
+        let c = if name == "parallax" { crop(c) } else { c };
+        let metrics = compare(
+            &framebuffer_from_image(&c, scene.background),
+            &framebuffer_from_image(&g, scene.background),
+        )?;
+        let mut failed = None;
+        let cpu_ms = median_ms(iters, || cpu().map_err(|e| failed = Some(e)));
+        let gpu_ms = median_ms(iters, || gpu().map_err(|e| failed = Some(e)));
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        let row = |setting: String, error, ms, note: String| Row {
+            area: "gpu parity".into(),
+            knob: "finalize (identical eyes)".into(),
+            setting,
+            error,
+            error_unit: "max level vs cpu".into(),
+            ms,
+            note,
+        };
+        rows.push(row(
+            format!("cpu {name}"),
+            Some(0.0),
+            cpu_ms,
+            format!("{size}; cpu/gpu time = {:.2}", cpu_ms / gpu_ms),
+        ));
+        rows.push(row(
+            format!("{} {name}", r.short_name()),
+            Some(metrics.max_channel_diff as f64),
+            gpu_ms,
+            format!("{size}; upload + WGSL pass + readback"),
+        ));
+    }
+    Ok(rows)
+}
+
+/// The stereo pair of `scene` on the CPU path and on the GPU, whole frame including readback
+/// into framebuffers (meshes uploaded once, outside the timing), as a ratio in the same run.
+/// Without an adapter the row says so instead of timing anything.
+///
+/// # Errors
+/// Rendering fails on either path.
+pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
+    let plan = Plan::new(&[Output::Left, Output::Right]);
+    let size = format!("{}x{}", scene.width, scene.height);
+    let row = |setting: String, error, ms, note: String| Row {
+        area: "gpu parity".into(),
+        knob: "backend".into(),
+        setting,
+        error,
+        error_unit: "% coverage vs cpu".into(),
+        ms,
+        note,
+    };
+    let r = match GpuRenderer::new() {
+        Ok(r) => r,
+        Err(e) => {
+            return Ok(vec![row(
+                "gpu".into(),
+                None,
+                f64::NAN,
+                format!("not measured: {e}"),
+            )]);
+        }
+    };
+    let gpu_scene = GpuScene::upload(&r, scene)?;
+    let cpu = render(scene, &plan)?;
+    let gpu = r.render(&gpu_scene, &plan)?;
+    let worst = compare_frames(&cpu, &gpu, scene, None)?
+        .iter()
+        .map(|c| c.metrics.coverage_mismatch_percent())
+        .fold(0.0, f64::max);
+    let mut failed = None;
+    let cpu_ms = median_ms(iters, || render(scene, &plan).map_err(|e| failed = Some(e)));
+    let gpu_ms = median_ms(iters, || {
+        r.render(&gpu_scene, &plan).map_err(|e| failed = Some(e))
+    });
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let ratio = cpu_ms / gpu_ms;
+    let mut rows = vec![
+        row(
+            "cpu".into(),
+            Some(0.0),
+            cpu_ms,
+            format!("stereo pair {size}, cpu/gpu time = {ratio:.2}"),
+        ),
+        row(
+            r.short_name(),
+            Some(worst),
+            gpu_ms,
+            format!("stereo pair {size} incl. readback; {}", r.adapter_name()),
+        ),
+    ];
+    rows.extend(pair_and_anaglyph(&r, &gpu_scene, scene, iters)?);
+    rows.extend(finalize_rows(&r, &cpu, scene, iters)?);
+    rows.extend(sirds_rows(&r, iters)?);
+    Ok(rows)
+}
+
+/// The stereo pair + Dubois anaglyph frame as each backend's `render` makes it: the CPU path
+/// (passes + `anaglyph`), and the GPU path (passes, readback, then the WGSL anaglyph pass with
+/// its upload and readback, as `render --backend gpu` does), as a ratio in the same run.
+fn pair_and_anaglyph(
+    r: &GpuRenderer,
+    gpu_scene: &GpuScene,
+    scene: &Scene,
+    iters: usize,
+) -> Result<Vec<Row>> {
+    let output = Output::Anaglyph(AnaglyphKind::DuboisRedCyan);
+    let plan = Plan::new(&[output]);
+    let fin = GpuFinalize::new(r)?;
+    let cpu_frame = || -> Result<Image> { produce(output, &render(scene, &plan)?, scene) };
+    let gpu_frame = || -> Result<Image> {
+        let frame = r.render(gpu_scene, &plan)?;
+        crate::gpu::effects::produce_wgsl(r, &fin, output, &frame, scene)?
+            .map(Image::Rgba)
+            .ok_or_else(|| gpu_error("anaglyph", "no WGSL pass"))
+    };
+    let rgba = |i: Image| match i {
+        Image::Rgba(img) => Ok(framebuffer_from_image(&img, scene.background)),
+        _ => Err(gpu_error("anaglyph", "not an RGBA image")),
+    };
+    let max_diff = compare(&rgba(cpu_frame()?)?, &rgba(gpu_frame()?)?)?.max_channel_diff;
+    let mut failed = None;
+    let cpu_ms = median_ms(iters, || cpu_frame().map_err(|e| failed = Some(e)));
+    let gpu_ms = median_ms(iters, || gpu_frame().map_err(|e| failed = Some(e)));
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let size = format!("{}x{}", scene.width, scene.height);
+    let row = |setting: String, ms: f64, note: String| Row {
+        area: "gpu parity".into(),
+        knob: "pair + anaglyph".into(),
+        setting,
+        error: Some(f64::from(max_diff)),
+        error_unit: "max level vs cpu".into(),
+        ms,
+        note,
+    };
+    Ok(vec![
+        row(
+            "cpu".into(),
+            cpu_ms,
+            format!(
+                "stereo pair + Dubois anaglyph {size}; cpu/gpu time = {:.2}",
+                cpu_ms / gpu_ms
+            ),
+        ),
+        row(
+            r.short_name(),
+            gpu_ms,
+            format!("{size}: passes + readback + WGSL anaglyph (upload, pass, readback)"),
+        ),
+    ])
+}
+
+/// Seed 002 Table 1's first row (512×512, 2,500 triangles, k = 10, left start, bilinear) as a
+/// whole frame on each path: the depth pass (GPU: including its readback, which the depth range
+/// needs), the strip geometry on the host, the strips (GPU: including the image's readback).
+/// The GPU row's error is the share of pixels that differ from the CPU's, in percent.
+///
+/// # Errors
+/// Either path fails.
+fn sirds_rows(r: &GpuRenderer, iters: usize) -> Result<Vec<Row>> {
+    use crate::effects::sirds::depth_range;
+    use crate::fixtures::{TABLE_1, table_scene};
+    use crate::math::StereoRig;
+    use crate::render::render_view;
+    use crate::render::sirds_strips::per_vertex;
+
+    let (w, h, tris, k, paper_hz) = TABLE_1[0];
+    let s = table_scene(w, h, tris, k)?;
+    let center = StereoRig::center(&s.camera, s.aspect())?;
+    let d = s.sirds.geometry.to_pixels()?;
+    let opts = &s.sirds.per_vertex;
+    let cpu_frame = || -> Result<Vec<[u8; 4]>> {
+        let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
+        let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
+        let g = StripGeometry::new(&s, &center, &range, &d, false);
+        Ok(per_vertex(&g, w, h, &d, &s.sirds.pattern, opts, false)?.pixels)
+    };
+    let gpu_scene = GpuScene::upload(r, &s)?;
+    let strips = GpuStrips::new(r)?;
+    let gpu_frame = || -> Result<Vec<[u8; 4]>> {
+        let fb = r.render_view(&gpu_scene, &center, Shading::DepthOnly)?;
+        let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
+        let g = StripGeometry::new(&s, &center, &range, &d, false);
+        Ok(strips.run(r, &g, w, h, &d, &s.sirds.pattern, opts)?.pixels)
+    };
+    let (cpu, gpu) = (cpu_frame()?, gpu_frame()?);
+    let differ = cpu.iter().zip(&gpu).filter(|(a, b)| a != b).count();
+    let differ_percent = 100.0 * differ as f64 / cpu.len() as f64;
+    let mut failed = None;
+    let cpu_ms = median_ms(iters, || cpu_frame().map_err(|e| failed = Some(e)));
+    let gpu_ms = median_ms(iters, || gpu_frame().map_err(|e| failed = Some(e)));
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let row = |setting: String, error, ms: f64, note: String| Row {
+        area: "gpu parity".into(),
+        knob: "sirds strips, seed 002 Table 1".into(),
+        setting,
+        error,
+        error_unit: "% pixels differing from cpu".into(),
+        ms,
+        note,
+    };
+    let what = format!("{w}x{h} {tris} tris k={k}");
+    Ok(vec![
+        row(
+            format!("cpu {what}"),
+            Some(0.0),
+            cpu_ms,
+            format!(
+                "depth pass + strips; cpu/gpu time = {:.2}; paper {paper_hz} Hz",
+                cpu_ms / gpu_ms
+            ),
+        ),
+        row(
+            format!("{} {what}", r.short_name()),
+            Some(differ_percent),
+            gpu_ms,
+            format!(
+                "depth pass + readback + WGSL strips + readback: {:.0} Hz",
+                1e3 / gpu_ms
+            ),
+        ),
+    ])
+}

@@ -1,0 +1,178 @@
+//! `stereolab compare`: CPU against GPU for a scene, or any two images: metrics and diff strips.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::Args;
+use stereolab::compare::{self, Comparison, Thresholds};
+use stereolab::plan::Plan;
+use stereolab::scene::Scene;
+use stereolab::{Error, Result, grade};
+
+use super::load_scene;
+
+/// Arguments of `stereolab compare`.
+#[derive(Args)]
+pub struct CompareArgs {
+    /// A scene file (TOML), or the expected image when ACTUAL is given.
+    pub first: PathBuf,
+    /// The actual image (compares two image files).
+    pub second: Option<PathBuf>,
+    /// Folder for the `expected | diff | actual` PNG strips.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Change a limit: coverage=% (0.1), max=0..255 (255), mean=channel (1.0),
+    /// psnr=dB (30), depth=window depth (1e-5). Repeatable.
+    #[arg(long = "threshold", value_name = "KEY=VALUE")]
+    pub thresholds: Vec<String>,
+    /// Image size WxH, overriding the scene's.
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Override a scene field (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Background color R,G,B (0..255) for two images; default: each image's top-left pixel.
+    #[arg(long)]
+    pub background: Option<String>,
+    /// Instead of the scene's outputs: the student's ex1 stereo matrices rendered on the
+    /// CPU (actual) against the reference rig on the GPU (expected), one row per eye.
+    #[arg(long, value_name = "EXERCISE", conflicts_with_all = ["second", "background"])]
+    pub exercise: Option<String>,
+    /// With --exercise: the instructor's solution instead of the student's code.
+    #[arg(long, requires = "exercise")]
+    pub solution: bool,
+    /// With --exercise: the folder holding the exercise crates (default: ./exercises or .).
+    #[arg(long, requires = "exercise")]
+    pub exercises: Option<PathBuf>,
+}
+
+/// Runs `stereolab compare`.
+///
+/// # Errors
+/// Whatever the work fails with; the message names the input.
+pub fn run(args: CompareArgs) -> Result<()> {
+    let CompareArgs {
+        first,
+        second,
+        out,
+        thresholds,
+        size,
+        sets,
+        background,
+        exercise,
+        solution,
+        exercises,
+    } = args;
+    let mut limits = Thresholds::default();
+    for t in &thresholds {
+        limits.set(t)?;
+    }
+    let mut problems = Vec::new();
+    let rows = match second {
+        None if exercise.is_some() => {
+            let name = exercise.unwrap_or_default();
+            let [ex] = grade::Exercise::parse_list(&name)?[..] else {
+                return Err(Error::invalid("--exercise", name, "name one exercise: ex1"));
+            };
+            let s = load_scene(&first, &sets, size.as_deref())?;
+            let (rows, p) = compare_exercise(ex, &s, exercises, solution, out.as_deref())?;
+            problems = p;
+            rows
+        }
+        Some(second) => {
+            let bg = background.as_deref().map(parse_rgb).transpose()?;
+            vec![compare::compare_images(
+                &first,
+                &second,
+                bg,
+                out.as_deref(),
+            )?]
+        }
+        None => {
+            let s = load_scene(&first, &sets, size.as_deref())?;
+            compare_scene(&s, out.as_deref())?
+        }
+    };
+    print!("{}", compare::table(&rows));
+    for p in rows.iter().filter_map(|r| r.strip.as_ref()) {
+        println!("  wrote {}", p.display());
+    }
+    for p in &problems {
+        println!("  {p}");
+    }
+    let mut failed = limits.violations(&rows);
+    failed.extend(problems);
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "--threshold",
+            format!("{} exceeded", failed.len()),
+            failed.join("; "),
+        ))
+    }
+}
+
+fn parse_rgb(s: &str) -> Result<[u8; 4]> {
+    let bad = || Error::invalid("--background", s, "expected R,G,B with each in 0..=255");
+    let v = s
+        .split(',')
+        .map(|c| c.trim().parse::<u8>().map_err(|_| bad()))
+        .collect::<Result<Vec<_>>>()?;
+    match v[..] {
+        [r, g, b] => Ok([r, g, b, 255]),
+        _ => Err(bad()),
+    }
+}
+
+#[cfg(feature = "gpu")]
+fn compare_scene(scene: &Scene, out: Option<&std::path::Path>) -> Result<Vec<Comparison>> {
+    let r = stereolab::gpu::GpuRenderer::new()?;
+    println!("cpu (expected) vs gpu (actual): {}", r.adapter_name());
+    stereolab::gpu::parity::compare_scene(&r, scene, &Plan::new(&scene.outputs), out)
+}
+
+#[cfg(not(feature = "gpu"))]
+fn compare_scene(_: &Scene, _: Option<&std::path::Path>) -> Result<Vec<Comparison>> {
+    Err(super::no_gpu("compare SCENE (CPU against GPU)"))
+}
+
+/// `compare --exercise`: rows and the student's per-eye problems.
+#[cfg(feature = "gpu")]
+fn compare_exercise(
+    ex: grade::Exercise,
+    scene: &Scene,
+    exercises: Option<PathBuf>,
+    solution: bool,
+    out: Option<&std::path::Path>,
+) -> Result<(Vec<Comparison>, Vec<String>)> {
+    let dir = grade::exercises_dir(exercises)?;
+    let r = stereolab::gpu::GpuRenderer::new()?;
+    println!(
+        "gpu reference (expected) vs your matrices on the cpu (actual): {}",
+        r.adapter_name()
+    );
+    let c = grade::gpu_compare::compare_exercise(
+        &r,
+        ex,
+        scene,
+        &dir,
+        solution,
+        Duration::from_secs(30),
+        out,
+    )?;
+    Ok((c.rows, c.problems))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn compare_exercise(
+    _: grade::Exercise,
+    _: &Scene,
+    _: Option<PathBuf>,
+    _: bool,
+    _: Option<&std::path::Path>,
+) -> Result<(Vec<Comparison>, Vec<String>)> {
+    Err(super::no_gpu(
+        "compare --exercise (your matrices against the GPU)",
+    ))
+}

@@ -1,0 +1,38 @@
+//! `stereolab exercises`: exercise material (the student handout).
+
+use std::path::{Path, PathBuf};
+
+use clap::Subcommand;
+use stereolab::{Result, grade};
+
+/// What `stereolab exercises` does.
+#[derive(Subcommand)]
+pub enum ExercisesCommand {
+    /// Write the student handout (stubs, tests, assets, the library with the grader; no
+    /// solutions) to DIR.
+    Export {
+        /// Output folder.
+        dir: PathBuf,
+        /// The stereolab repository (default: . when it has exercises/, else the build's source).
+        #[arg(long)]
+        root: Option<PathBuf>,
+    },
+}
+
+/// Runs `stereolab exercises`.
+///
+/// # Errors
+/// The handout cannot be read or written.
+pub fn run(command: ExercisesCommand) -> Result<()> {
+    let ExercisesCommand::Export { dir, root } = command;
+    let root = root.unwrap_or_else(|| {
+        if Path::new("exercises/ex1_stereo").is_dir() {
+            PathBuf::from(".")
+        } else {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        }
+    });
+    grade::export::export(&root, &dir)?;
+    println!("wrote the student handout to {}", dir.display());
+    Ok(())
+}

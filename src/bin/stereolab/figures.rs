@@ -1,0 +1,29 @@
+//! `stereolab figures`: redraws the slides' figures from the library's own functions.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use stereolab::scene::Scene;
+use stereolab::{Result, figures};
+
+/// Arguments of `stereolab figures`.
+#[derive(Args)]
+pub struct FiguresArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Output folder.
+    #[arg(long, default_value = "slides/figures")]
+    pub out: PathBuf,
+}
+
+/// Runs `stereolab figures`.
+///
+/// # Errors
+/// The scene cannot be loaded, or a figure cannot be written.
+pub fn run(args: FiguresArgs) -> Result<()> {
+    let s = Scene::load(&args.scene, &[])?;
+    for p in figures::write_all(&s, &args.out)? {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,71 @@
+//! `stereolab grade`: build and run the student's exercise crates; points table, verdict and hints.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::Args;
+use stereolab::{Error, Result, grade};
+
+/// Arguments of `stereolab grade`.
+#[derive(Args)]
+pub struct GradeArgs {
+    /// ex1, ex2, ex3 or all.
+    pub exercise: String,
+    /// Also write Gradescope's results.json here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Grade the instructor's solution (the crates' `solution` feature).
+    #[arg(long)]
+    pub solution: bool,
+    /// The folder holding the exercise crates (default: ./exercises, else .).
+    #[arg(long)]
+    pub exercises: Option<PathBuf>,
+    /// Time limit per task in seconds (an endless loop costs that task only).
+    #[arg(long, default_value_t = 10.0)]
+    pub timeout: f64,
+    /// Where failing image checks write `expected | diff | actual`.
+    #[arg(long, default_value = "grade-out")]
+    pub out: PathBuf,
+}
+
+/// Runs `stereolab grade`.
+///
+/// # Errors
+/// Whatever the work fails with; the message names the input.
+pub fn run(args: GradeArgs) -> Result<()> {
+    let GradeArgs {
+        exercise,
+        json,
+        solution,
+        exercises,
+        timeout,
+        out,
+    } = args;
+    let opts = grade::GradeOptions {
+        exercises: grade::Exercise::parse_list(&exercise)?,
+        dir: grade::exercises_dir(exercises)?,
+        solution,
+        timeout: parse_timeout(timeout)?,
+        out,
+    };
+    let report = grade::grade(&opts, grade::fixture::grading_scene()?)?;
+    print!("{}", report.text());
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(&report.gradescope())
+            .map_err(|e| Error::io(&path, std::io::Error::other(e)))?;
+        std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+    }
+    Ok(())
+}
+
+fn parse_timeout(seconds: f64) -> Result<Duration> {
+    if seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0 {
+        Ok(Duration::from_secs_f64(seconds))
+    } else {
+        Err(Error::invalid(
+            "--timeout",
+            seconds,
+            "must be between 0 and 3600 seconds",
+        ))
+    }
+}

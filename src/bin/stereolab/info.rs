@@ -1,0 +1,28 @@
+//! `stereolab info`: both eyes' frusta, the separation, the zero-parallax distance and the
+//! scene's parallax range and budget.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use stereolab::scene::Scene;
+use stereolab::{Result, info};
+
+/// Arguments of `stereolab info`.
+#[derive(Args)]
+pub struct InfoArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Override a scene field (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+}
+
+/// Runs `stereolab info`.
+///
+/// # Errors
+/// The scene cannot be loaded or its rig is invalid.
+pub fn run(args: InfoArgs) -> Result<()> {
+    let s = Scene::load(&args.scene, &args.sets)?;
+    print!("{}", info::describe(&s)?);
+    Ok(())
+}

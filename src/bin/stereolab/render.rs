@@ -1,0 +1,147 @@
+//! `stereolab render`: the outputs a scene asks for, as PNG files, and the render report.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use clap::{Args, ValueEnum};
+use stereolab::plan::Plan;
+use stereolab::render::Frame;
+use stereolab::scene::Scene;
+use stereolab::{Error, Result, grade, info, output, render};
+
+use super::load_scene;
+
+/// Arguments of `stereolab render`.
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Image size WxH, overriding the scene's.
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Override a scene field: --set stereo.eye_separation=0.2 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Print the plan (which passes run for which outputs) and render nothing.
+    #[arg(long)]
+    pub explain: bool,
+    /// Which path renders.
+    #[arg(long, value_enum, default_value = "cpu")]
+    pub backend: Backend,
+    /// Instead of the scene's outputs: the student's exercise (ex1, ex2, ex3) next to the
+    /// reference, as `reference | diff | yours` images.
+    #[arg(long, value_name = "EXERCISE")]
+    pub exercise: Option<String>,
+    /// With --exercise: the instructor's solution instead of the student's code.
+    #[arg(long, requires = "exercise")]
+    pub solution: bool,
+    /// With --exercise: the folder holding the exercise crates (default: ./exercises or .).
+    #[arg(long, requires = "exercise")]
+    pub exercises: Option<PathBuf>,
+}
+
+/// Runs `stereolab render`.
+///
+/// # Errors
+/// Whatever the work fails with; the message names the input.
+pub fn run(args: RenderArgs) -> Result<()> {
+    let RenderArgs {
+        scene,
+        out,
+        size,
+        sets,
+        explain,
+        backend,
+        exercise,
+        solution,
+        exercises,
+    } = args;
+    let s = load_scene(&scene, &sets, size.as_deref())?;
+    if let Some(name) = exercise {
+        let [ex] = grade::Exercise::parse_list(&name)?[..] else {
+            return Err(Error::invalid(
+                "--exercise",
+                name,
+                "name one exercise: ex1, ex2 or ex3",
+            ));
+        };
+        let dir = grade::exercises_dir(exercises)?;
+        let timeout = Duration::from_secs(30);
+        for line in grade::render_exercise(ex, s, &dir, solution, timeout, &out)? {
+            println!("{line}");
+        }
+        return Ok(());
+    }
+    let plan = Plan::new(&s.outputs);
+    if explain {
+        print!("{}", plan.explain());
+        return Ok(());
+    }
+    let (frame, paths) = match backend {
+        Backend::Cpu => {
+            let frame = render::render(&s, &plan)?;
+            let paths = output::write_all(&frame, &s, &out)?;
+            (frame, paths)
+        }
+        Backend::Gpu => render_gpu(&s, &plan, &out)?,
+    };
+    println!("rendered {} ({}x{})", scene.display(), s.width, s.height);
+    if backend == Backend::Gpu {
+        let ms = frame
+            .passes
+            .first()
+            .map_or(0.0, |p| p.time.as_secs_f64() * 1e3);
+        println!(
+            "  {} passes on the GPU in one submission: {ms:.2} ms including readback \
+             and, on this first frame, shader compilation",
+            frame.passes.len()
+        );
+    }
+    for p in frame.passes.iter().filter(|_| backend == Backend::Cpu) {
+        println!(
+            "  pass {:?} {:?}: {:.2} ms, {} triangles, {} fragments, {} clipped, {} culled",
+            p.pass.view,
+            p.pass.shading,
+            p.time.as_secs_f64() * 1e3,
+            p.stats.triangles,
+            p.stats.fragments,
+            p.stats.clipped,
+            p.stats.culled
+        );
+    }
+    if let Some(report) = info::frame_budget_report(&frame, &s)? {
+        print!("{report}");
+    }
+    for p in paths {
+        println!("  wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// Which path renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Backend {
+    /// The CPU rasterizer (the reference).
+    Cpu,
+    /// wgpu on Vulkan (lavapipe without a GPU); needs the `gpu` cargo feature.
+    Gpu,
+}
+
+/// Renders on the GPU and writes the outputs (a per-vertex `sirds` with the WGSL strips).
+#[cfg(feature = "gpu")]
+fn render_gpu(scene: &Scene, plan: &Plan, out: &Path) -> Result<(Frame, Vec<PathBuf>)> {
+    use stereolab::gpu::{GpuRenderer, GpuScene};
+    let r = GpuRenderer::new()?;
+    println!("gpu: {}", r.adapter_name());
+    let frame = r.render(&GpuScene::upload(&r, scene)?, plan)?;
+    let paths = stereolab::gpu::output::write_all(&r, &frame, scene, out)?;
+    Ok((frame, paths))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn render_gpu(_: &Scene, _: &Plan, _: &Path) -> Result<(Frame, Vec<PathBuf>)> {
+    Err(super::no_gpu("--backend"))
+}

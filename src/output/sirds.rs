@@ -1,0 +1,184 @@
+//! The scene's SIRDS from a rendered frame: the cyclopean depth pass, the scene's depth range,
+//! and the algorithm the scene chose (the strips pass or TIW), guide dots last; and the SIRDS
+//! files (PNG or PPM, streamed for large depth maps).
+
+use std::io::Write as _;
+use std::path::Path;
+
+use crate::effects::sirds::{
+    Algorithm, DepthMap, DepthRange, Disparity, Settings, Sirds, depth_range, pattern, per_pixel,
+};
+use crate::error::{Error, Result};
+use crate::framebuffer::Framebuffer;
+use crate::plan::View;
+use crate::render::Frame;
+use crate::render::sirds_strips::{self, StripGeometry, StripResult};
+use crate::scene::Scene;
+
+/// The cyclopean depth pass of `frame`.
+fn depth_pass(frame: &Frame) -> Result<&Framebuffer> {
+    frame.view(View::Center).ok_or_else(|| {
+        Error::invalid(
+            "plan",
+            "sirds",
+            "the Center depth pass was not run (a SIRDS needs it)",
+        )
+    })
+}
+
+/// The depth map a SIRDS of `frame` encodes (output `sirds_depth`).
+///
+/// # Errors
+/// No center pass in the frame, or an invalid depth range.
+pub fn scene_depth(frame: &Frame, scene: &Scene) -> Result<(DepthMap, DepthRange)> {
+    let fb = depth_pass(frame)?;
+    let (near, far) = (scene.camera.near, scene.camera.far);
+    let range = depth_range(&scene.sirds, fb, near, far)?;
+    Ok((DepthMap::from_framebuffer(fb, near, far, &range), range))
+}
+
+/// Makes the scene's SIRDS from its depth pass (output `sirds`) with the algorithm the scene
+/// chose; adds guide dots if asked.
+///
+/// # Errors
+/// As [`scene_depth`], [`per_pixel::per_pixel`] and [`sirds_strips::per_vertex`].
+pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
+    let s = &scene.sirds;
+    from_frame_with(frame, scene, |g, d| {
+        sirds_strips::per_vertex(
+            g,
+            scene.width,
+            scene.height,
+            d,
+            &s.pattern,
+            &s.per_vertex,
+            false,
+        )
+    })
+}
+
+/// [`from_frame`] with the per-vertex strips made by `strips` from the strip geometry and the
+/// disparity (the CPU's [`sirds_strips::per_vertex`], or the GPU's ping-pong); everything else
+/// (depth range, TIW, guide dots) is the same for both.
+///
+/// # Errors
+/// As [`from_frame`], and whatever `strips` returns.
+pub fn from_frame_with(
+    frame: &Frame,
+    scene: &Scene,
+    strips: impl FnOnce(&StripGeometry, &Disparity) -> Result<StripResult>,
+) -> Result<Sirds> {
+    let s = &scene.sirds;
+    let (depth, range) = scene_depth(frame, scene)?;
+    let d = s.geometry.to_pixels()?;
+    let (mut pixels, iterations) = match s.algorithm {
+        Algorithm::PerPixel => {
+            let encoded = if s.cross_eyed {
+                depth.inverted()
+            } else {
+                depth.clone()
+            };
+            (
+                per_pixel::per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?,
+                None,
+            )
+        }
+        Algorithm::PerVertex => {
+            let g = StripGeometry::new(scene, &frame.center, &range, &d, s.cross_eyed);
+            let r = strips(&g, &d)?;
+            (r.pixels, Some(r.iterations))
+        }
+    };
+    if s.guide_dots {
+        pattern::draw_guide_dots(&mut pixels, scene.width, scene.height, d.max_separation());
+    }
+    Ok(Sirds {
+        pixels,
+        width: scene.width,
+        height: scene.height,
+        depth,
+        disparity: d,
+        iterations,
+    })
+}
+
+/// Writes RGBA pixels as PNG, or as binary PPM (P6, no compression) for `.ppm`/`.pnm`.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext == "ppm" || ext == "pnm" {
+        let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+        let mut write = || -> std::io::Result<()> {
+            write!(w, "P6\n{width} {height}\n255\n")?;
+            let mut row = Vec::with_capacity(width as usize * 3);
+            for line in pixels.chunks_exact(width.max(1) as usize) {
+                row.clear();
+                row.extend(line.iter().flat_map(|p| [p[0], p[1], p[2]]));
+                w.write_all(&row)?;
+            }
+            w.flush()
+        };
+        write().map_err(|e| Error::io(path, e))
+    } else {
+        let bytes = pixels.iter().flatten().copied().collect();
+        let img = image::RgbaImage::from_raw(width, height, bytes).expect("buffer size matches");
+        img.save(path)
+            .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
+    }
+}
+
+/// TIW from a depth-map file straight into a PPM, a chunk of rows at a time: the depth map is
+/// never held as floats, nor the image as RGBA (a 4096×3072 map would need 100 MB for both).
+///
+/// # Errors
+/// The depth map cannot be read or is too large, or the file cannot be written.
+pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u32, u32)> {
+    let img = image::open(depth)
+        .map_err(|e| Error::parse(depth, None, format!("cannot read depth map: {e}")))?;
+    let (width, height) = (img.width(), img.height());
+    crate::framebuffer::check_size(width, height).map_err(|e| e.in_file(depth))?;
+    let (samples, max): (Vec<u16>, f32) = match img {
+        image::DynamicImage::ImageLuma8(g) => {
+            (g.into_raw().into_iter().map(u16::from).collect(), 255.0)
+        }
+        image::DynamicImage::ImageLuma16(g) => (g.into_raw(), 65535.0),
+        other => (other.to_luma16().into_raw(), 65535.0),
+    };
+    let invert = settings.cross_eyed;
+    let w = width as usize;
+    let depth_row = |y: u32, row: &mut Vec<f32>| {
+        let line = &samples[y as usize * w..(y as usize + 1) * w];
+        row.extend(line.iter().map(|&v| {
+            let z = v as f32 / max;
+            if invert { 1.0 - z } else { z }
+        }));
+    };
+    let file = std::fs::File::create(out).map_err(|e| Error::io(out, e))?;
+    let mut writer = std::io::BufWriter::with_capacity(1 << 20, file);
+    write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| Error::io(out, e))?;
+    let mut bytes = Vec::new();
+    crate::effects::sirds::per_pixel::per_pixel_streamed(
+        width,
+        height,
+        depth_row,
+        &settings.geometry.to_pixels()?,
+        &settings.pattern,
+        &settings.per_pixel,
+        |rows| {
+            bytes.resize(rows.len() * 3, 0);
+            for (b, p) in bytes.chunks_exact_mut(3).zip(rows) {
+                b.copy_from_slice(&p[..3]);
+            }
+            writer.write_all(&bytes).map_err(|e| Error::io(out, e))
+        },
+    )?;
+    writer.flush().map_err(|e| Error::io(out, e))?;
+    Ok((width, height))
+}
