@@ -8,7 +8,7 @@ use crate::framebuffer::Framebuffer;
 ///
 /// # Errors
 /// `Invalid` naming both sizes, or the eye whose color buffer has the wrong length.
-pub fn check_same_size(left: &Framebuffer, right: &Framebuffer) -> Result<()> {
+pub(crate) fn check_same_size(left: &Framebuffer, right: &Framebuffer) -> Result<()> {
     if (left.width, left.height) != (right.width, right.height) {
         return Err(Error::invalid(
             "eye framebuffers",
@@ -37,7 +37,7 @@ pub fn check_same_size(left: &Framebuffer, right: &Framebuffer) -> Result<()> {
 ///
 /// # Errors
 /// `Invalid` for a missing or short depth buffer, or naming the first bad pixel and its value.
-pub fn check_depth(name: &str, fb: &Framebuffer) -> Result<()> {
+pub(crate) fn check_depth(name: &str, fb: &Framebuffer) -> Result<()> {
     let n = fb.width as usize * fb.height as usize;
     if fb.depth.len() != n {
         return Err(Error::invalid(

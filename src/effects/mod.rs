@@ -3,7 +3,7 @@
 
 pub mod anaglyph;
 pub mod chromadepth;
-pub mod eye_input;
+pub(crate) mod eye_input;
 pub mod layout;
 pub mod legend;
 pub mod occlusion;

@@ -64,7 +64,7 @@ fn library_manifest(text: &str, path: &Path) -> Result<String> {
 
 /// Writes the handout for the repository at `root` into `dir`:
 /// `dir/Cargo.toml` (a workspace of the three exercises, with stereolab's profiles),
-/// `dir/stereolab/` (library, CLI with the grader, assets), `dir/ex*/` (stubs, student tests,
+/// `dir/stereolab/` (library, CLI with the grader, docs, assets), `dir/ex*/` (stubs, student tests,
 /// the grader's entry binary; no `solution.rs`, no `solution` feature), `dir/README.md`.
 ///
 /// # Errors
@@ -80,6 +80,8 @@ pub fn export(root: &Path, dir: &Path) -> Result<()> {
     )
     .map_err(io(&lib))?;
     copy_tree(&root.join("src"), &lib.join("src"), &|_| false)?;
+    // The crate documentation includes docs/formulas.md, and the code cites the rest.
+    copy_tree(&root.join("docs"), &lib.join("docs"), &|_| false)?;
     for asset in ["scenes", "models"] {
         copy_tree(
             &root.join("assets").join(asset),

@@ -8,7 +8,7 @@ use crate::math::{Camera, CameraMode, Lighting};
 /// A scene file as written.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SceneFile {
+pub(crate) struct SceneFile {
     /// Output image.
     pub image: ImageSpec,
     /// The (cyclopean) camera.
@@ -44,7 +44,7 @@ pub struct SceneFile {
 /// `[image]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ImageSpec {
+pub(crate) struct ImageSpec {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
@@ -61,7 +61,7 @@ fn default_background() -> [f32; 3] {
 /// Eye separation: a number or `"auto"`.
 #[derive(Debug, Deserialize, Clone)]
 #[serde(untagged)]
-pub enum SeparationSpec {
+pub(crate) enum SeparationSpec {
     /// World units.
     Value(f32),
     /// Should be `"auto"`.
@@ -71,7 +71,7 @@ pub enum SeparationSpec {
 /// `[stereo]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct StereoSpec {
+pub(crate) struct StereoSpec {
     /// `off-axis` (default), `toe-in`, `parallel`.
     #[serde(default)]
     pub mode: CameraMode,
@@ -116,7 +116,7 @@ fn one() -> f32 {
 /// `[light]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct LightSpec {
+pub(crate) struct LightSpec {
     /// World position.
     pub position: [f32; 3],
     /// Ambient 0..1.
@@ -154,7 +154,7 @@ impl Default for LightSpec {
 /// `[layout]`.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
-pub struct LayoutSpec {
+pub(crate) struct LayoutSpec {
     /// Black rows between the two views of `above_below_squashed` (seed 003: 20–50 typical).
     #[serde(default)]
     pub blank_interval: u32,
@@ -163,7 +163,7 @@ pub struct LayoutSpec {
 /// `[raster]`.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
-pub struct RasterSpec {
+pub(crate) struct RasterSpec {
     /// Back-face culling.
     #[serde(default)]
     pub cull_back: bool,
@@ -172,7 +172,7 @@ pub struct RasterSpec {
 /// `[finalize]`.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
-pub struct FinalizeSpec {
+pub(crate) struct FinalizeSpec {
     /// Apply anaglyph matrices to linear-light values (decode sRGB, mix, encode).
     #[serde(default)]
     pub linear_light: bool,
@@ -184,7 +184,7 @@ pub struct FinalizeSpec {
 /// One `[[mesh]]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct MeshSpec {
+pub(crate) struct MeshSpec {
     /// `obj`, `sphere`, `cube`, `torus`, `plane`, `triangles`, `terrain`.
     pub kind: String,
     /// OBJ path (or terrain CSV path), relative to the scene file.

@@ -6,7 +6,7 @@ mod obj;
 pub mod terrain;
 pub mod terrain_data;
 
-pub use file::SceneFile;
+pub(crate) use file::SceneFile;
 pub use mesh::Mesh;
 pub use obj::load_obj;
 
@@ -103,7 +103,7 @@ impl Scene {
     ///
     /// # Errors
     /// The first invalid field.
-    pub fn from_file(f: SceneFile, base_dir: &Path) -> Result<Scene> {
+    pub(crate) fn from_file(f: SceneFile, base_dir: &Path) -> Result<Scene> {
         check_size(f.image.width, f.image.height)?;
         f.camera.validate()?;
         let separation = match &f.stereo.eye_separation {
