@@ -245,11 +245,11 @@ fn pair_and_anaglyph(
         let frame = r.render(gpu_scene, &plan)?;
         super::effects::produce_wgsl(r, &fin, output, &frame, scene)?
             .map(Image::Rgba)
-            .ok_or_else(|| super::gpu_error("anaglyph", "no WGSL pass"))
+            .ok_or_else(|| crate::Error::internal("anaglyph", "no WGSL pass"))
     };
     let rgba = |i: Image| match i {
         Image::Rgba(img) => Ok(framebuffer_from_image(&img, scene.background)),
-        _ => Err(super::gpu_error("anaglyph", "not an RGBA image")),
+        _ => Err(crate::Error::internal("anaglyph", "not an RGBA image")),
     };
     let max_diff = compare(&rgba(cpu_frame()?)?, &rgba(gpu_frame()?)?)?.max_channel_diff;
     let mut failed = None;
