@@ -152,7 +152,12 @@ pub fn produce(
         .iter()
         .find(|p| Output::ChromaDepth.needs().contains(&p.pass))
         .map(|p| &p.framebuffer)
-        .ok_or_else(|| Error::invalid("plan", output.name(), "the ChromaDepth pass was not run"))?;
+        .ok_or_else(|| {
+            Error::internal(
+                "plan",
+                format!("{}: the ChromaDepth pass was not run", output.name()),
+            )
+        })?;
     let shift = settings.max_shift_px(fb.width);
     let view = |eye| glasses::glasses_view(fb, eye, shift);
     Ok(match output {
