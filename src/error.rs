@@ -1,4 +1,6 @@
-//! One error type for everything a user can get wrong, with the context to fix it.
+//! One error type for everything a user can get wrong, with the context to fix it, plus the two
+//! failures that are not the user's doing: the GPU's ([`Error::Gpu`]) and stereolab's own bugs
+//! ([`Error::Internal`]).
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -31,6 +33,22 @@ pub enum Error {
         /// Why it is refused and what would be accepted.
         reason: String,
     },
+    /// The GPU path failed: no adapter or device, a shader rejected, a buffer that would not map,
+    /// a readback that did not come back. Not about a value the user set.
+    Gpu {
+        /// What was being done or used, e.g. `readback`, `sirds_strip.wgsl`, the adapter's name.
+        context: String,
+        /// What went wrong, with the driver's own words where there are some.
+        message: String,
+    },
+    /// A bug in stereolab: an invariant it keeps itself does not hold (e.g. a plan that did not
+    /// run a pass its outputs need). Never the user's doing.
+    Internal {
+        /// Where, e.g. `plan` or `pipeline cache`.
+        context: String,
+        /// Which invariant broke.
+        message: String,
+    },
 }
 
 /// Shorthand used across the crate.
@@ -47,6 +65,22 @@ impl Error {
             field: field.into(),
             value: value.to_string(),
             reason: reason.into(),
+        }
+    }
+
+    /// A GPU failure: `context` is what was being done (e.g. `readback`), `message` what failed.
+    pub fn gpu(context: impl fmt::Display, message: impl Into<String>) -> Self {
+        Error::Gpu {
+            context: context.to_string(),
+            message: message.into(),
+        }
+    }
+
+    /// A bug in stereolab: `context` is where (e.g. `plan`), `message` the broken invariant.
+    pub fn internal(context: impl fmt::Display, message: impl Into<String>) -> Self {
+        Error::Internal {
+            context: context.to_string(),
+            message: message.into(),
         }
     }
 
@@ -105,6 +139,15 @@ impl fmt::Display for Error {
                 value,
                 reason,
             } => write!(f, "{field} = {value}: {reason}"),
+            Error::Gpu { context, message } => write!(
+                f,
+                "gpu {context}: {message} (the CPU renderer, --backend cpu, needs no GPU)"
+            ),
+            Error::Internal { context, message } => write!(
+                f,
+                "internal error in {context}: {message}; this is a bug in stereolab, not in \
+                 your input: please report it with the command and scene that triggered it"
+            ),
         }
     }
 }
@@ -115,5 +158,39 @@ impl std::error::Error for Error {
             Error::Io { source, .. } => Some(source),
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gpu_and_internal_name_their_context_and_remedy() {
+        let g = Error::gpu("readback", "cannot map a buffer: lost").to_string();
+        assert!(
+            g.starts_with("gpu readback: cannot map a buffer: lost"),
+            "{g}"
+        );
+        assert!(g.contains("--backend cpu"), "{g}");
+        let i = Error::internal("plan", "the Left pass was not run").to_string();
+        assert!(
+            i.starts_with("internal error in plan: the Left pass was not run"),
+            "{i}"
+        );
+        assert!(
+            i.contains("bug in stereolab") && i.contains("report"),
+            "{i}"
+        );
+    }
+
+    #[test]
+    fn in_file_keeps_gpu_and_internal_as_they_are() {
+        let p = Path::new("scene.toml");
+        assert!(matches!(Error::gpu("a", "b").in_file(p), Error::Gpu { .. }));
+        assert!(matches!(
+            Error::internal("a", "b").in_file(p),
+            Error::Internal { .. }
+        ));
     }
 }

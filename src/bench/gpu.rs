@@ -15,7 +15,7 @@ use crate::scene::Scene;
 
 use crate::gpu::parity::compare_frames;
 use crate::gpu::sirds::GpuStrips;
-use crate::gpu::{GpuFinalize, GpuRenderer, GpuScene, gpu_error};
+use crate::gpu::{GpuFinalize, GpuRenderer, GpuScene};
 use crate::output::{Image, produce};
 use crate::plan::{Output, Plan, Shading};
 use crate::render::render;
@@ -191,11 +191,11 @@ fn pair_and_anaglyph(
         let frame = r.render(gpu_scene, &plan)?;
         crate::gpu::effects::produce_wgsl(r, &fin, output, &frame, scene)?
             .map(Image::Rgba)
-            .ok_or_else(|| gpu_error("anaglyph", "no WGSL pass"))
+            .ok_or_else(|| crate::Error::internal("anaglyph", "no WGSL pass"))
     };
     let rgba = |i: Image| match i {
         Image::Rgba(img) => Ok(framebuffer_from_image(&img, scene.background)),
-        _ => Err(gpu_error("anaglyph", "not an RGBA image")),
+        _ => Err(crate::Error::internal("anaglyph", "not an RGBA image")),
     };
     let max_diff = compare(&rgba(cpu_frame()?)?, &rgba(gpu_frame()?)?)?.max_channel_diff;
     let mut failed = None;

@@ -281,7 +281,7 @@ fn perspective_correction(iters: usize) -> Result<Vec<Row>> {
         });
         let v = uv
             .into_inner()
-            .map_err(|_| Error::invalid("bench", "uv", "poisoned"))?;
+            .map_err(|_| Error::internal("bench uv", "poisoned by a panic in another thread"))?;
         Ok((v, ms))
     };
     let (exact, ms_exact) = run(true)?;

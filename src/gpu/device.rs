@@ -54,7 +54,7 @@ impl GpuRenderer {
         }))
         .map_err(|e| {
             gpu_error(
-                "no adapter",
+                "adapter",
                 format!(
                     "no Vulkan adapter found ({e}); on Debian/Ubuntu install \
                      mesa-vulkan-drivers and libvulkan1 for lavapipe"
@@ -141,7 +141,8 @@ impl GpuRenderer {
     pub(crate) fn check_target_size(&self, width: u32, height: u32) -> Result<()> {
         let max = self.max_texture_side();
         if width > max || height > max {
-            return Err(gpu_error(
+            return Err(crate::Error::invalid(
+                "gpu",
                 format!("{width}x{height}"),
                 format!("the adapter's largest texture side is {max} pixels"),
             ));

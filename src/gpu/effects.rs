@@ -199,7 +199,10 @@ pub fn produce_wgsl(
     use crate::plan::{Output, View};
     let eye = |v: View| {
         frame.view(v).ok_or_else(|| {
-            Error::invalid("plan", output.name(), format!("the {v:?} pass was not run"))
+            Error::internal(
+                "plan",
+                format!("{}: the {v:?} pass was not run", output.name()),
+            )
         })
     };
     let mvps = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
@@ -225,7 +228,7 @@ pub fn produce_wgsl(
             let mut bytes = area.into_raw();
             bytes.extend_from_slice(legend.data());
             RgbaImage::from_raw(left.width, left.height + legend.height(), bytes)
-                .ok_or_else(|| Error::invalid("parallax", "image", "size mismatch"))?
+                .ok_or_else(|| Error::internal("parallax", "image and legend size mismatch"))?
         }
         _ => return Ok(None),
     }))

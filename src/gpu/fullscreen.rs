@@ -265,7 +265,7 @@ impl FullscreenPass {
         let mut out = submit_and_read(r, encoder, &[&target])?;
         Target::give_back(r, [target]);
         out.pop()
-            .ok_or_else(|| gpu_error(&self.label, "no framebuffer came back"))
+            .ok_or_else(|| crate::Error::internal(&self.label, "no framebuffer came back"))
     }
 }
 

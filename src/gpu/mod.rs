@@ -47,9 +47,9 @@ pub const GL_TO_WGPU_DEPTH: Mat4 = Mat4::from_cols(
     Vec4::new(0.0, 0.0, 0.5, 1.0),
 );
 
-/// An error from the GPU path, as the CLI reports it (`gpu = <what>: <why>`).
+/// A failure of the GPU itself ([`crate::Error::Gpu`]: `gpu <what>: <why>`).
 pub(crate) fn gpu_error(what: impl std::fmt::Display, why: impl Into<String>) -> crate::Error {
-    crate::Error::invalid("gpu", what, why)
+    crate::Error::gpu(what, why)
 }
 
 #[cfg(test)]

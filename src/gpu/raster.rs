@@ -18,10 +18,10 @@ use crate::render::{Frame, PassResult};
 use crate::scene::{Object, Scene};
 use crate::shade::BlinnPhong;
 
+use super::GL_TO_WGPU_DEPTH;
 use super::device::{GpuRenderer, PipelineKey};
 use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
 use super::resources::buffer_with;
-use super::{GL_TO_WGPU_DEPTH, gpu_error};
 
 /// The mirror of [`BlinnPhong`](crate::shade::BlinnPhong).
 const BLINN_PHONG_WGSL: &str = concat!(
@@ -64,7 +64,8 @@ impl<'a> GpuScene<'a> {
     /// llvmpipe's 8), or the image is larger than the device allows.
     pub fn upload(r: &GpuRenderer, scene: &'a Scene) -> Result<Self> {
         if scene.raster.subpixel_bits != RasterOptions::default().subpixel_bits {
-            return Err(gpu_error(
+            return Err(crate::Error::invalid(
+                "gpu",
                 format!("raster.subpixel_bits = {}", scene.raster.subpixel_bits),
                 "the GPU snaps to its own fixed 8 subpixel bits",
             ));
@@ -159,7 +160,7 @@ impl GpuRenderer {
     ) -> Result<Framebuffer> {
         let mut fbs = self.render_views(scene, &[(*m, shading)])?;
         fbs.pop()
-            .ok_or_else(|| gpu_error("render_view", "no framebuffer came back"))
+            .ok_or_else(|| crate::Error::internal("render_view", "no framebuffer came back"))
     }
 
     /// Renders several views in one submission and reads them all back.
@@ -198,7 +199,12 @@ impl GpuRenderer {
                         .to_vec(),
                     Shading::ChromaDepth => match texgen {
                         Some(texgen) => chromadepth_uniforms(o, m, texgen, s),
-                        None => return Err(gpu_error("chromadepth", "texgen not resolved")),
+                        None => {
+                            return Err(crate::Error::internal(
+                                "chromadepth",
+                                "texgen not resolved",
+                            ));
+                        }
                     },
                 };
                 let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_ne_bytes()).collect();
@@ -307,10 +313,9 @@ impl GpuRenderer {
 
     /// The pipeline for `key`, built on first use.
     fn scene_pipeline(&self, key: PipelineKey) -> Result<wgpu::RenderPipeline> {
-        let mut cache = self
-            .pipelines
-            .lock()
-            .map_err(|_| gpu_error("pipeline cache", "poisoned by a panic in another thread"))?;
+        let mut cache = self.pipelines.lock().map_err(|_| {
+            crate::Error::internal("pipeline cache", "poisoned by a panic in another thread")
+        })?;
         Ok(cache
             .entry(key)
             .or_insert_with(|| build_scene_pipeline(self, key))

@@ -266,10 +266,9 @@ impl GpuStrips {
         }
         let uniforms = vertex("strip uniforms", &uniforms, wgpu::BufferUsages::UNIFORM);
 
-        let mut cache = self
-            .targets
-            .lock()
-            .map_err(|_| gpu_error("strip targets", "poisoned by a panic in another thread"))?;
+        let mut cache = self.targets.lock().map_err(|_| {
+            crate::Error::internal("strip targets", "poisoned by a panic in another thread")
+        })?;
         let t = match cache.take() {
             Some(t) if (t.width, t.height) == (width, height) => t,
             _ => StripTargets::new(r, width, height),

@@ -21,7 +21,12 @@ pub fn produce(
         .iter()
         .find(|p| Output::ChromaDepth.needs().contains(&p.pass))
         .map(|p| &p.framebuffer)
-        .ok_or_else(|| Error::invalid("plan", output.name(), "the ChromaDepth pass was not run"))?;
+        .ok_or_else(|| {
+            Error::internal(
+                "plan",
+                format!("{}: the ChromaDepth pass was not run", output.name()),
+            )
+        })?;
     let view = match output {
         Output::ChromaDepth => ChromaDepthView::Image,
         Output::ChromaDepthLeft => ChromaDepthView::Left,

@@ -39,10 +39,9 @@ impl Image {
 
 fn need(frame: &Frame, view: View, output: Output) -> Result<&Framebuffer> {
     frame.view(view).ok_or_else(|| {
-        Error::invalid(
+        Error::internal(
             "plan",
-            output.name(),
-            format!("the {view:?} pass was not run"),
+            format!("{}: the {view:?} pass was not run", output.name()),
         )
     })
 }

@@ -18,10 +18,9 @@ use crate::scene::Scene;
 /// The cyclopean depth pass of `frame`.
 fn depth_pass(frame: &Frame) -> Result<&Framebuffer> {
     frame.view(View::Center).ok_or_else(|| {
-        Error::invalid(
+        Error::internal(
             "plan",
-            "sirds",
-            "the Center depth pass was not run (a SIRDS needs it)",
+            "sirds: the Center depth pass was not run (a SIRDS needs it)",
         )
     })
 }

@@ -1,0 +1,124 @@
+//! Exercise 1 (seed 004): the tasks, their reference answers, known mistakes and image checks.
+//!
+//! One file per task group: `frustum` (mono and stereo frusta), `rig` (the stereo rig's view
+//! and projection matrices), `anaglyph` (anaglyph and Dubois matrices), `remap` (left-to-right
+//! remapping), `visible` (occlusion) and `parallax` (parallax and its color map). This file
+//! holds the task list and the helpers they share.
+
+mod anaglyph;
+mod frustum;
+mod parallax;
+mod remap;
+mod rig;
+mod visible;
+
+use super::fixture::{Fixture, reference_rig};
+use super::spec::{TaskSpec, Tolerance};
+use crate::exercise::{Answer, StereoSetup};
+use crate::framebuffer::Framebuffer;
+use crate::math::{Camera, CameraMode, EyeMatrices, Lighting};
+
+pub use anaglyph::reference_anaglyph;
+pub(crate) use rig::{eye_matrices_from_answer, eye_view_input};
+
+pub(crate) fn flat<A: Answer>(a: &A) -> Vec<f64> {
+    let mut v = Vec::new();
+    a.flatten(&mut v);
+    v
+}
+
+/// Every task of exercise 1.
+pub fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
+    vec![
+        frustum::frustum_task(fx),
+        frustum::stereo_frustum_task(fx),
+        rig::stereo_matrices_task(fx),
+        anaglyph::anaglyph_task(fx),
+        anaglyph::dubois_task(),
+        remap::remap_task(fx),
+        visible::visible_task(fx),
+        parallax::parallax_task(),
+        parallax::parallax_color_task(fx),
+    ]
+}
+
+const MATRIX_TOLERANCE: Tolerance = Tolerance {
+    abs: 1e-5,
+    rel: 1e-4,
+    why: "f32 arithmetic in another order differs by ~1e-6 relative; elements that should be 0 \
+          come out near 1e-7 after a product with an inverse",
+};
+
+/// A camera with `setup`'s frustum looking from `eye` at `target`.
+fn camera(setup: &StereoSetup, eye: [f32; 3], target: [f32; 3]) -> Camera {
+    Camera {
+        eye,
+        target,
+        up: [0.0, 1.0, 0.0],
+        fov_y: setup.fov_y_degrees,
+        near: setup.near,
+        far: setup.far,
+    }
+}
+
+/// The setups the numeric stereo checks use: the fixture's, seed 003's worked example, and a
+/// wide, close one.
+fn setups(fx: &Fixture) -> Vec<(StereoSetup, Camera)> {
+    let seed003 = StereoSetup {
+        fov_y_degrees: 90.0,
+        aspect: 1.0,
+        near: 1.0,
+        far: 100.0,
+        eye_separation: 1.0,
+        zero_parallax: 9.0,
+    };
+    let wide = StereoSetup {
+        fov_y_degrees: 70.0,
+        aspect: 16.0 / 9.0,
+        near: 0.3,
+        far: 40.0,
+        eye_separation: 0.065,
+        zero_parallax: 2.0,
+    };
+    vec![
+        (fx.setup, fx.scene.camera.clone()),
+        (seed003, camera(&seed003, [0.0, 0.0, 9.0], [0.0, 0.0, 0.0])),
+        (wide, camera(&wide, [3.0, 2.0, -1.0], [0.0, 0.5, 0.0])),
+    ]
+}
+
+/// The reference eyes for a setup with a changed separation, mode and lighting.
+fn eyes(
+    setup: &StereoSetup,
+    cam: &Camera,
+    separation: f32,
+    mode: CameraMode,
+    lighting: Lighting,
+) -> [EyeMatrices; 2] {
+    let s = StereoSetup {
+        eye_separation: separation,
+        ..*setup
+    };
+    let mut rig = reference_rig(&s, lighting);
+    rig.mode = mode;
+    rig.eyes(cam, setup.aspect)
+        .expect("the grader's own setups are valid")
+}
+
+/// An empty framebuffer of `like`'s size: the picture of a missing answer.
+pub(crate) fn blank(like: &Framebuffer, background: [u8; 4]) -> Framebuffer {
+    Framebuffer::new(like.width, like.height, background).expect("same size as a valid one")
+}
+
+/// Covered pixels of the left view, with their texture coordinate and stored depth.
+fn left_samples(fx: &Fixture) -> Vec<(u32, u32, [f32; 2], f32)> {
+    let (w, h) = fx.size();
+    let left = &fx.views[0];
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter_map(|(x, y)| {
+            let d = left.depth[left.index(x, y)];
+            (d < 1.0).then(|| (x, y, fx.uv(x, y), d))
+        })
+        .collect()
+}
