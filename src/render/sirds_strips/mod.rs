@@ -23,6 +23,7 @@
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+pub mod reference;
 
 use glam::Vec4;
 use rayon::prelude::*;
@@ -107,9 +108,18 @@ impl StripGeometry {
         self.clip
             .iter()
             .zip(&self.separation)
-            .map(|(c, s)| Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w))
+            .map(|(c, s)| shift(*c, *s, toward, wf))
             .collect()
     }
+}
+
+/// Fig. 4's vertex shift of one clip position `c` with separation `s` on a `wf`-pixel-wide
+/// image: `toward · s/2` pixels, `x + toward · s · w / W` in clip space (the NDC width 2 spans
+/// W pixels). [`StripGeometry::shifted`] and the reference's vertex stage
+/// ([`reference`]) both shift with it.
+#[inline]
+fn shift(c: Vec4, s: f32, toward: f32, wf: f32) -> Vec4 {
+    Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w)
 }
 
 /// What a strip run produced.
