@@ -1,4 +1,5 @@
-//! Triangle rasterization with llvmpipe's exact fixed-point rules (see DESIGN.md).
+//! Triangle rasterization with llvmpipe's exact fixed-point rules (docs/ARCHITECTURE.md
+//! "Rasterization rules").
 //!
 //! Pipeline per triangle: vertex stage → clip → perspective divide → viewport → snap to the
 //! subpixel grid → orient → edge functions with the top-left tie-break → depth test LESS →
@@ -8,11 +9,11 @@
 pub(crate) mod avx2;
 mod clip;
 mod setup;
+mod traverse;
 
 pub use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
-pub use setup::{
-    Band, Plane, Setup, SetupTriangle, SmallBox, WindowVertex, setup_triangle, snap, traverse,
-};
+pub use setup::{Plane, Setup, SetupTriangle, WindowVertex, setup_triangle, snap};
+pub use traverse::{Band, SmallBox, traverse};
 
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
