@@ -4,6 +4,7 @@ mod chromadepth;
 mod cli;
 mod common;
 mod conformance;
+mod coverage;
 mod determinism;
 mod finalize;
 mod golden;

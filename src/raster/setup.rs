@@ -1,6 +1,6 @@
-//! Fixed-point triangle setup: snapping, orientation, the edge functions, and the attribute
-//! planes. llvmpipe's rules, written out in docs/ARCHITECTURE.md "Rasterization rules";
-//! walking the covered pixels is in `traverse.rs`.
+//! Fixed-point triangle setup: snapping, orientation, the edge functions and their coverage
+//! rule ([`SetupTriangle::covers`]), and the attribute planes. llvmpipe's rules, written out in
+//! docs/ARCHITECTURE.md "Rasterization rules"; walking the covered pixels is in `traverse.rs`.
 
 use crate::shade::{MAX_VARYINGS, Varyings};
 
@@ -92,7 +92,7 @@ impl Plane {
 #[derive(Clone, Debug)]
 pub struct SetupTriangle {
     /// Edge `i` at subpixel grid point `(x, y)` is `c[i] + dcdy[i]·y − dcdx[i]·x`, with
-    /// llvmpipe's `c + bias − 1` stored as `c`.
+    /// llvmpipe's `c + bias − 1` stored as `c` (see [`SetupTriangle::covers`]).
     pub(super) c: [i64; 3],
     pub(super) dcdx: [i64; 3],
     pub(super) dcdy: [i64; 3],
@@ -156,8 +156,8 @@ pub fn setup_triangle(
         xs.swap(1, 2);
         ys.swap(1, 2);
     }
-    // Edge functions: pixel (px, py) is covered when c + dcdy·py·S − dcdx·px·S − 1 ≥ 0 on all
-    // three edges; the +1 on left/top edges is the top-left tie-break.
+    // Edge functions, stored as c + bias − 1: the rule and its tie-break are written out in
+    // `SetupTriangle::covers`.
     let mut c = [0i64; 3];
     let mut dcdx = [0i64; 3];
     let mut dcdy = [0i64; 3];
@@ -234,6 +234,32 @@ pub fn setup_triangle(
 }
 
 impl SetupTriangle {
+    /// Whether the triangle covers pixel (`px`, `py`): the definition of coverage, tested edge
+    /// by edge from the stored values. The fast walks ([`spans`](Self::spans),
+    /// [`small_box`](Self::small_box) and the AVX2 loops built on them) are held to it pixel
+    /// for pixel (tests/coverage.rs).
+    ///
+    /// llvmpipe's rule (docs/ARCHITECTURE.md "Rasterization rules"): the vertices are snapped
+    /// to a grid of `S = 2^bits` steps per pixel, placed so that pixel `p`'s center is grid
+    /// point `p·S` ([`snap`]), and ordered so that the inside is on the positive side. Edge `i`,
+    /// from vertex `i` to vertex `i + 1`, has `dcdx = Y_i − Y_{i+1}`, `dcdy = X_i − X_{i+1}` and
+    /// `c = dcdx·X_i − dcdy·Y_i`; the pixel is covered when, on all three edges,
+    /// `c + bias + dcdy·py·S − dcdx·px·S − 1 ≥ 0`, in 64-bit integers.
+    ///
+    /// Tie-break: the value is 0 exactly when the pixel center lies on the edge. The `− 1`
+    /// leaves such a pixel out, unless the edge has `bias = 1`: llvmpipe's left edges
+    /// (`dcdx < 0`) and, of the horizontal ones, its top edges (`dcdy > 0`). An edge shared by
+    /// two triangles is a left or top edge for exactly one of them, which alone gets the
+    /// pixels on it: a top-left rule (window y down). Setup stores `c + bias − 1` as `c`.
+    ///
+    /// Pixels outside the target are tested the same way; the walks visit only a tile's.
+    pub fn covers(&self, px: u32, py: u32) -> bool {
+        let s = 1i64 << self.bits;
+        // The pixel's center on the subpixel grid.
+        let (x, y) = (px as i64 * s, py as i64 * s);
+        (0..3).all(|i| self.c[i] + self.dcdy[i] * y - self.dcdx[i] * x >= 0)
+    }
+
     /// First and last pixel row the triangle may cover.
     pub fn rows(&self) -> (u32, u32) {
         (self.py0 as u32, self.py1 as u32)

@@ -1,7 +1,8 @@
 //! Traversal of set-up triangles: a tile's covered pixels row by row
 //! ([`SetupTriangle::spans`]) or a small triangle's box at once ([`SetupTriangle::small_box`]),
-//! and the scalar fragment loop ([`traverse`]). Both walks visit exactly the pixels whose edge
-//! functions pass; llvmpipe's rules are in docs/ARCHITECTURE.md "Rasterization rules".
+//! and the scalar fragment loop ([`traverse`]). Both walks visit exactly the pixels of
+//! [`SetupTriangle::covers`], the readable definition they are held to (tests/coverage.rs);
+//! llvmpipe's rules are in docs/ARCHITECTURE.md "Rasterization rules".
 
 use crate::shade::{Fragment, MAX_VARYINGS, Shader, Varyings};
 
@@ -9,8 +10,8 @@ use super::RasterOptions;
 use super::setup::SetupTriangle;
 
 /// A small triangle's box (see [`SetupTriangle::small_box`]): pixel `(x + j, y)` is covered
-/// when `e[i] + dx[i]·j + dy[i]·(y − y0) ≥ 0` for all three edges, exactly the coverage of
-/// [`SetupTriangle::spans`].
+/// when `e[i] + dx[i]·j + dy[i]·(y − y0) ≥ 0` for all three edges, exactly
+/// [`SetupTriangle::covers`] (and so the pixels of [`SetupTriangle::spans`]).
 #[derive(Clone, Copy, Debug)]
 pub struct SmallBox {
     /// First column.
@@ -124,8 +125,8 @@ impl SetupTriangle {
 
     /// Calls `span(py, x_lo, x_hi)` for every row of the tile (columns `x0 .. x0 + width`, rows
     /// `y0 .. y0 + rows`) in which the triangle covers pixels: exactly the covered pixels
-    /// `x_lo ..= x_hi` (never empty), top row first. Coverage as testing each pixel's edge
-    /// functions, found per row in integers (see `EdgeStep`).
+    /// `x_lo ..= x_hi` (never empty), top row first. Coverage is [`covers`](Self::covers)'s,
+    /// solved per row in integers instead of tested pixel by pixel (see `EdgeStep`).
     pub fn spans(
         &self,
         x0: u32,
