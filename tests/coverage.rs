@@ -13,9 +13,12 @@ use stereolab::shade::{MAX_VARYINGS, Varyings};
 const W: u32 = 37;
 const H: u32 = 29;
 
+/// A triangle's vertices in window coordinates (pixels, y down).
+type Tri = [(f32, f32); 3];
+
 /// Sets up a triangle given in window coordinates (pixels, y down; pixel `p`'s center at
 /// `p + 0.5`) for a `W`×`H` target; `None` when it covers no sample point there.
-fn setup(v: [(f32, f32); 3], bits: u32) -> Option<SetupTriangle> {
+fn setup(v: Tri, bits: u32) -> Option<SetupTriangle> {
     let var: Varyings = [0.0; MAX_VARYINGS];
     let wv = v.map(|(x, y)| WindowVertex {
         x,
@@ -105,7 +108,7 @@ fn small_box(
 /// sets differ.
 fn same(
     name: &str,
-    v: [(f32, f32); 3],
+    v: Tri,
     bits: u32,
     tile: Tile,
     want: &BTreeSet<(u32, u32)>,
@@ -146,7 +149,7 @@ fn point() -> impl Strategy<Value = (f32, f32)> {
 /// Triangles of every kind: any three points (large, partly outside, either orientation);
 /// tiny ones, at most a few pixels across (the small-box path); slivers, the third vertex
 /// near the line through the other two.
-fn triangle() -> impl Strategy<Value = [(f32, f32); 3]> {
+fn triangle() -> impl Strategy<Value = Tri> {
     let any = [point(), point(), point()];
     let tiny = (
         point(),
@@ -237,7 +240,7 @@ fn shared_edges_cover_each_pixel_exactly_once() {
         (lo, hi),
         (lo, mid),
     ];
-    let cuts: [(&str, Vec<[(f32, f32); 3]>); 4] = [
+    let cuts: [(&str, Vec<Tri>); 4] = [
         (
             "diagonal",
             vec![
