@@ -5,6 +5,7 @@ mod chromadepth;
 mod cli;
 mod common;
 mod conformance;
+mod coverage;
 mod determinism;
 mod figures;
 mod finalize;

@@ -1,4 +1,5 @@
-//! Triangle rasterization with llvmpipe's exact fixed-point rules (see DESIGN.md).
+//! Triangle rasterization with llvmpipe's exact fixed-point rules (docs/ARCHITECTURE.md
+//! "Rasterization rules").
 //!
 //! Pipeline per triangle: vertex stage → clip → perspective divide → viewport → snap to the
 //! subpixel grid → orient → edge functions with the top-left tie-break → depth test LESS →
@@ -8,11 +9,11 @@
 pub(crate) mod avx2;
 mod clip;
 mod setup;
+mod traverse;
 
 pub use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
-pub use setup::{
-    Band, Plane, Setup, SetupTriangle, SmallBox, WindowVertex, setup_triangle, snap, traverse,
-};
+pub use setup::{Plane, Setup, SetupTriangle, WindowVertex, setup_triangle, snap};
+pub use traverse::{Band, SmallBox, traverse};
 
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -111,9 +112,6 @@ pub fn rasterize<S: Shader>(
         setup_triangles(triangles, vertex_count, shader, fb.width, fb.height, opts);
     let width = fb.width as usize;
     let bins = bin_rows(&setups, BAND_ROWS as u32, fb.height);
-    // A depth-only pass runs its triangles through the AVX2 loop (the same bits as
-    // `traverse`, which stays the scalar reference).
-    let depth_only = !shader.writes_color() && opts.depth_test && avx2_available();
     stats.fragments = fb
         .color
         .par_chunks_mut(width * BAND_ROWS)
@@ -128,20 +126,36 @@ pub fn rasterize<S: Shader>(
                 color,
                 depth,
             };
-            bin.iter()
-                .map(|t| {
-                    #[cfg(target_arch = "x86_64")]
-                    if depth_only {
-                        // SAFETY: `depth_only` is only set where AVX2 is available.
-                        return unsafe { avx2::depth_triangle(t, &mut band) };
-                    }
-                    let _ = depth_only;
-                    traverse(t, shader, &mut band, opts)
-                })
-                .sum::<usize>()
+            traverse_band(bin, shader, &mut band, opts)
         })
         .sum();
     stats
+}
+
+/// [`traverse`] of `triangles`, in order, over `band`; returns the fragments written. In a
+/// depth-only pass (the shader writes no color, depth test on) where [`avx2_available`], each
+/// triangle goes through the AVX2 kernel `avx2::depth_triangle` instead, which writes the same
+/// depth bits and counts the same fragments (`avx2_depth_bands_match_traverse`): `traverse`
+/// stays the scalar reference.
+fn traverse_band<S: Shader>(
+    triangles: &[&SetupTriangle],
+    shader: &S,
+    band: &mut Band,
+    opts: &RasterOptions,
+) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    if !shader.writes_color() && opts.depth_test && avx2_available() {
+        // SAFETY: `depth_triangle` requires AVX2 and POPCNT (its only safety condition),
+        // which `avx2_available` has just found on this CPU (`avx2::available`).
+        return triangles
+            .iter()
+            .map(|t| unsafe { avx2::depth_triangle(t, band) })
+            .sum();
+    }
+    triangles
+        .iter()
+        .map(|t| traverse(t, shader, band, opts))
+        .sum()
 }
 
 /// The triangles of each band of `band_rows` rows (of a `height`-row target), in submission
