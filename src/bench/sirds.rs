@@ -27,7 +27,8 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
         .map(|r| (r, true))
         .chain(std::iter::once((scalar_row, false)));
     for ((w, h, tris, k, paper_hz), simd) in runs {
-        let s = table_scene(w, h, tris, k)?;
+        let mut s = table_scene(w, h, tris, k)?;
+        s.set_simd(simd);
         let center = StereoRig::center(&s.camera, s.aspect())?;
         let d = s.sirds.geometry.to_pixels()?;
         let frame = || -> Result<Vec<[u8; 4]>> {
@@ -36,11 +37,9 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
             let g = StripGeometry::new(&s, &center, &range, &d, false);
             Ok(per_vertex(&g, w, h, &d, &s.sirds.pattern, &s.sirds.per_vertex, false)?.pixels)
         };
-        crate::raster::set_simd(simd);
         // At least 100 frames: a frame is ~1.5 ms, and 15 of them (22 ms) are shorter than a
         // stall of this shared VM, which then moved the median by up to 35%.
         let ms = frame().map(|_| median_ms(iters.max(100), || frame().is_ok()));
-        crate::raster::set_simd(true);
         let ms = ms?;
         let hz = 1e3 / ms;
         let loops = if !simd {
@@ -102,6 +101,7 @@ rotate = [0.0, 35.0, 0.0]
             start,
             filter,
             iterations: None,
+            ..PerVertexOptions::default()
         };
         variants.push(("strip start/filter", format!("{start:?} {filter:?}"), s));
     }

@@ -15,25 +15,16 @@ pub use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
 pub use setup::{Plane, Setup, SetupTriangle, WindowVertex, setup_triangle, snap};
 pub use traverse::{Band, SmallBox, traverse};
 
-use std::sync::OnceLock;
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use rayon::prelude::*;
 
 use crate::framebuffer::Framebuffer;
 use crate::shade::{Shader, Varyings};
 
-/// Whether the AVX2 fragment loops run: x86-64 with AVX2, unless turned off with
-/// [`set_simd`] or the environment variable `STEREOLAB_SCALAR=1`. The bytes are the same either
-/// way (unit tests hold each loop to its scalar twin); only the speed differs.
+/// Whether this CPU can run the AVX2 loops (x86-64 with AVX2 and POPCNT). They run where
+/// this holds and the options allow them ([`RasterOptions::simd`], the strips'
+/// `PerVertexOptions::simd`); the bytes are the same either way (unit tests hold each loop to
+/// its scalar twin), only the speed differs.
 pub fn avx2_available() -> bool {
-    static SCALAR_ENV: OnceLock<bool> = OnceLock::new();
-    let scalar = *SCALAR_ENV.get_or_init(|| {
-        std::env::var_os("STEREOLAB_SCALAR").is_some_and(|v| !v.is_empty() && v != "0")
-    });
-    if scalar || SIMD_OFF.load(Ordering::Relaxed) {
-        return false;
-    }
     #[cfg(target_arch = "x86_64")]
     {
         avx2::available()
@@ -42,15 +33,6 @@ pub fn avx2_available() -> bool {
     {
         false
     }
-}
-
-/// Set by [`set_simd`]`(false)`.
-static SIMD_OFF: AtomicBool = AtomicBool::new(false);
-
-/// Turns the AVX2 loops off (`false`) or back on where the CPU has them (`true`), for the
-/// whole process: the benchmark measures the scalar loops this way.
-pub fn set_simd(on: bool) {
-    SIMD_OFF.store(!on, Ordering::Relaxed);
 }
 
 /// Rasterizer knobs. The defaults are what lavapipe does.
@@ -64,6 +46,9 @@ pub struct RasterOptions {
     pub perspective_correct: bool,
     /// Depth test LESS with depth writes (true), or no depth test and no depth writes.
     pub depth_test: bool,
+    /// Run the AVX2 loops where the CPU has them (true), or the scalar ones only (false). The
+    /// same bytes either way; `STEREOLAB_SCALAR=1` sets false in the `stereolab` command.
+    pub simd: bool,
 }
 
 impl Default for RasterOptions {
@@ -73,6 +58,7 @@ impl Default for RasterOptions {
             subpixel_bits: 8,
             perspective_correct: true,
             depth_test: true,
+            simd: true,
         }
     }
 }
@@ -133,7 +119,8 @@ pub fn rasterize<S: Shader>(
 }
 
 /// [`traverse`] of `triangles`, in order, over `band`; returns the fragments written. In a
-/// depth-only pass (the shader writes no color, depth test on) where [`avx2_available`], each
+/// depth-only pass (the shader writes no color, depth test on) where [`RasterOptions::simd`]
+/// allows it and [`avx2_available`], each
 /// triangle goes through the AVX2 kernel `avx2::depth_triangle` instead, which writes the same
 /// depth bits and counts the same fragments (`avx2_depth_bands_match_traverse`): `traverse`
 /// stays the scalar reference.
@@ -144,7 +131,7 @@ fn traverse_band<S: Shader>(
     opts: &RasterOptions,
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
-    if !shader.writes_color() && opts.depth_test && avx2_available() {
+    if !shader.writes_color() && opts.depth_test && opts.simd && avx2_available() {
         // SAFETY: `depth_triangle` requires AVX2 and POPCNT (its only safety condition),
         // which `avx2_available` has just found on this CPU (`avx2::available`).
         return triangles
@@ -321,7 +308,7 @@ fn setup_chunk(
 }
 
 /// For a test comparing the AVX2 loops with the scalar ones: whether there are AVX2 loops to
-/// compare. Without them (a CPU without AVX2, or `STEREOLAB_SCALAR` set) it says so on stderr
+/// compare. Without them (a CPU without AVX2) it says so on stderr
 /// and the test has nothing to hold: every path that runs is then the scalar one, which the
 /// other tests cover. (Unlike lavapipe, which `.ci/run` installs, AVX2 is the hardware's.)
 #[cfg(test)]
@@ -329,7 +316,7 @@ pub(crate) fn avx2_to_compare(test: &str) -> bool {
     if avx2_available() {
         return true;
     }
-    eprintln!("{test}: NOT RUN: no AVX2 here (or STEREOLAB_SCALAR set), nothing to compare");
+    eprintln!("{test}: NOT RUN: no AVX2 here, nothing to compare");
     false
 }
 

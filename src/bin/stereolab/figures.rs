@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use stereolab::scene::Scene;
 use stereolab::{Result, figures};
 
 /// Arguments of `stereolab figures`.
@@ -21,7 +20,7 @@ pub struct FiguresArgs {
 /// # Errors
 /// The scene cannot be loaded, or a figure cannot be written.
 pub fn run(args: FiguresArgs) -> Result<()> {
-    let s = Scene::load(&args.scene, &[])?;
+    let s = super::load_scene(&args.scene, &[], None)?;
     for p in figures::write_all(&s, &args.out)? {
         println!("wrote {}", p.display());
     }

@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use stereolab::scene::Scene;
 use stereolab::{Result, info};
 
 /// Arguments of `stereolab info`.
@@ -22,7 +21,7 @@ pub struct InfoArgs {
 /// # Errors
 /// The scene cannot be loaded or its rig is invalid.
 pub fn run(args: InfoArgs) -> Result<()> {
-    let s = Scene::load(&args.scene, &args.sets)?;
+    let s = super::load_scene(&args.scene, &args.sets, None)?;
     print!("{}", info::describe(&s)?);
     Ok(())
 }

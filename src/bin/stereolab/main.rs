@@ -78,8 +78,18 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
     ))
 }
 
+/// `STEREOLAB_SCALAR=1` (any value but empty or `0`): every pass on the scalar loops, what a
+/// CPU without AVX2 runs. The bytes are the same; only the speed differs.
+fn scalar_requested() -> bool {
+    std::env::var_os("STEREOLAB_SCALAR").is_some_and(|v| !v.is_empty() && v != "0")
+}
+
+/// Loads a scene with `--set` overrides, `--size`, and `STEREOLAB_SCALAR` applied.
 fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Result<Scene> {
     let mut s = Scene::load(path, sets)?;
+    if scalar_requested() {
+        s.set_simd(false);
+    }
     if let Some(size) = size {
         let (w, h) = parse_size(size)?;
         s.set_size(w, h)?;

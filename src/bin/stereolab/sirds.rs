@@ -9,7 +9,6 @@ use stereolab::output::animate::{AnimationOptions, animate};
 use stereolab::output::sirds::{from_frame, save, stream_depth_map};
 use stereolab::plan::{Output, Plan};
 use stereolab::render::render;
-use stereolab::scene::Scene;
 use stereolab::{Error, Result};
 
 /// Arguments of `stereolab sirds`.
@@ -141,7 +140,7 @@ fn report(args: &SirdsArgs) -> Result<String> {
         .scene
         .as_ref()
         .ok_or_else(|| Error::invalid("sirds", "no input", "give a scene, --depth or --decode"))?;
-    let scene = Scene::load(scene_path, &args.sets)?;
+    let scene = super::load_scene(scene_path, &args.sets, None)?;
     if let Some(frames) = args.frames {
         let opts = AnimationOptions {
             frames,

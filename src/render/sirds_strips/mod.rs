@@ -19,7 +19,8 @@
 //!    its source, as the earlier strips left the image.
 //!
 //! Steps 2 and 3 run eight pixels at a time on AVX2 (`per_vertex/avx2.rs`), with the scalar
-//! loops' bytes; `STEREOLAB_SCALAR=1` runs the scalar ones.
+//! loops' bytes; `PerVertexOptions::simd = false` (`STEREOLAB_SCALAR=1` for the command) runs
+//! the scalar ones.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -341,7 +342,7 @@ fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, simd: bool) 
             #[cfg(target_arch = "x86_64")]
             if simd {
                 let band = (width, y0, rows);
-                // SAFETY: `simd` is only set where `avx2_available()` said so.
+                // SAFETY: `simd` is only set where `avx2_available()` said so (`per_vertex`).
                 unsafe { avx2::triangle_sources(t, r, band, &mut depth, &mut sources) };
                 continue;
             }
@@ -473,31 +474,8 @@ pub fn per_vertex(
     opts: &PerVertexOptions,
     record_links: bool,
 ) -> Result<StripResult> {
-    let simd = avx2_available();
-    strips_with(
-        geometry,
-        width,
-        height,
-        d,
-        pattern,
-        opts,
-        record_links,
-        simd,
-    )
-}
-
-/// [`per_vertex`] with the AVX2 loops (`simd`, only where available) or the scalar ones.
-#[allow(clippy::too_many_arguments)]
-fn strips_with(
-    geometry: &StripGeometry,
-    width: u32,
-    height: u32,
-    d: &Disparity,
-    pattern: &Pattern,
-    opts: &PerVertexOptions,
-    record_links: bool,
-    simd: bool,
-) -> Result<StripResult> {
+    // The AVX2 loops where the options allow them and this CPU has them.
+    let simd = opts.simd && avx2_available();
     check_inputs(width, d, pattern)?;
     // The same size checks as any framebuffer.
     crate::framebuffer::check_size(width, height)?;
@@ -696,10 +674,19 @@ mod tests {
                         start,
                         filter,
                         iterations: None,
+                        ..PerVertexOptions::default()
                     };
                     let run = |simd| {
-                        strips_with(&g, w, h, &d, &s.sirds.pattern, &opts, true, simd)
-                            .expect("strips")
+                        per_vertex(
+                            &g,
+                            w,
+                            h,
+                            &d,
+                            &s.sirds.pattern,
+                            &PerVertexOptions { simd, ..opts },
+                            true,
+                        )
+                        .expect("strips")
                     };
                     let (fast, plain) = (run(true), run(false));
                     let differ = fast

@@ -196,7 +196,7 @@ mod tests {
     use crate::plan::Shading;
     use crate::raster::avx2_available;
     use crate::render::render_view;
-    use crate::render::sirds_strips::{Start, strips_with};
+    use crate::render::sirds_strips::{Start, per_vertex};
     use crate::scene::Scene;
 
     /// The camera of tests/sirds.rs.
@@ -301,6 +301,7 @@ mod tests {
                         start,
                         filter,
                         iterations,
+                        ..PerVertexOptions::default()
                     };
                     let want = k_passes(&g, w, h, &d, &pattern, &opts, true).expect("k passes");
                     // Not vacuous: most pixels copy another one.
@@ -310,8 +311,19 @@ mod tests {
                         "{name} {w}x{h} {start:?}: only {linked} pixels linked"
                     );
                     for simd in [false, true] {
-                        let got = strips_with(&g, w, h, &d, &pattern, &opts, true, simd && avx2)
-                            .expect("fast strips");
+                        let got = per_vertex(
+                            &g,
+                            w,
+                            h,
+                            &d,
+                            &pattern,
+                            &PerVertexOptions {
+                                simd: simd && avx2,
+                                ..opts
+                            },
+                            true,
+                        )
+                        .expect("fast strips");
                         compared += 1;
                         if let Some(diff) = differences(&want, &got, w) {
                             failures.push(format!(
@@ -341,7 +353,18 @@ mod tests {
                 iterations,
                 ..Default::default()
             };
-            let want = strips_with(&g, w, 67, &d, &pattern, &opts, false, false);
+            let want = per_vertex(
+                &g,
+                w,
+                67,
+                &d,
+                &pattern,
+                &PerVertexOptions {
+                    simd: false,
+                    ..opts
+                },
+                false,
+            );
             let got = k_passes(&g, w, 67, &d, &pattern, &opts, false);
             let message = |r: Result<StripResult>| r.err().map(|e| e.to_string());
             let (want, got) = (message(want), message(got));
