@@ -7,7 +7,7 @@ use crate::effects::sirds::DepthMap;
 use crate::error::Result;
 use crate::scene::Scene;
 
-/// Seed 002 Table 1: (width, height, triangles, k, frame rate in Hz on a GeForce4 Ti 4600).
+/// The SIRDS paper's Table 1: (width, height, triangles, k, frame rate in Hz on a GeForce4 Ti 4600).
 pub const TABLE_1: [(u32, u32, u32, u32, f64); 6] = [
     (512, 512, 2_500, 10, 60.1),
     (512, 512, 5_000, 10, 40.2),

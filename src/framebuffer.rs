@@ -24,12 +24,12 @@ pub struct Framebuffer {
     pub depth: Vec<f32>,
 }
 
-/// Index of the left eye in an eye pair (seed 004: 0 = left, 1 = right).
+/// Index of the left eye in an eye pair (the exercise slides: 0 = left, 1 = right).
 pub const LEFT: usize = 0;
 /// Index of the right eye in an eye pair.
 pub const RIGHT: usize = 1;
 
-/// The two eye framebuffers, index 0 left and 1 right as in seed 004.
+/// The two eye framebuffers, index 0 left and 1 right as in the exercise slides.
 pub type EyePair = [Framebuffer; 2];
 
 impl Framebuffer {

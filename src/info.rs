@@ -1,4 +1,4 @@
-//! `stereolab info`: the derived cameras and the scene's parallax range (seed 003's budget).
+//! `stereolab info`: the derived cameras and the scene's parallax range (the StereoGraphics guide's budget).
 
 use std::fmt::Write as _;
 
@@ -114,13 +114,13 @@ pub fn describe(scene: &Scene) -> Result<String> {
     if p.min_percent < -PARALLAX_BUDGET_PERCENT || p.max_percent > PARALLAX_BUDGET_PERCENT {
         let _ = writeln!(
             s,
-            "warning: parallax exceeds seed 003's ~{PARALLAX_BUDGET_PERCENT}% budget; reduce eye_separation or user_offset"
+            "warning: parallax exceeds the StereoGraphics guide's ~{PARALLAX_BUDGET_PERCENT}% budget; reduce eye_separation or user_offset"
         );
     }
     if p.max_vertical_percent > 0.01 {
         let _ = writeln!(
             s,
-            "warning: vertical parallax (toe-in?) of {:.3}% of height strains fusion (seed 003)",
+            "warning: vertical parallax (toe-in?) of {:.3}% of height strains fusion (the StereoGraphics guide (Akka))",
             p.max_vertical_percent
         );
     }

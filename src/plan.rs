@@ -23,7 +23,7 @@ pub enum Output {
     CrossEyed,
     /// Left on top of right, each full size.
     AboveBelow,
-    /// Seed 003's sync-doubling format: both eyes squashed 1:2 into one frame, left on top,
+    /// The StereoGraphics guide's sync-doubling format: both eyes squashed 1:2 into one frame, left on top,
     /// separated by a black blank interval.
     AboveBelowSquashed,
     /// Even rows left, odd rows right (row-interleaved polarized displays).
@@ -32,7 +32,7 @@ pub enum Output {
     InterlacedColumns,
     /// Left where x + y is even, right elsewhere (DLP checkerboard).
     Checkerboard,
-    /// Seed 000's ChromaDepth image: depth as a red → green → blue ramp, one center-eye pass.
+    /// The ChromaDepth article's ChromaDepth image: depth as a red → green → blue ramp, one center-eye pass.
     ChromaDepth,
     /// The left eye's view of the ChromaDepth image through the glasses (simulated).
     ChromaDepthLeft,
@@ -40,17 +40,17 @@ pub enum Output {
     ChromaDepthRight,
     /// Both simulated views as a red–cyan anaglyph, for viewers without ChromaDepth glasses.
     ChromaDepthAnaglyph,
-    /// `anaglyph_<kind>`: both eyes' colors mixed by the kind's matrices (seed 004).
+    /// `anaglyph_<kind>`: both eyes' colors mixed by the kind's matrices (the exercise slides).
     Anaglyph(AnaglyphKind),
-    /// The left eye's view recolored from the right eye by remapping (seed 004).
+    /// The left eye's view recolored from the right eye by remapping (the exercise slides).
     RemapLeft,
     /// The right eye's view recolored from the left eye.
     RemapRight,
     /// Per eye, what it sees that the other eye cannot (remapping + visibility check).
     Occlusion,
-    /// The left eye's parallax `p(z) = d(1 − z0/z)` as color with a legend (seed 004).
+    /// The left eye's parallax `p(z) = d(1 − z0/z)` as color with a legend (the exercise slides).
     Parallax,
-    /// Single-image random-dot stereogram of the cyclopean view (seed 002).
+    /// Single-image random-dot stereogram of the cyclopean view (the SIRDS paper (Petz et al.)).
     Sirds,
     /// The depth map the SIRDS encodes (16-bit, white = near).
     SirdsDepth,
@@ -74,7 +74,7 @@ pub enum Shading {
     DepthOnly,
     /// Shaded color (and depth).
     Color,
-    /// ChromaDepth: color from the depth ramp (and depth), seed 000.
+    /// ChromaDepth: color from the depth ramp (and depth), the ChromaDepth article.
     ChromaDepth,
 }
 
@@ -184,7 +184,7 @@ impl Output {
             Output::Right => vec![color(View::Right)],
             Output::LeftDepth => vec![depth(View::Left)],
             Output::RightDepth => vec![depth(View::Right)],
-            // One center pass, no stereo pair: the glasses make the pair (seed 000).
+            // One center pass, no stereo pair: the glasses make the pair (the ChromaDepth article).
             Output::ChromaDepth
             | Output::ChromaDepthLeft
             | Output::ChromaDepthRight
@@ -199,7 +199,7 @@ impl Output {
             Output::Occlusion => vec![depth(View::Left), depth(View::Right)],
             // p(z) needs the left eye's depth and the rig, nothing else.
             Output::Parallax => vec![depth(View::Left)],
-            // One depth pass of the cyclopean view; no color shading at all (seed 002).
+            // One depth pass of the cyclopean view; no color shading at all (the SIRDS paper (Petz et al.)).
             Output::Sirds | Output::SirdsDepth => vec![depth(View::Center)],
             _ => vec![color(View::Left), color(View::Right)],
         }

@@ -65,7 +65,7 @@ impl Default for Light {
 }
 
 /// Blinn-Phong in eye space: the modelview it is given decides whether each eye lights from its
-/// own position (per-eye) or both from the cyclopean eye (cyclopic), seed 004.
+/// own position (per-eye) or both from the cyclopean eye (cyclopic), the exercise slides.
 pub struct BlinnPhong<'a> {
     positions: &'a [Vec3],
     normals: &'a [Vec3],

@@ -1,4 +1,4 @@
-//! ChromaDepth (seed 000): texgen, ramp, the one-pass plan, per-vertex vs per-pixel, the glasses
+//! ChromaDepth (the ChromaDepth article): texgen, ramp, the one-pass plan, per-vertex vs per-pixel, the glasses
 //! simulation, terrain from scattered points, and bad input.
 
 use std::path::Path;
@@ -83,7 +83,7 @@ fn texgen_maps_d1_to_zero_and_d2_to_one() {
 
 #[test]
 fn texgen_coefficients_match_seed_000_sample_code() {
-    // Seed 000: D1 5, D2 15 → {0, 0, −1/(D2−D1), −D1/(D2−D1)} = {0, 0, −0.1, −0.5}.
+    // The ChromaDepth article: D1 5, D2 15 → {0, 0, −1/(D2−D1), −D1/(D2−D1)} = {0, 0, −0.1, −0.5}.
     let t = Texgen::from_range(5.0, 15.0).expect("valid range");
     assert_eq!(t.plane, Vec4::new(0.0, 0.0, -0.1, -0.5));
 }
@@ -125,9 +125,9 @@ fn object_transforms_move_objects_through_the_ramp() {
 #[test]
 fn a_plane_specified_under_a_transform_moves_with_it() {
     let t = Texgen::from_range(5.0, 15.0).expect("valid range");
-    // Seed 000: specify the plane under the identity modelview, it stays fixed in eye space.
+    // The ChromaDepth article: specify the plane under the identity modelview, it stays fixed in eye space.
     assert_eq!(eye_plane_specified_under(t.plane, Mat4::IDENTITY), t.plane);
-    // Specified after a transform (the mistake seed 000 warns about) it is carried along: the
+    // Specified after a transform (the mistake the ChromaDepth article warns about) it is carried along: the
     // point D1 in front of the eye no longer gets s = 0.
     let moved =
         eye_plane_specified_under(t.plane, Mat4::from_translation(Vec3::new(0.0, 0.0, -3.0)));

@@ -1,5 +1,5 @@
 //! The finalize pass (issue 3): anaglyphs, remapping, the visibility check and occlusion map,
-//! parallax as color and seed 003's budget. Helpers here; tests in `tests/finalize/`.
+//! parallax as color and the StereoGraphics guide's budget. Helpers here; tests in `tests/finalize/`.
 
 mod anaglyph;
 mod inputs;
@@ -52,7 +52,7 @@ impl Rig {
         self.width as f64 / xrange
     }
 
-    /// Seed 004: p(z) = d (1 − z0/z), in pixels.
+    /// The exercise slides: p(z) = d (1 − z0/z), in pixels.
     pub fn parallax_px(&self, z: f64) -> f64 {
         self.separation as f64 * (1.0 - self.zero_parallax as f64 / z) * self.pixels_per_unit()
     }

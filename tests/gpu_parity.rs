@@ -113,7 +113,7 @@ fn push_triangle(m: &mut Mesh, rng: &mut Rng, v: [(u64, u64, f32); 3]) {
     m.triangles.push([base, base + 1, base + 2]);
 }
 
-/// The conformance scenes of DESIGN.md: random triangles, fans around a shared vertex, and
+/// The conformance scenes of docs/ARCHITECTURE.md: random triangles, fans around a shared vertex, and
 /// axis-aligned quads split in two, all with vertices on the 1/256 grid inside the viewport.
 fn grid_scene(seed: u64) -> Mesh {
     let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
@@ -446,7 +446,7 @@ fn fullscreen_pass_reports_bad_shaders_and_inputs_as_errors() {
 }
 
 /// Clipping parity. Measured here at 320×240: 0 pixels differ in coverage in either eye, max
-/// channel difference 1, depth within 4.3e-7; DESIGN.md saw about 0.01% on random triangles
+/// channel difference 1, depth within 4.3e-7; docs/ARCHITECTURE.md saw about 0.01% on random triangles
 /// crossing the viewport edge, so the bound is the shipped scenes' 0.1%.
 #[test]
 fn clipped_scene_matches_coverage_depth_and_color() {

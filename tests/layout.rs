@@ -1,4 +1,4 @@
-//! Stereo layouts, seed 003's above-below format included.
+//! Stereo layouts, the StereoGraphics guide's above-below format included.
 
 use stereolab::effects::layout;
 use stereolab::framebuffer::Framebuffer;

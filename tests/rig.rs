@@ -1,4 +1,4 @@
-//! The stereo rig against seeds 001, 003 and 004.
+//! The stereo rig against the SGI course notes, the StereoGraphics guide (Akka) and the exercise slides.
 
 use glam::{Vec3, Vec3Swizzles};
 use proptest::prelude::*;
@@ -8,7 +8,7 @@ use stereolab::math::{
 };
 
 fn seed003_camera() -> Camera {
-    // Seed 003 §5: camera at (0, 0, 9) looking at the xy plane; fov 90° so the plane spans ±9.
+    // The StereoGraphics guide's §5: camera at (0, 0, 9) looking at the xy plane; fov 90° so the plane spans ±9.
     Camera {
         eye: [0.0, 0.0, 9.0],
         target: [0.0, 0.0, 0.0],
@@ -157,7 +157,7 @@ fn toe_in_has_vertical_parallax_off_center() {
     };
     // On the vertical center line the two rotations are mirror images: no vertical parallax.
     assert!(vertical_px(Vec3::new(0.0, 5.0, -3.0)).abs() < 1e-3);
-    // Off center (seed 003's point): the keystone distortion differs between the eyes.
+    // Off center (the StereoGraphics guide's point): the keystone distortion differs between the eyes.
     let v = vertical_px(Vec3::new(8.0, -5.0, -3.0));
     println!("toe-in vertical parallax of (8,-5,-3), d = 1, z0 = 9, 1024 rows: {v:.3} px");
     assert!(

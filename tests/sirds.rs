@@ -1,4 +1,4 @@
-//! SIRDS (issue 5, seed 002): disparity formulas, constraints, decode round trips, left vs
+//! SIRDS (issue 5, the SIRDS paper (Petz et al.)): disparity formulas, constraints, decode round trips, left vs
 //! center start, SIRDS vs noise, bad input, CLI, plan.
 
 use std::path::Path;
@@ -28,7 +28,7 @@ near = 1.0
 far = 20.0
 "#;
 
-/// Seed 002 Fig. 5: a plane receding from near on the left to far on the right.
+/// The SIRDS paper's Fig. 5: a plane receding from near on the left to far on the right.
 fn ramp() -> Scene {
     scene(RAMP)
 }
@@ -41,7 +41,7 @@ detail = 16
 rotate = [0.0, 35.0, 0.0]
 "#;
 
-/// A sphere over the background plane (seed 002 §3).
+/// A sphere over the background plane (the SIRDS paper's §3).
 fn sphere() -> Scene {
     scene(SPHERE)
 }
@@ -351,7 +351,7 @@ fn gradient(pixels: &[[u8; 4]], w: usize, x0: usize, x1: usize) -> f64 {
 
 #[test]
 fn center_start_stays_sharper_than_left_start() {
-    // Seed 002 Fig. 7: sharpness degrades with distance from the initial strip. Bilinear copies
+    // The SIRDS paper's Fig. 7: sharpness degrades with distance from the initial strip. Bilinear copies
     // of black/white dots lose contrast at every copy; a center start copies half as often.
     let text = format!("outputs = [\"sirds\"]\n{}{RAMP}", camera(960, 96));
     let mut s =

@@ -179,7 +179,7 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
     Ok(rows)
 }
 
-/// Remap coordinates in f32 (seed 004's shader), f32 with the composed matrix, and f64: time,
+/// Remap coordinates in f32 (the exercise slides' shader), f32 with the composed matrix, and f64: time,
 /// and the largest texture-coordinate difference to f64 over drawn pixels (and over all pixels,
 /// including the far plane).
 fn remap_precision_rows(
@@ -193,7 +193,7 @@ fn remap_precision_rows(
     for (p, name) in [
         (Precision::F64, "f64"),
         (Precision::F32Composed, "f32 composed"),
-        (Precision::F32, "f32 seed 004"),
+        (Precision::F32, "f32 the exercise slides"),
     ] {
         let coords = remap_coordinates(left, &mvp[0], &mvp[1], p)?;
         let (mut drawn, mut all) = (0.0f64, 0.0f64);

@@ -231,7 +231,7 @@ fn pair_and_anaglyph(
     ])
 }
 
-/// Seed 002 Table 1's first row (512×512, 2,500 triangles, k = 10, left start, bilinear) as a
+/// The SIRDS paper's Table 1's first row (512×512, 2,500 triangles, k = 10, left start, bilinear) as a
 /// whole frame on each path: the depth pass (GPU: including its readback, which the depth range
 /// needs), the strip geometry on the host, the strips (GPU: including the image's readback).
 /// The GPU row's error is the share of pixels that differ from the CPU's, in percent.
@@ -275,7 +275,7 @@ fn sirds_rows(r: &GpuRenderer, iters: usize) -> Result<Vec<Row>> {
     }
     let row = |setting: String, error, ms: f64, note: String| Row {
         area: "gpu parity".into(),
-        knob: "sirds strips, seed 002 Table 1".into(),
+        knob: "sirds strips, the SIRDS paper's Table 1".into(),
         setting,
         error,
         error_unit: "% pixels differing from cpu".into(),

@@ -1,4 +1,4 @@
-//! Anaglyphs: `out = clamp(ML · left + MR · right)` per pixel (seed 004, "Anaglyph").
+//! Anaglyphs: `out = clamp(ML · left + MR · right)` per pixel (the exercise slides, "Anaglyph").
 //!
 //! Written as the finalize fragment shader would be: [`mix`] is the whole shader body for one
 //! pixel, [`srgb_to_linear`] / [`linear_to_srgb`] the optional decode/encode around it, and
@@ -28,13 +28,13 @@ pub struct AnaglyphMatrices {
 /// Every anaglyph stereolab can produce.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum AnaglyphKind {
-    /// Seed 004 "true": luma to red (left) and blue (right). Dark; white becomes magenta.
+    /// The exercise slides' "true": luma to red (left) and blue (right). Dark; white becomes magenta.
     True,
-    /// Seed 004 "gray": luma to red (left) and to green and blue (right).
+    /// The exercise slides' "gray": luma to red (left) and to green and blue (right).
     Gray,
-    /// Seed 004 "color": red from the left eye, green and blue from the right.
+    /// The exercise slides' "color": red from the left eye, green and blue from the right.
     Color,
-    /// Seed 004 "half color": luma to red (left), green and blue from the right.
+    /// The exercise slides' "half color": luma to red (left), green and blue from the right.
     HalfColor,
     /// 3dtv.at "optimized": red = 0.7 G + 0.3 B of the left eye, green and blue from the right.
     Optimized,
@@ -48,7 +48,7 @@ pub enum AnaglyphKind {
     DuboisAmberBlue,
 }
 
-/// Rec. 601 luma weights, as seed 004 writes them (0,299 0,587 0,114).
+/// Rec. 601 luma weights, as the exercise slides write them (0,299 0,587 0,114).
 const LUMA: [f32; 3] = [0.299, 0.587, 0.114];
 const ZERO: [f32; 3] = [0.0, 0.0, 0.0];
 
@@ -83,9 +83,9 @@ impl AnaglyphKind {
 
     /// `(ML, MR)` of this kind, and where the numbers come from:
     ///
-    /// - `True`, `Gray`, `Color`, `HalfColor`: seed 004's slides (after 3dtv.at's anaglyph
+    /// - `True`, `Gray`, `Color`, `HalfColor`: the exercise slides (after 3dtv.at's anaglyph
     ///   comparison), luma weights 0.299 / 0.587 / 0.114.
-    /// - `Optimized`: 3dtv.at's comparison (linked from seed 004): `R = 0.7·G_l + 0.3·B_l`,
+    /// - `Optimized`: 3dtv.at's comparison (linked from the exercise slides): `R = 0.7·G_l + 0.3·B_l`,
     ///   G and B from the right eye.
     /// - `DuboisRedCyan`: Eric Dubois' least-squares red-cyan matrices for CRT primaries, at the
     ///   full precision three.js's `AnaglyphEffect` uses (there written column-major with
@@ -166,7 +166,7 @@ impl AnaglyphKind {
 
     /// Whether the source claims white stays white, i.e. every row of `ML + MR` sums to about 1.
     ///
-    /// Every kind except `True`: seed 004's true anaglyph sends luma to red and blue only, so
+    /// Every kind except `True`: the exercise slides' true anaglyph sends luma to red and blue only, so
     /// white becomes magenta (1, 0, 1). The Dubois matrices are least-squares fits, so their
     /// rows sum to 1 only within rounding of the published digits (the CRT blue row sums to
     /// 0.9960).

@@ -1,4 +1,4 @@
-//! Stereo pair layouts (seed 003 §8 for above-below): pure functions of the two eye images.
+//! Stereo pair layouts (the StereoGraphics guide's §8 for above-below): pure functions of the two eye images.
 
 use image::{Rgba, RgbaImage};
 
@@ -52,9 +52,9 @@ pub fn above_below(left: &Framebuffer, right: &Framebuffer) -> Result<RgbaImage>
     }))
 }
 
-/// Seed 003's sync-doubling format in a frame of the eyes' size W×H: each view squashed to
+/// The StereoGraphics guide's sync-doubling format in a frame of the eyes' size W×H: each view squashed to
 /// `(H − blank)/2` rows (area-averaged), left on top, a black blank interval between them.
-/// With H = 768 and blank = 40: left rows 0–363, blank 364–403, right 404–767 (seed 003).
+/// With H = 768 and blank = 40: left rows 0–363, blank 364–403, right 404–767 (the StereoGraphics guide (Akka)).
 ///
 /// # Errors
 /// Different sizes, or a blank interval that leaves no rows.

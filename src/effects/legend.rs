@@ -71,7 +71,7 @@ fn draw_text(pm: &mut Pixmap, text: &str, x: f32, y: f32, s: f32, rgba: [u8; 4])
 
 /// A `width`×[`LEGEND_HEIGHT`] legend for a symmetric scale of ±`scale` pixels: one
 /// tiny-skia rectangle per bar column colored by `color_of(parallax)` (so the bar matches the
-/// image exactly), a tick at 0, taller ticks at seed 003's ±3% budget when it lies inside the
+/// image exactly), a tick at 0, taller ticks at the StereoGraphics guide's ±3% budget when it lies inside the
 /// scale, and the end labels in pixels and percent of the width (omitted when too narrow).
 ///
 /// # Errors

@@ -1,4 +1,4 @@
-//! The occlusion map: what each eye sees that the other cannot (seed 004, remapping plus the
+//! The occlusion map: what each eye sees that the other cannot (the exercise slides, remapping plus the
 //! visibility check), drawn as `left eye's map | right eye's map`.
 
 use glam::Mat4;

@@ -1,10 +1,10 @@
-//! Screen parallax per pixel, `p(z) = d·(1 − z0/z)` (seed 004), drawn as color (blue negative,
-//! red positive, as seed 004's last slide), and seed 003's parallax budget.
+//! Screen parallax per pixel, `p(z) = d·(1 − z0/z)` (the exercise slides), drawn as color (blue negative,
+//! red positive, as the exercise slides' last slide), and the StereoGraphics guide's parallax budget.
 //!
 //! Per pixel, as a shader: the window depth back to the eye distance z ([`ParallaxRig::
 //! eye_distance`]), then `p(z)` in world units at the zero-parallax plane, then in pixels
 //! (`× W / Xrange`, Xrange the view width at z0). Positive parallax lies behind the screen (the
-//! right eye's image of a point is right of the left eye's), as seed 003 defines it.
+//! right eye's image of a point is right of the left eye's), as the StereoGraphics guide (Akka) defines it.
 
 use image::RgbaImage;
 
@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::math::{Camera, CameraMode, StereoRig};
 
-/// Seed 003: keep negative and positive parallax each within about 3% of the image width.
+/// The StereoGraphics guide (Akka): keep negative and positive parallax each within about 3% of the image width.
 pub const PARALLAX_BUDGET_PERCENT: f32 = 3.0;
 
 /// The rig's numbers the parallax formula needs, resolved for one image size.
@@ -24,7 +24,7 @@ pub struct ParallaxRig {
     pub eye_separation: f64,
     /// Zero-parallax distance z0.
     pub zero_parallax_distance: f64,
-    /// Seed 003's `UserBalanceAdjustment` b (off-axis), 1 for toe-in, 0 for parallel axes.
+    /// The StereoGraphics guide's `UserBalanceAdjustment` b (off-axis), 1 for toe-in, 0 for parallel axes.
     pub balance: f64,
     /// Near plane distance n.
     pub near: f64,
@@ -71,7 +71,7 @@ impl ParallaxRig {
     }
 
     /// Screen parallax of a point at eye distance z, world units at the zero-parallax plane:
-    /// `p(z) = d·(b − z0/z)`. With seed 003's balance b = 1 this is seed 004's
+    /// `p(z) = d·(b − z0/z)`. With the StereoGraphics guide's balance b = 1 this is the exercise slides'
     /// `p(z) = d·(1 − z0/z)`; b scales the frustum shift (`n·d/(2 z0)·b`), b = 0 is parallel
     /// axes. Exact for off-axis and parallel rigs; for toe-in a first-order approximation on the
     /// center line (0.3% off at wuson's nearest depths; tests/figures.rs measures it).
@@ -109,7 +109,7 @@ pub fn parallax_map(fb: &Framebuffer, rig: &ParallaxRig) -> Result<Vec<Option<f6
     Ok(fb.depth.iter().map(|d| rig.parallax_pixels(*d)).collect())
 }
 
-/// Seed 003's parallax budget over one eye's pixels.
+/// The StereoGraphics guide's parallax budget over one eye's pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParallaxBudget {
     /// Image width (parallax percentages are of this).
@@ -122,7 +122,7 @@ pub struct ParallaxBudget {
     pub max_pixels: f64,
     /// Drawn pixels whose |parallax| exceeds [`PARALLAX_BUDGET_PERCENT`] of the width.
     pub beyond_budget: usize,
-    /// Border pixels with negative parallax (seed 003's window violation), per side:
+    /// Border pixels with negative parallax (the StereoGraphics guide's window violation), per side:
     /// left, right, top, bottom.
     pub window_violations: [usize; 4],
 }
@@ -209,7 +209,7 @@ pub fn budget_of(fb: &Framebuffer, rig: &ParallaxRig) -> Result<ParallaxBudget> 
 /// Color of background pixels in the parallax image.
 pub const PARALLAX_BACKGROUND: [u8; 4] = [24, 24, 24, 255];
 
-/// Seed 004's parallax color: white at zero, towards blue (0, 64, 255) for negative and red
+/// The exercise slides' parallax color: white at zero, towards blue (0, 64, 255) for negative and red
 /// (255, 32, 0) for positive parallax, saturating at ±`scale` pixels.
 #[inline]
 pub fn parallax_color(pixels: f64, scale: f64) -> [u8; 4] {

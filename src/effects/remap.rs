@@ -1,5 +1,5 @@
-//! Remapping one eye's pixels into the other eye (seed 004, "Remapping"), and the visibility
-//! check built on it (seed 004, "Visibility Check").
+//! Remapping one eye's pixels into the other eye (the exercise slides, "Remapping"), and the visibility
+//! check built on it (the exercise slides, "Visibility Check").
 //!
 //! For a pixel of eye `this` (window coordinates from `gl_FragCoord.xy`, depth from its depth
 //! texture):
@@ -11,7 +11,7 @@
 //! τ = ½ (ndc_other.xy + 1)                                      (texture coordinates, v up)
 //! ```
 //!
-//! and the other eye's color and depth are fetched at τ with nearest filtering (seed 004 sets
+//! and the other eye's color and depth are fetched at τ with nearest filtering (the exercise slides set
 //! `TF_NEAREST` on all four textures). [`Remapper::remap`] is the shader for one pixel; the
 //! functions below it only loop.
 
@@ -26,7 +26,7 @@ use crate::framebuffer::Framebuffer;
 /// In which precision the unproject/project chain runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Precision {
-    /// As seed 004's shader: `iMVP_this` (inverted in f32) and `MVP_other` as f32 uniforms, two
+    /// As the exercise slides' shader: `iMVP_this` (inverted in f32) and `MVP_other` as f32 uniforms, two
     /// f32 products per pixel through world space. Loses accuracy as far/near grows: the
     /// inverse projection's entries grow like 1/near and cancel. On the real model at 1024 px
     /// width the texture coordinates are off by 2.3e-4 px at near/far = 1/20 but by 1.5 px at
@@ -180,7 +180,7 @@ pub fn remap_coordinates(
 /// `this` eye's view recolored from the `other` eye: each pixel takes the other eye's color at
 /// its remapped position. Reads this eye's depth and the other eye's color only; regions the
 /// other eye cannot see show whatever the other eye sees there instead, which is what makes
-/// occlusions visible (seed 004). Pixels where this eye drew nothing (depth 1) have no surface
+/// occlusions visible (the exercise slides). Pixels where this eye drew nothing (depth 1) have no surface
 /// point to remap and stay black; points outside the other image get
 /// [`OUT_OF_VIEW_COLOR`](super::occlusion::OUT_OF_VIEW_COLOR).
 ///
@@ -237,7 +237,7 @@ pub enum Visibility {
     /// The point lies outside the other eye's image (or behind it).
     OutOfView,
     /// The other eye's depth there is *farther* than the point. Impossible for exact geometry
-    /// (seed 004: "if violated, only d₁ < d₀ possible"); it happens only where nearest
+    /// (the exercise slides: "if violated, only d₁ < d₀ possible"); it happens only where nearest
     /// sampling at a silhouette fetches the background next to the surface.
     Farther,
 }
@@ -286,7 +286,7 @@ pub fn tolerance(slope: f64) -> f64 {
     DEPTH_PRECISION + slope
 }
 
-/// The visibility check for one pixel (seed 004): the other eye's depth `other_depth` at the
+/// The visibility check for one pixel (the exercise slides): the other eye's depth `other_depth` at the
 /// remapped texel against the remapped depth, within `tolerance`. `target` is `None` when the
 /// point falls outside the other image.
 #[inline]

@@ -6,7 +6,7 @@
 //!
 //! Conventions every stub states again: right-handed eye space looking down −Z, Y up, OpenGL
 //! NDC with Z in [−1, 1], window depth and texture coordinates in [0, 1] (v = 0 at the bottom
-//! row, as in OpenGL textures), eye index 0 = left, 1 = right (seed 004).
+//! row, as in OpenGL textures), eye index 0 = left, 1 = right (the exercise slides).
 
 pub mod protocol;
 pub mod types;

@@ -7,7 +7,7 @@ use super::protocol::Answer;
 use crate::effects::anaglyph;
 pub use crate::effects::anaglyph::{AnaglyphMatrices, ColorMatrix};
 
-/// A mono camera's symmetric frustum plus the stereo rig (seed 004's parameters).
+/// A mono camera's symmetric frustum plus the stereo rig (the exercise slides' parameters).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StereoSetup {
     /// Vertical field of view in degrees.
@@ -41,7 +41,7 @@ impl Answer for EyeView {
     }
 }
 
-/// The four anaglyph kinds of seed 004 (after 3dtv.at's comparison).
+/// The four anaglyph kinds of the exercise slides (after 3dtv.at's comparison).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum AnaglyphKind {
@@ -56,7 +56,7 @@ pub enum AnaglyphKind {
 }
 
 impl AnaglyphKind {
-    /// All four, in seed 004's order.
+    /// All four, in the exercise slides' order.
     pub const ALL: [AnaglyphKind; 4] = [
         AnaglyphKind::True,
         AnaglyphKind::Gray,
@@ -84,7 +84,7 @@ impl Answer for AnaglyphMatrices {
     }
 }
 
-/// Seed 002's viewing geometry for a scan line, in pixels.
+/// The SIRDS paper's viewing geometry for a scan line, in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SirdsGeometry {
     /// Distance a between the eyes.
@@ -93,7 +93,7 @@ pub struct SirdsGeometry {
     pub focal_length: f32,
 }
 
-/// What one SIRDS scan line needs: seed 002's eye geometry and the depth range the nearness
+/// What one SIRDS scan line needs: the SIRDS paper's eye geometry and the depth range the nearness
 /// values span, all in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SirdsSetup {

@@ -3,7 +3,7 @@
 //! [`Framebuffer`](crate::Framebuffer) type, so that [`compare`](crate::compare) can measure the
 //! two paths pixel by pixel. Built only with the cargo feature `gpu`.
 //!
-//! Conventions (DESIGN.md "Conventions"):
+//! Conventions (docs/ARCHITECTURE.md "Conventions"):
 //! - the matrices are OpenGL's (NDC z in [−1, 1]); wgpu clips and maps z in [0, 1], so every
 //!   projection goes through [`GL_TO_WGPU_DEPTH`] (the only place the two conventions meet);
 //! - wgpu's NDC has y = +1 at the top row (wgpu itself gives Vulkan a negative viewport height),
@@ -15,7 +15,7 @@
 //! Layout: [`device`] (adapter, device, pipeline cache), [`raster`] (scene passes),
 //! [`fullscreen`] (the generic full-screen pass that effects mirror), [`effects`] (the finalize
 //! effects in WGSL), [`readback`] (textures to
-//! framebuffers), [`sirds`] (seed 002's strips as render-to-texture ping-pong), [`parity`]
+//! framebuffers), [`sirds`] (the SIRDS paper's strips as render-to-texture ping-pong), [`parity`]
 //! (render both paths and compare, and the benchmark row).
 
 pub mod device;

@@ -12,7 +12,7 @@ use super::device::GpuRenderer;
 use super::gpu_error;
 use super::resources::texture_2d;
 
-/// The color format of every target: 8-bit RGBA, no sRGB conversion (DESIGN.md).
+/// The color format of every target: 8-bit RGBA, no sRGB conversion (docs/ARCHITECTURE.md).
 pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// Spare targets kept between frames: a stereo pair plus a center pass and an effect pass.

@@ -1,4 +1,4 @@
-//! Seed 002's per-vertex strip algorithm as the paper built it, on the GPU: render-to-texture
+//! The SIRDS paper's per-vertex strip algorithm as the paper built it, on the GPU: render-to-texture
 //! ping-pong (§4). A mirror of [`per_vertex`](crate::render::sirds_strips::per_vertex)
 //! on the same [`StripGeometry`] and the same strips
 //! ([`plan_strips`](crate::effects::sirds::per_vertex)):

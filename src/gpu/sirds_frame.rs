@@ -1,5 +1,5 @@
 //! The GPU strips in use: a scene's SIRDS from a frame's depth pass, the strip-parity row of
-//! `compare SCENE`, and seed 002 Table 1's first row on both paths for `stereolab bench`.
+//! `compare SCENE`, and the SIRDS paper's Table 1's first row on both paths for `stereolab bench`.
 
 use std::path::Path;
 

@@ -1,4 +1,4 @@
-//! Exercise 2 (seed 000, ChromaDepth): the tasks, reference answers, mistakes, image checks.
+//! Exercise 2 (the ChromaDepth article, ChromaDepth): the tasks, reference answers, mistakes, image checks.
 //!
 //! The reference is stereolab's ChromaDepth module (`effects::chromadepth`): its exact HSV ramp,
 //! its texgen plane and its bounding-sphere range; the texgen image check renders the real
@@ -30,12 +30,12 @@ fn hue_to_rgb(hue: f32) -> [f32; 3] {
     hsv_to_rgb(hue, 1.0, 1.0).to_array()
 }
 
-/// Seed 000's ramp as stereolab computes it: hue 240° · clamp(t), red near, blue far.
+/// The ChromaDepth article's ramp as stereolab computes it: hue 240° · clamp(t), red near, blue far.
 pub fn reference_ramp(t: f32) -> [f32; 3] {
     exact(RampKind::Hsv, t).to_array()
 }
 
-/// Seed 000's texgen plane `[A, B, C, D]` as stereolab's `Texgen::from_range` computes it; for
+/// The ChromaDepth article's texgen plane `[A, B, C, D]` as stereolab's `Texgen::from_range` computes it; for
 /// `d1 ≥ d2`, which it refuses, the formula itself.
 pub fn reference_texgen(d1: f32, d2: f32) -> [f32; 4] {
     Texgen::from_range(d1, d2).map_or_else(
@@ -142,7 +142,7 @@ fn ramp_task() -> TaskSpec {
     }
 }
 
-/// Seed 000's bounding-sphere range of the fixture's objects, seen from the cyclopean eye
+/// The ChromaDepth article's bounding-sphere range of the fixture's objects, seen from the cyclopean eye
 /// (stereolab's `auto_range`, which keeps it between the clip planes).
 fn fixture_range(fx: &Fixture) -> [f32; 2] {
     let points: Vec<Vec3> = fx.scene.world_points().collect();

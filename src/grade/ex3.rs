@@ -1,4 +1,4 @@
-//! Exercise 3 (seed 002, SIRDS): the tasks, reference answers, mistakes, image checks.
+//! Exercise 3 (the SIRDS paper (Petz et al.), SIRDS): the tasks, reference answers, mistakes, image checks.
 //!
 //! The reference is stereolab's SIRDS module: its Eq. (3) separation and its per-pixel linking
 //! (`effects::sirds::per_pixel::RowLinker`, Thimbleby, Inglis and Witten's algorithm). The known
@@ -254,7 +254,7 @@ fn link_task(fx: &Fixture) -> TaskSpec {
             Mistake {
                 id: "d-instead-of-half-d",
                 hint: "d instead of d/2: the two pixels sit s/2 to the left and s/2 to the right \
-                       of x (seed 002 shifts the vertex by d/2 and the texture by d/2)",
+                       of x (the SIRDS paper (Petz et al.) shifts the vertex by d/2 and the texture by d/2)",
                 answers: each(Linking::FullDisparity),
             },
             Mistake {

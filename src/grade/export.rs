@@ -133,8 +133,8 @@ pub fn export(root: &Path, dir: &Path) -> Result<()> {
 
 const HANDOUT_README: &str = "# Stereo rendering exercises
 
-Three exercises, one crate each: `ex1_stereo` (seed 004: stereo frusta, anaglyphs, remapping,
-parallax), `ex2_chromadepth` (seed 000), `ex3_sirds` (seed 002). Complete the `todo!`s in each
+Three exercises, one crate each: `ex1_stereo` (the exercise slides: stereo frusta, anaglyphs, remapping,
+parallax), `ex2_chromadepth` (the ChromaDepth article), `ex3_sirds` (the SIRDS paper (Petz et al.)). Complete the `todo!`s in each
 crate's `src/stubs.rs`; every stub's doc comment states the task, the formula's source and the
 conventions (right-handed, NDC z in [-1, 1], eye index 0 = left).
 

@@ -14,7 +14,7 @@ use crate::scene::Scene;
 
 /// The built-in grading scene: small (fast, ASCII maps fit a terminal), with depth in front of
 /// and behind the screen (parallax of both signs), occluders in front of a backdrop (remapping,
-/// visibility) and a background plane behind everything (seed 002's SIRDS bound).
+/// visibility) and a background plane behind everything (the SIRDS paper's SIRDS bound).
 pub const GRADING_SCENE: &str = r#"
 outputs = ["left", "right"]
 [image]
@@ -82,7 +82,7 @@ pub struct Fixture {
 }
 
 /// The reference rig of the exercises: off-axis with the scene's separation and screen distance,
-/// no user adjustments (seed 004's rig).
+/// no user adjustments (the exercise slides' rig).
 pub fn reference_rig(setup: &StereoSetup, lighting: Lighting) -> StereoRig {
     StereoRig {
         separation: Separation::Absolute(setup.eye_separation),

@@ -34,11 +34,11 @@ use spec::TaskSpec;
 /// The exercises of the course.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Exercise {
-    /// Stereo frusta, anaglyphs, remapping, parallax (seed 004).
+    /// Stereo frusta, anaglyphs, remapping, parallax (the exercise slides).
     Ex1,
-    /// ChromaDepth (seed 000).
+    /// ChromaDepth (the ChromaDepth article).
     Ex2,
-    /// SIRDS (seed 002).
+    /// SIRDS (the SIRDS paper (Petz et al.)).
     Ex3,
 }
 

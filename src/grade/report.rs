@@ -7,7 +7,7 @@ use serde_json::{Value, json};
 use super::Exercise;
 use super::score::TaskResult;
 
-/// The course's rule (seed 004, "Passing Criteria"): at least this share of all points…
+/// The course's rule (the exercise slides, "Passing Criteria"): at least this share of all points…
 pub const PASS_FRACTION: f64 = 0.5;
 /// …and at least this many points in each exercise.
 pub const MIN_POINTS_PER_EXERCISE: f64 = 2.0;
@@ -51,7 +51,7 @@ pub struct Report {
 }
 
 impl Report {
-    /// Points earned, bonus included (bonus points count towards the 50%, seed 004).
+    /// Points earned, bonus included (bonus points count towards the 50%, the exercise slides).
     pub fn score(&self) -> f64 {
         round2(self.exercises.iter().map(ExerciseResult::score).sum())
     }

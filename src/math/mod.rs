@@ -12,7 +12,7 @@ pub use rig::{
 
 use glam::{Mat4, Vec3, Vec4};
 
-/// `P_frustum(l, r, b, t, n, f)` exactly as seed 004 writes it (OpenGL's `glFrustum`).
+/// `P_frustum(l, r, b, t, n, f)` exactly as the exercise slides write it (OpenGL's `glFrustum`).
 ///
 /// ```text
 /// | 2n/(r-l)    0      (r+l)/(r-l)      0        |

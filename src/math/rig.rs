@@ -1,4 +1,4 @@
-//! The stereo rig: two eyes from one camera (seeds 001, 003, 004).
+//! The stereo rig: two eyes from one camera (the SGI course notes, the StereoGraphics guide (Akka) and the exercise slides).
 
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
@@ -105,17 +105,17 @@ impl Camera {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum CameraMode {
-    /// Parallel axes + asymmetric frustum (seed 003 §5–6, seed 004). The correct one; default.
+    /// Parallel axes + asymmetric frustum (the StereoGraphics guide's §5–6, the exercise slides). The correct one; default.
     #[default]
     OffAxis,
-    /// Each eye rotated by atan((iod/2)/fusion) towards the fusion point (seed 001). Produces
-    /// vertical parallax off-center (seed 003 warns against it); kept for teaching.
+    /// Each eye rotated by atan((iod/2)/fusion) towards the fusion point (the SGI course notes). Produces
+    /// vertical parallax off-center (the StereoGraphics guide (Akka) warns against it); kept for teaching.
     ToeIn,
     /// Parallel axes, symmetric frusta: zero parallax at infinity, everything in front of the screen.
     Parallel,
 }
 
-/// Which modelview the shading sees (seed 004 "Effect on lighting").
+/// Which modelview the shading sees (the exercise slides' "Effect on lighting").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum Lighting {
@@ -126,12 +126,12 @@ pub enum Lighting {
     Cyclopic,
 }
 
-/// Eye separation: an absolute distance or seed 003's automatic rule.
+/// Eye separation: an absolute distance or the StereoGraphics guide's automatic rule.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Separation {
     /// Distance between the two eyes in world units (≥ 0).
     Absolute(f32),
-    /// Seed 003 §7: each camera is offset by `Xrange · 0.035 · user_offset`, where `Xrange` is the
+    /// The StereoGraphics guide's §7: each camera is offset by `Xrange · 0.035 · user_offset`, where `Xrange` is the
     /// frustum's width at the zero-parallax plane; the separation is twice that offset.
     Auto,
 }
@@ -141,11 +141,11 @@ pub enum Separation {
 pub enum ZeroParallax {
     /// An eye-space distance, strictly between near and far.
     Distance(f32),
-    /// Seed 001: a dimensionless position between the clip planes, `near + t (far − near)`, t in (0, 1).
+    /// The SGI course notes: a dimensionless position between the clip planes, `near + t (far − near)`, t in (0, 1).
     Fraction(f32),
 }
 
-/// The stereo rig: separation, fusion distance, camera mode, and seed 003's user factors.
+/// The stereo rig: separation, fusion distance, camera mode, and the StereoGraphics guide's user factors.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StereoRig {
     /// Off-axis, toe-in or parallel.
@@ -154,9 +154,9 @@ pub struct StereoRig {
     pub separation: Separation,
     /// Zero-parallax distance.
     pub zero_parallax: ZeroParallax,
-    /// Seed 003's `UserOffsetAdjustment`: multiplies the separation (and so the asymmetry), 0..2.
+    /// The StereoGraphics guide's `UserOffsetAdjustment`: multiplies the separation (and so the asymmetry), 0..2.
     pub user_offset: f32,
-    /// Seed 003's `UserBalanceAdjustment`: multiplies the frustum asymmetry only, 0..2.
+    /// The StereoGraphics guide's `UserBalanceAdjustment`: multiplies the frustum asymmetry only, 0..2.
     pub user_balance: f32,
     /// Per-eye or cyclopic modelview for shading.
     pub lighting: Lighting,
@@ -197,7 +197,7 @@ pub struct ResolvedRig {
     pub eye_separation: f32,
     /// Zero-parallax distance z0 (eye-space, positive).
     pub zero_parallax_distance: f32,
-    /// Width of the view at the zero-parallax plane (seed 003's `Xrange`).
+    /// Width of the view at the zero-parallax plane (the StereoGraphics guide's `Xrange`).
     pub xrange: f32,
 }
 
@@ -240,7 +240,7 @@ impl StereoRig {
                 return Err(Error::invalid(
                     name,
                     v,
-                    "must lie in 0..2 (seed 003: 1.0 default, 2.0 upper limit)",
+                    "must lie in 0..2 (the StereoGraphics guide (Akka): 1.0 default, 2.0 upper limit)",
                 ));
             }
         }
@@ -288,13 +288,13 @@ impl StereoRig {
         let t = Mat4::from_translation(Vec3::new(-side * half, 0.0, 0.0));
         let (eye_view, fr) = match self.mode {
             CameraMode::OffAxis => {
-                // Seed 003: FrustumAsymmetry = −offset · balance · n/z0, positive for the left eye.
+                // The StereoGraphics guide (Akka): FrustumAsymmetry = −offset · balance · n/z0, positive for the left eye.
                 let shift = -side * half * self.user_balance * n / r.zero_parallax_distance;
                 (t * mv, [-w + shift, w + shift, -h, h, n, f])
             }
             CameraMode::Parallel => (t * mv, [-w, w, -h, h, n, f]),
             CameraMode::ToeIn => {
-                // Seed 001, per-eye look-at: both eyes aim at the fusion point on the center line.
+                // The SGI course notes, per-eye look-at: both eyes aim at the fusion point on the center line.
                 let inv = mv.inverse();
                 let eye = inv.transform_point3(Vec3::new(side * half, 0.0, 0.0));
                 let fusion = inv.transform_point3(Vec3::new(0.0, 0.0, -r.zero_parallax_distance));

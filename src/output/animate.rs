@@ -1,4 +1,4 @@
-//! A rotating model as an animated SIRDS GIF (seed 002 §5: animated SIRDS stay fusable, and a
+//! A rotating model as an animated SIRDS GIF (the SIRDS paper's §5: animated SIRDS stay fusable, and a
 //! pattern that changes every frame keeps the eyes on the object rather than the dots).
 
 use std::io::BufWriter;

@@ -141,7 +141,7 @@ impl Shader for RecordS<'_> {
     }
 }
 
-/// D1/D2 for the pass: the scene's values where given, seed 000's bounding sphere for the rest
+/// D1/D2 for the pass: the scene's values where given, the ChromaDepth article's bounding sphere for the rest
 /// (see [`auto_range`]), checked by [`Texgen::from_range`].
 ///
 /// # Errors

@@ -25,7 +25,7 @@ pub(crate) struct SceneFile {
     /// Rasterizer options.
     #[serde(default)]
     pub raster: RasterSpec,
-    /// ChromaDepth options (seed 000).
+    /// ChromaDepth options (the ChromaDepth article).
     #[serde(default)]
     pub chromadepth: ChromaDepthSettings,
     /// Finalize-pass options (anaglyphs).
@@ -49,7 +49,7 @@ pub(crate) struct ImageSpec {
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// Clear color, 0..1. Default mid-gray (seed 003: a gray background reduces ghosting).
+    /// Clear color, 0..1. Default mid-gray (the StereoGraphics guide (Akka): a gray background reduces ghosting).
     #[serde(default = "default_background")]
     pub background: [f32; 3],
 }
@@ -84,10 +84,10 @@ pub(crate) struct StereoSpec {
     /// Zero-parallax position between near (0) and far (1); default 0.5 if neither is given.
     #[serde(default)]
     pub zero_parallax_fraction: Option<f32>,
-    /// Seed 003 `UserOffsetAdjustment`.
+    /// The StereoGraphics guide's `UserOffsetAdjustment`.
     #[serde(default = "one")]
     pub user_offset: f32,
-    /// Seed 003 `UserBalanceAdjustment`.
+    /// The StereoGraphics guide's `UserBalanceAdjustment`.
     #[serde(default = "one")]
     pub user_balance: f32,
     /// `per-eye` (default) or `cyclopic`.
@@ -155,7 +155,7 @@ impl Default for LightSpec {
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct LayoutSpec {
-    /// Black rows between the two views of `above_below_squashed` (seed 003: 20–50 typical).
+    /// Black rows between the two views of `above_below_squashed` (the StereoGraphics guide (Akka): 20–50 typical).
     #[serde(default)]
     pub blank_interval: u32,
 }

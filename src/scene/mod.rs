@@ -60,7 +60,7 @@ pub struct Scene {
     pub blank_interval: u32,
     /// Rasterizer options.
     pub raster: RasterOptions,
-    /// ChromaDepth options (seed 000).
+    /// ChromaDepth options (the ChromaDepth article).
     pub chromadepth: ChromaDepthSettings,
     /// Finalize-pass options from `[finalize]` (anaglyph linear light, swapped eyes).
     pub finalize: AnaglyphOptions,

@@ -1,4 +1,4 @@
-//! Terrain from scattered `(x, y, height)` points (seed 000's fault valley and map images):
+//! Terrain from scattered `(x, y, height)` points (the ChromaDepth article's fault valley and map images):
 //! read from CSV, triangulated by Delaunay (spade) over the map plane, heights lifted onto the
 //! world's up axis.
 

@@ -1,4 +1,4 @@
-//! The terrain data sets shipped under `assets/terrain/`, in the spirit of seed 000's gallery:
+//! The terrain data sets shipped under `assets/terrain/`, in the spirit of the ChromaDepth article's gallery:
 //! an earthquake fault valley and a map-like island. Generated deterministically from fixed
 //! seeds with integer hashing and `+ − × ÷` only (no `sin`/`exp`, whose last bits vary between
 //! math libraries), so the same CSV bytes come out on every machine.
@@ -96,7 +96,7 @@ pub fn fault_valley_points() -> Vec<[f64; 3]> {
     })
 }
 
-/// A map-like volcanic island on `[−50, 50]²`, after seed 000's Oahu map: two ridges (like the
+/// A map-like volcanic island on `[−50, 50]²`, after the ChromaDepth article's Oahu map: two ridges (like the
 /// Waianae and Ko'olau ranges) on a low dome, roughened by fractal noise; everything below sea
 /// level is flat sea at height 0. 6004 points.
 pub fn island_points() -> Vec<[f64; 3]> {

@@ -22,7 +22,7 @@ const Z: [f32; 3] = [0.0; 3];
 /// The numbers exactly as each source writes them (see the doc of `AnaglyphKind::matrices`).
 fn source(kind: Kind) -> (ColorMatrix, ColorMatrix) {
     match kind {
-        // Seed 004's slides.
+        // The exercise slides.
         Kind::True => ([LUMA, Z, Z], [Z, Z, LUMA]),
         Kind::Gray => ([LUMA, Z, Z], [Z, LUMA, LUMA]),
         Kind::Color => (
@@ -139,7 +139,7 @@ fn white_preserved_where_the_source_claims_it() {
                 assert!(out[c] >= 254, "{kind:?}: white became {out:?}");
             }
         } else {
-            // Seed 004's true anaglyph: white becomes magenta (documented exception).
+            // The exercise slides' true anaglyph: white becomes magenta (documented exception).
             assert_eq!(out, [255, 0, 255, 255], "{kind:?}");
         }
     }

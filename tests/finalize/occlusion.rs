@@ -138,7 +138,7 @@ fn check_scene(rig: &Rig, occ: Option<Occluder>, precision: Precision) -> Vec<us
                         rig.far / rig.near
                     ),
                     None => {
-                        // Occluder pixel: visible, or (seed 004: never "farther" off a
+                        // Occluder pixel: visible, or (the exercise slides: never "farther" off a
                         // silhouette) a nearest-sampling artifact next to the wall.
                         let next_to_wall = [px.wrapping_sub(1), px + 1]
                             .iter()

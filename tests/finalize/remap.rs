@@ -1,4 +1,4 @@
-//! Remapping (seed 004): identity at the zero-parallax plane, a shift of exactly p(z) behind it.
+//! Remapping (the exercise slides): identity at the zero-parallax plane, a shift of exactly p(z) behind it.
 
 use stereolab::effects::remap::{Precision, remap_color, remap_coordinates};
 use stereolab::plan::Output;
@@ -117,7 +117,7 @@ fn seed_004_f32_unprojection_drifts_past_half_a_pixel_at_near_far_1e5() {
         let slides = unprojection_error_px(near_over_far, Precision::F32);
         let composed = unprojection_error_px(near_over_far, Precision::F32Composed);
         println!(
-            "real model, near/far {near_over_far:e}: f32 as seed 004 {slides:.2e} px, f32 composed {composed:.2e} px (vs f64, 1024 px wide)"
+            "real model, near/far {near_over_far:e}: f32 as the exercise slides {slides:.2e} px, f32 composed {composed:.2e} px (vs f64, 1024 px wide)"
         );
         if near_over_far >= 0.05 {
             assert!(slides < 1e-2 && composed < 1e-2, "{slides} {composed}");
@@ -125,7 +125,7 @@ fn seed_004_f32_unprojection_drifts_past_half_a_pixel_at_near_far_1e5() {
         if near_over_far <= 1e-5 {
             // The limitation `Precision::F32` documents: f32 iMVP through world space picks
             // the wrong texel; one composed matrix stays well inside half a pixel.
-            assert!(slides > 0.5, "seed 004 f32: {slides} px");
+            assert!(slides > 0.5, "the exercise slides f32: {slides} px");
             assert!(composed < 0.25, "composed f32: {composed} px");
         }
     }

@@ -1,4 +1,4 @@
-//! Exercise 1: Stereoscopy (seed 004, "Exercise 1 — Stereoscopy").
+//! Exercise 1: Stereoscopy (the exercise slides, "Exercise 1 — Stereoscopy").
 //!
 //! Complete the functions in `src/stubs.rs`, then run `stereolab grade ex1` (points, hints)
 //! and `stereolab render --exercise ex1 SCENE` (your images next to the reference).

@@ -12,7 +12,7 @@ fn planted(mistake: &str) -> bool {
     std::env::var("STEREOLAB_MUTANT").is_ok_and(|v| v.split(',').any(|m| m == mistake))
 }
 
-/// `P_frustum(l, r, b, t, n, f)` (seed 004).
+/// `P_frustum(l, r, b, t, n, f)` (the exercise slides).
 pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
     Mat4::from_cols(
         Vec4::new(2.0 * n / (r - l), 0.0, 0.0, 0.0),
@@ -46,7 +46,7 @@ fn half_separation(s: &StereoSetup) -> f32 {
     }
 }
 
-/// `[l, r, b, t, n, f]` of `P_frustum±` (seed 004).
+/// `[l, r, b, t, n, f]` of `P_frustum±` (the exercise slides).
 pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
     let t = setup.near * (setup.fov_y_degrees.to_radians() * 0.5).tan();
     let w = t * setup.aspect;
@@ -58,7 +58,7 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
     [-w + shift, w + shift, -t, t, setup.near, setup.far]
 }
 
-/// View and projection of one eye (seed 004, per-eye or cyclopic lighting).
+/// View and projection of one eye (the exercise slides, per-eye or cyclopic lighting).
 pub fn stereo_matrices(
     setup: &StereoSetup,
     modelview: Mat4,
@@ -69,7 +69,7 @@ pub fn stereo_matrices(
     let p = frustum(l, r, b, t, n, f);
     let half = half_separation(setup);
     let eye_view = if planted("toe-in") {
-        // Seed 001's rotated eyes: each looks at the fusion point on the center line.
+        // The SGI course notes' rotated eyes: each looks at the fusion point on the center line.
         let inv = modelview.inverse();
         let at = inv.transform_point3(Vec3::new(side(eye) * half, 0.0, 0.0));
         let fusion = inv.transform_point3(Vec3::new(0.0, 0.0, -setup.zero_parallax));
@@ -96,7 +96,7 @@ fn transposed(m: ColorMatrix) -> ColorMatrix {
     std::array::from_fn(|i| std::array::from_fn(|j| m[j][i]))
 }
 
-/// ML, MR of seed 004's four anaglyphs.
+/// ML, MR of the exercise slides' four anaglyphs.
 pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
     let left = match kind {
         AnaglyphKind::Color => [[1.0, 0.0, 0.0], ZERO, ZERO],
@@ -133,7 +133,7 @@ pub fn dubois_matrices() -> AnaglyphMatrices {
     }
 }
 
-/// Seed 004's remapping through `MVP_r · MVP_l⁻¹`.
+/// The exercise slides' remapping through `MVP_r · MVP_l⁻¹`.
 pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) -> Option<Vec3> {
     let z_ndc = if planted("opengl-depth") {
         depth_left
@@ -154,7 +154,7 @@ pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) ->
     Some(Vec3::new(0.5 * (ndc.x + 1.0), 0.5 * (ndc.y + 1.0), depth))
 }
 
-/// Seed 004's visibility check.
+/// The exercise slides' visibility check.
 pub fn visible(
     uv_right: Option<Vec2>,
     remapped_depth: f32,
@@ -166,7 +166,7 @@ pub fn visible(
     inside && (stored_depth - remapped_depth).abs() <= tolerance
 }
 
-/// `p(z) = d (1 − z0/z)` (seed 004).
+/// `p(z) = d (1 − z0/z)` (the exercise slides).
 pub fn parallax(z: f32, zero_parallax: f32, eye_separation: f32) -> f32 {
     if planted("hang-parallax") {
         #[allow(clippy::empty_loop)]

@@ -7,7 +7,7 @@ use stereolab::math::Lighting;
 
 /// Task `frustum` (2 points): the projection matrix `P_frustum(l, r, b, t, n, f)`.
 ///
-/// Source: seed 004, "Projection Matrix – View Frustum" (OpenGL's `glFrustum`):
+/// Source: the exercise slides, "Projection Matrix – View Frustum" (OpenGL's `glFrustum`):
 /// ```text
 /// | 2n/(r-l)    0      (r+l)/(r-l)      0        |
 /// |    0     2n/(t-b)  (t+b)/(t-b)      0        |
@@ -25,12 +25,12 @@ pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
 /// Task `stereo_frustum` (2 points): the arguments `[l, r, b, t, n, f]` of eye `eye`'s
 /// `P_frustum±` in the off-axis (parallel-axis, asymmetric frustum) stereo rig.
 ///
-/// Source: seed 004, "Projection Matrix Stereo Case": the mono frustum has
+/// Source: the exercise slides, "Projection Matrix Stereo Case": the mono frustum has
 /// `t = n · tan(fov_y / 2)`, `b = −t`, `r = t · aspect`, `l = −r`; each eye's frustum is
 /// translated by ∓d/2 and sheared by ±d/(2 z0), so on the near plane `l` and `r` move by
 /// `± (d/2) · n / z0` (intercept theorem): the left eye (index 0, at x = −d/2) moves them by
 /// `+(d/2)·n/z0`, the right eye (index 1, at x = +d/2) by `−(d/2)·n/z0`. `t, b, n, f` do not
-/// change. Toe-in (rotating the eyes) is wrong: it gives vertical parallax (seed 003).
+/// change. Toe-in (rotating the eyes) is wrong: it gives vertical parallax (the StereoGraphics guide (Akka)).
 pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
     // TODO: the mono frustum, then shift l and r for this eye.
     todo!("frustum bounds of eye {eye:?} for {setup:?}")
@@ -39,7 +39,7 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
 /// Task `stereo_matrices` (2 points, image check): eye `eye`'s view and projection, given the
 /// camera's (cyclopean) modelview `modelview`.
 ///
-/// Source: seed 004, "Transformation Matrices – Effect on lighting". `T±` moves the world so
+/// Source: the exercise slides, "Transformation Matrices – Effect on lighting". `T±` moves the world so
 /// that the eye at x = ∓d/2 (eye space) becomes the origin: `T_left = translate(+d/2, 0, 0)`,
 /// `T_right = translate(−d/2, 0, 0)`. With `P±` = [`frustum`] of [`stereo_frustum`]:
 /// - per-eye lighting: `view = T± · MV`, `projection = P±`;
@@ -59,7 +59,7 @@ pub fn stereo_matrices(
 /// Task `anaglyph_matrices` (2 points, image check): the matrices `ML`, `MR` of
 /// `out = clamp(ML · left + MR · right)` for `kind`.
 ///
-/// Source: seed 004, "Anaglyph" (after 3dtv.at): true, gray, color and half-color anaglyphs for
+/// Source: the exercise slides, "Anaglyph" (after 3dtv.at): true, gray, color and half-color anaglyphs for
 /// red (left eye, index 0) / cyan (right eye) glasses. Luminance weights `0.299, 0.587, 0.114`.
 /// `ColorMatrix` is written as on the slides: `m[row][column]`, rows are output R, G, B.
 pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
@@ -80,7 +80,7 @@ pub fn dubois_matrices() -> AnaglyphMatrices {
 /// Task `remap` (2 points, image check): where the surface point seen by the left eye at
 /// texture coordinate `uv_left` with stored depth `depth_left` appears in the right image.
 ///
-/// Source: seed 004, "Stereo Rendering – Remapping":
+/// Source: the exercise slides, "Stereo Rendering – Remapping":
 /// `clip_r = MVP_r · MVP_l⁻¹ · (x_ndc,l, y_ndc,l, z_ndc,l, 1)`, `ndc_r = clip_r.xyz / clip_r.w`,
 /// `τ = ((x_ndc,r + 1)/2, (y_ndc,r + 1)/2)`.
 /// Conventions: `uv_left` and the returned `u, v` are texture coordinates in [0, 1]
@@ -96,7 +96,7 @@ pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) ->
 /// Task `visible` (1 point, image check): is the left eye's surface point also visible to the
 /// right eye?
 ///
-/// Source: seed 004, "Visibility Check": look up the right eye's depth texture at the remapped
+/// Source: the exercise slides, "Visibility Check": look up the right eye's depth texture at the remapped
 /// coordinate (`stored_depth`) and compare with the point's own remapped depth
 /// (`remapped_depth`, from [`remap`]): visible when they agree within `tolerance`
 /// (`|stored − remapped| ≤ tolerance`). Otherwise only `stored < remapped` is possible: the
@@ -116,7 +116,7 @@ pub fn visible(
 
 /// Task `parallax` (1 point): the screen parallax of a point at eye distance `z`.
 ///
-/// Source: seed 004, "Parallax and Eye Separation": `p(z) = d · (1 − z0 / z)` with `z` and
+/// Source: the exercise slides, "Parallax and Eye Separation": `p(z) = d · (1 − z0 / z)` with `z` and
 /// `z0` positive distances in front of the eyes and `d` the eye separation. Negative in front
 /// of the screen (`z < z0`), zero on it, positive behind it, approaching `d` at infinity.
 pub fn parallax(z: f32, zero_parallax: f32, eye_separation: f32) -> f32 {
@@ -124,7 +124,7 @@ pub fn parallax(z: f32, zero_parallax: f32, eye_separation: f32) -> f32 {
     todo!("p(z = {z:?}) with z0 = {zero_parallax:?}, d = {eye_separation:?}")
 }
 
-/// Task `parallax_color` (1 point, image check): parallax shown as color (seed 004: "blue
+/// Task `parallax_color` (1 point, image check): parallax shown as color (the exercise slides: "blue
 /// negative, red positive").
 ///
 /// The mapping: `t = clamp(p / max_abs, −1, 1)`; positive `t` gives `[t, 0, 0]` (red), negative

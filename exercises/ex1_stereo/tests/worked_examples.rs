@@ -5,7 +5,7 @@ use glam::{Mat4, Vec3, Vec4Swizzles};
 use stereolab::exercise::{AnaglyphKind, StereoSetup};
 use stereolab::math::{Lighting, look_at};
 
-/// Seed 003 §5: camera at (0, 0, 9), 90° fov, separation 1, screen at the xy plane.
+/// The StereoGraphics guide's §5: camera at (0, 0, 9), 90° fov, separation 1, screen at the xy plane.
 fn seed003() -> (StereoSetup, Mat4) {
     let setup = StereoSetup {
         fov_y_degrees: 90.0,

@@ -1,4 +1,4 @@
-//! Exercise 2: ChromaDepth (seed 000, "Using ChromaDepth to obtain Inexpensive Single-image Stereovision").
+//! Exercise 2: ChromaDepth (the ChromaDepth article, "Using ChromaDepth to obtain Inexpensive Single-image Stereovision").
 //!
 //! Complete the functions in `src/stubs.rs`, then run `stereolab grade ex2` (points, hints)
 //! and `stereolab render --exercise ex2 SCENE` (your images next to the reference).

@@ -24,7 +24,7 @@ pub fn hsv_ramp(t: f32) -> [f32; 3] {
     }
 }
 
-/// Seed 000's texgen coefficients.
+/// The ChromaDepth article's texgen coefficients.
 pub fn texgen(d1: f32, d2: f32) -> [f32; 4] {
     let c = -1.0 / (d2 - d1);
     let c = if planted("texgen-sign") { -c } else { c };

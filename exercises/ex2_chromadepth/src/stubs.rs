@@ -5,7 +5,7 @@ use glam::Vec3;
 
 /// Task `hsv_ramp` (2 points, image check): the ChromaDepth color at ramp position `t`.
 ///
-/// Source: seed 000, "Creating ChromaDepth Scenes": a 1D texture running red (near, `t = 0`)
+/// Source: the ChromaDepth article, "Creating ChromaDepth Scenes": a 1D texture running red (near, `t = 0`)
 /// through green to blue (far, `t = 1`), interpolated in HSV: hue `240° · t`, saturation 1,
 /// value 1, converted to RGB in [0, 1]. `t` outside [0, 1] is clamped first (`GL_CLAMP`).
 pub fn hsv_ramp(t: f32) -> [f32; 3] {
@@ -17,7 +17,7 @@ pub fn hsv_ramp(t: f32) -> [f32; 3] {
 /// `s = A x + B y + C z + D` so that `s = 0` at distance `d1` in front of the eye and `s = 1` at
 /// `d2`.
 ///
-/// Source: seed 000: `A = 0`, `B = 0`, `C = −1/(D2 − D1)`, `D = −D1/(D2 − D1)`. Eye space looks
+/// Source: the ChromaDepth article: `A = 0`, `B = 0`, `C = −1/(D2 − D1)`, `D = −D1/(D2 − D1)`. Eye space looks
 /// down −Z: a point `d` in front of the eye has `z = −d`.
 pub fn texgen(d1: f32, d2: f32) -> [f32; 4] {
     // TODO: four coefficients.
@@ -26,7 +26,7 @@ pub fn texgen(d1: f32, d2: f32) -> [f32; 4] {
 
 /// Task `depth_range` (1 point): `[D1, D2]` from a bounding sphere of the scene.
 ///
-/// Source: seed 000: "fit a spherical bounding volume around the center of the scene, and set
+/// Source: the ChromaDepth article: "fit a spherical bounding volume around the center of the scene, and set
 /// D1 and D2 to the limits of the sphere". `center` is in eye space (looking down −Z, so its
 /// distance in front of the eye is `−center.z`); D1 is the sphere's nearest, D2 its farthest
 /// distance along the view direction.

@@ -1,4 +1,4 @@
-//! Exercise 3: Single-image random-dot stereograms (seed 002, Petz, Goldlücke, Magnor).
+//! Exercise 3: Single-image random-dot stereograms (the SIRDS paper, Petz, Goldlücke, Magnor).
 //!
 //! Complete the functions in `src/stubs.rs`, then run `stereolab grade ex3` (points, hints)
 //! and `stereolab render --exercise ex3 SCENE` (your images next to the reference).

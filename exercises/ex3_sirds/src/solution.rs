@@ -9,17 +9,17 @@ fn planted(mistake: &str) -> bool {
     std::env::var("STEREOLAB_MUTANT").is_ok_and(|v| v.split(',').any(|m| m == mistake))
 }
 
-/// Eq. (1) of seed 002.
+/// Eq. (1) of the SIRDS paper (Petz et al.).
 pub fn disparity_constant_direction(z: f32, phi: f32) -> f32 {
     2.0 * z / phi.tan()
 }
 
-/// Eq. (3) of seed 002.
+/// Eq. (3) of the SIRDS paper (Petz et al.).
 pub fn disparity_constant_eyes(z: f32, geometry: &SirdsGeometry) -> f32 {
     geometry.eye_distance * z / (z + geometry.focal_length)
 }
 
-/// Thimbleby, Inglis and Witten's linking with seed 002's geometry.
+/// Thimbleby, Inglis and Witten's linking with the SIRDS paper's geometry.
 pub fn link_row(nearness: &[f32], row: u32, setup: &SirdsSetup) -> Vec<usize> {
     let n = nearness.len();
     let span = setup.depth_far - setup.depth_near;

@@ -7,7 +7,7 @@ use stereolab::exercise::{SirdsGeometry, SirdsSetup};
 /// point at depth `z` behind the image plane, assuming every eye ray meets the image plane at
 /// the angle `phi` (radians).
 ///
-/// Source: seed 002, §2.1, Eq. (1): `d = 2 z / tan(φ)`.
+/// Source: the SIRDS paper (Petz et al.), §2.1, Eq. (1): `d = 2 z / tan(φ)`.
 pub fn disparity_constant_direction(z: f32, phi: f32) -> f32 {
     // TODO: Eq. (1).
     todo!("d for z = {z:?}, phi = {phi:?} rad")
@@ -16,14 +16,14 @@ pub fn disparity_constant_direction(z: f32, phi: f32) -> f32 {
 /// Task `disparity_constant_eyes` (1 point): the same distance for eyes `a` apart at distance
 /// `f` in front of the image plane (all in pixels), the point centered in front of the eyes.
 ///
-/// Source: seed 002, §2.2, Eq. (3): `d = a z / (z + f)`.
+/// Source: the SIRDS paper (Petz et al.), §2.2, Eq. (3): `d = a z / (z + f)`.
 pub fn disparity_constant_eyes(z: f32, geometry: &SirdsGeometry) -> f32 {
     // TODO: Eq. (3).
     todo!("d for z = {z:?} with {geometry:?}")
 }
 
 /// Task `link_row` (3 points, image check): the per-scan-line constraints of a SIRDS with
-/// hidden-surface removal (seed 002 §2–3, after its reference 5: Thimbleby, Inglis and Witten,
+/// hidden-surface removal (the SIRDS paper's §2–3, after its reference 5: Thimbleby, Inglis and Witten,
 /// "Displaying 3D images", IEEE Computer 27(10), 1994).
 ///
 /// `nearness[x]` in [0, 1] is the surface seen through pixel `x` of image row `row`: 1 is the
@@ -35,7 +35,7 @@ pub fn disparity_constant_eyes(z: f32, geometry: &SirdsGeometry) -> f32 {
 ///    division: for odd `s` the extra pixel alternates between rows), `right = left + s`;
 ///    skip `x` unless `0 ≤ left` and `right < nearness.len()`.
 /// 2. Hidden-surface removal: the rays from the point to the eyes rise by
-///    `rise = (2 (t + f) / a) / (depth_far − depth_near)` nearness per pixel (seed 002 Eq. (2));
+///    `rise = (2 (t + f) / a) / (depth_far − depth_near)` nearness per pixel (the SIRDS paper's Eq. (2));
 ///    for `k = 1, 2, …`: `zk = z + k · rise`; the point is hidden (skip `x`) when
 ///    `nearness[x − k] ≥ zk` or `nearness[x + k] ≥ zk` (indices inside the row); it is visible
 ///    once `zk ≥ 1` (checked after the test).

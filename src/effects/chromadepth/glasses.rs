@@ -1,7 +1,7 @@
 //! What each eye sees through ChromaDepth glasses, so a viewer without them can be shown the
 //! effect as an ordinary stereo pair.
 //!
-//! The model (seed 000): each lens is a thin diffraction grating with its lines vertical, so it
+//! The model (the ChromaDepth article): each lens is a thin diffraction grating with its lines vertical, so it
 //! bends light sideways, towards the nose. A grating deflects wavelength λ by `sin θ = λ / p`
 //! (first order, line period p); for the small angles of the glasses `θ ≈ λ / p`, so the
 //! apparent shift on the screen grows linearly with λ: red (long) is bent most, blue (short)
@@ -20,7 +20,7 @@
 //! so pure red moves `max_shift`, green about 0.56 of it, blue and black not at all, and the
 //! shift falls monotonically along both ramps (HSV and red–white–blue) from near to far. The left
 //! eye's view moves right and the right eye's left (inward), so red gets the most negative
-//! (crossed) parallax `x_R − x_L = −2 shift`: red appears nearest, as seed 000 says.
+//! (crossed) parallax `x_R − x_L = −2 shift`: red appears nearest, as the ChromaDepth article says.
 
 use crate::framebuffer::Framebuffer;
 

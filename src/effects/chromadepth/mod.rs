@@ -1,4 +1,4 @@
-//! ChromaDepth (seed 000): depth coded as a red → green → blue ramp in one center-eye pass, and
+//! ChromaDepth (the ChromaDepth article): depth coded as a red → green → blue ramp in one center-eye pass, and
 //! the glasses simulation that turns it into a stereo pair for viewers without the glasses.
 //!
 //! - [`ramp`]: the 1D texture (HSV red–green–blue or red–white–blue), clamped at both ends.
@@ -55,7 +55,7 @@ pub struct ChromaDepthSettings {
     /// Modulate the ramp by diffuse lighting, keeping its hue.
     pub lit: bool,
     /// How far the glasses move the reddest pixel inward in each eye, as a fraction of the image
-    /// width (default 0.01: red–blue parallax 2% of the width, inside seed 003's ~3% budget).
+    /// width (default 0.01: red–blue parallax 2% of the width, inside the StereoGraphics guide's ~3% budget).
     pub glasses_shift: f32,
     /// The anaglyph that shows the simulated glasses pair, by kind name (`gray` default: every
     /// ChromaDepth hue reaches both eyes, where a color anaglyph shows pure red to the left eye

@@ -1,4 +1,4 @@
-//! The ChromaDepth color ramp: a 1D texture from red through green to blue (seed 000), or the
+//! The ChromaDepth color ramp: a 1D texture from red through green to blue (the ChromaDepth article), or the
 //! red–white–blue alternative, sampled like an OpenGL 1D texture with `GL_CLAMP_TO_EDGE`.
 
 use glam::Vec3;
@@ -6,7 +6,7 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result};
 
-/// Texels in the ramp unless the scene says otherwise (seed 000 builds a 1D texture; 256 is
+/// Texels in the ramp unless the scene says otherwise (the ChromaDepth article builds a 1D texture; 256 is
 /// one texel per 8-bit step).
 pub const DEFAULT_TEXELS: usize = 256;
 
@@ -17,7 +17,7 @@ pub const FAR_HUE_DEGREES: f32 = 240.0;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum RampKind {
-    /// Seed 000: hue 0° → 240° at full saturation and value, interpolated in HSV
+    /// The ChromaDepth article: hue 0° → 240° at full saturation and value, interpolated in HSV
     /// (red, yellow, green, cyan, blue).
     #[default]
     Hsv,

@@ -1,15 +1,15 @@
-//! Eye-linear texture-coordinate generation (seed 000): `s = A x + B y + C z + D` on eye-space
+//! Eye-linear texture-coordinate generation (the ChromaDepth article): `s = A x + B y + C z + D` on eye-space
 //! positions, and the choice of D1/D2.
 
 use glam::{Mat4, Vec3, Vec4};
 
 use crate::error::{Error, Result};
 
-/// The texgen plane `(A, B, C, D)` of seed 000, fixed in eye space.
+/// The texgen plane `(A, B, C, D)` of the ChromaDepth article, fixed in eye space.
 ///
 /// With `A = B = 0`, `C = −1/(D2 − D1)`, `D = −D1/(D2 − D1)`, a point `D1` units in front of
 /// the eye (eye z = −D1, the camera looks down −Z) gets `s = 0` (red) and a point at `D2` gets
-/// `s = 1` (blue). The plane is specified under an identity modelview, as seed 000 insists:
+/// `s = 1` (blue). The plane is specified under an identity modelview, as the ChromaDepth article insists:
 /// object transforms applied afterwards move objects through the ramp, never the ramp with them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Texgen {
@@ -75,9 +75,9 @@ impl Texgen {
 }
 
 /// What OpenGL stores for `glTexGenfv(GL_S, GL_EYE_PLANE, p)` issued while the modelview is `m`:
-/// `p' = p · m⁻¹` (OpenGL 1.x spec §2.10.4). With `m` the identity, as seed 000 demands, the
+/// `p' = p · m⁻¹` (OpenGL 1.x spec §2.10.4). With `m` the identity, as the ChromaDepth article demands, the
 /// plane stays fixed in eye space; under any other `m` it is carried along with `m`, the mistake
-/// seed 000 warns about.
+/// the ChromaDepth article warns about.
 pub fn eye_plane_specified_under(plane: Vec4, modelview: Mat4) -> Vec4 {
     modelview.inverse().transpose() * plane
 }
@@ -100,10 +100,10 @@ pub fn bounding_sphere(points: &[Vec3]) -> Option<(Vec3, f32)> {
     Some((center, radius))
 }
 
-/// Seed 000's automatic D1/D2: "fit a spherical bounding volume around the center of the scene,
+/// The ChromaDepth article's automatic D1/D2: "fit a spherical bounding volume around the center of the scene,
 /// and set D1 and D2 to the limits of the sphere": `D1 = c − r`, `D2 = c + r` with `c` the
 /// sphere center's distance in front of the eye (`−z` in eye space, `view` maps world → eye).
-/// Each is then kept between the clip planes (seed 000: "somewhere between the near and far
+/// Each is then kept between the clip planes (the ChromaDepth article: "somewhere between the near and far
 /// clipping planes") so the visible scene spans the whole ramp.
 ///
 /// # Errors

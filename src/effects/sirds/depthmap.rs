@@ -191,7 +191,7 @@ impl DepthMap {
     }
 
     /// The range a depth buffer spans: `front` at the nearest covered pixel, the background
-    /// plane 10% of the covered span behind the farthest one (seed 002 §3: "a certain distance
+    /// plane 10% of the covered span behind the farthest one (the SIRDS paper's §3: "a certain distance
     /// behind the geometry"), kept inside the far clip plane. `None` when nothing is covered.
     pub fn auto_range(fb: &Framebuffer, near: f32, far: f32) -> Option<DepthRange> {
         // The rasterizer's bands in parallel (min and max do not care about the order): split

@@ -1,8 +1,8 @@
-//! How far apart two linked pixels are: seed 002 §2's two models, and the one place where
+//! How far apart two linked pixels are: the SIRDS paper's §2's two models, and the one place where
 //! physical parameters (inches, DPI) become pixels.
 //!
 //! Depth conventions used by every SIRDS function:
-//! - `t` is the depth of a scene point behind the image plane (seed 002's `z`), in pixels once
+//! - `t` is the depth of a scene point behind the image plane (the SIRDS paper's `z`), in pixels once
 //!   [`Geometry::to_pixels`] has run;
 //! - `z` is normalized nearness in [0, 1] as in Thimbleby–Inglis–Witten (1994): 0 is the
 //!   background plane at `t_far`, 1 the front of the depth range at `t_near`, linearly between:
@@ -10,7 +10,7 @@
 
 use crate::error::{Error, Result};
 
-/// Which projection model of the visual system maps depth to separation (seed 002 §2).
+/// Which projection model of the visual system maps depth to separation (the SIRDS paper's §2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DisparityModel {
     /// Eq. 1, constant viewing direction: `d = 2 t / tan φ`, linear in depth.
@@ -21,13 +21,13 @@ pub enum DisparityModel {
     EyeDistance,
 }
 
-/// Seed 002 eq. 1: separation `d = 2 t / tan φ` of a point `t` behind the image plane, seen
+/// The SIRDS paper's eq. 1: separation `d = 2 t / tan φ` of a point `t` behind the image plane, seen
 /// along a constant direction at angle `φ` to the plane. `t` and `d` share one length unit.
 pub fn separation_view_angle(t: f32, tan_phi: f32) -> f32 {
     2.0 * t / tan_phi
 }
 
-/// Seed 002 eq. 3: separation `d = a t / (t + f)` for eye distance `a`, focal length (eye to
+/// The SIRDS paper's eq. 3: separation `d = a t / (t + f)` for eye distance `a`, focal length (eye to
 /// image plane) `f` and depth `t` behind the image plane, all in one length unit. Note the
 /// division: a public Rust port multiplies by `(t + f)` instead, which grows without bound.
 ///
@@ -51,7 +51,7 @@ pub fn separation_eye_distance(t: f32, a: f32, f: f32) -> Result<f32> {
     }
 }
 
-/// Seed 002 eq. 2: `tan φ = 2 (t + f) / a`, the slope (depth per lateral length) of the ray from
+/// The SIRDS paper's eq. 2: `tan φ = 2 (t + f) / a`, the slope (depth per lateral length) of the ray from
 /// a point `t` behind the image plane to an eye, under the eq. 3 model.
 pub fn tan_phi_eye_distance(t: f32, a: f32, f: f32) -> f32 {
     2.0 * (t + f) / a
@@ -69,7 +69,7 @@ pub struct Geometry {
     /// Eye-to-image-plane distance `f` (TIW's `D`).
     pub viewing_distance_in: f32,
     /// Depth behind the image plane of the front of the depth range (`z = 1`); > 0 because
-    /// seed 002 §3 needs a non-zero minimum separation.
+    /// the SIRDS paper's §3 needs a non-zero minimum separation.
     pub depth_near_in: f32,
     /// Depth behind the image plane of the background plane (`z = 0`).
     pub depth_far_in: f32,

@@ -1,13 +1,13 @@
 //! Single-image random-dot stereograms (SIRDS).
 //!
-//! Seed 002 (Petz, Goldlücke, Magnor, "Hardware-accelerated autostereogram rendering") is the
+//! The SIRDS paper (Petz, Goldlücke, Magnor, "Hardware-accelerated autostereogram rendering") is the
 //! specification; its reference 5 (Thimbleby, Inglis, Witten 1994, "TIW") is the classic
 //! per-pixel algorithm. A SIRDS needs one depth-only pass of the cyclopean view and no color
 //! shading (`plan.rs`: `sirds` → `Center`, `DepthOnly`).
 //!
 //! - [`disparity`]: eq. 1 and eq. 3, physical units → pixels in one place;
 //! - [`depthmap`]: nearness per pixel from the depth pass or an image file;
-//! - [`per_vertex`]: seed 002's strip algorithm on stereolab's rasterizer;
+//! - [`per_vertex`]: the SIRDS paper's strip algorithm on stereolab's rasterizer;
 //! - [`per_pixel`]: TIW with hidden-surface removal and oversampling;
 //! - [`pattern`]: random dots, pattern images, guide dots;
 //! - [`decode`]: separation (and depth) back from a finished image;

@@ -1,5 +1,5 @@
 //! The classic per-pixel algorithm of Thimbleby, Inglis and Witten (IEEE Computer 27(10),
-//! 1994; seed 002's reference 5) on any depth map: per scan line, link the pixel pairs each
+//! 1994; the SIRDS paper's reference 5) on any depth map: per scan line, link the pixel pairs each
 //! visible point constrains (`same[]`), then color right to left.
 
 use rayon::prelude::*;

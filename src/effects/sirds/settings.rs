@@ -10,7 +10,7 @@ use super::pattern::Pattern;
 use super::per_pixel::{MAX_OVERSAMPLE, PerPixelOptions};
 use crate::error::{Error, Result};
 
-/// Where the pattern strip sits (seed 002 Fig. 7).
+/// Where the pattern strip sits (the SIRDS paper's Fig. 7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Start {
     /// At the left edge; iterations propagate right (§3).
@@ -61,7 +61,7 @@ impl Default for PerVertexOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Algorithm {
-    /// Seed 002's strip algorithm: the scene rendered k times with shifted vertices.
+    /// The SIRDS paper's strip algorithm: the scene rendered k times with shifted vertices.
     #[default]
     PerVertex,
     /// Thimbleby–Inglis–Witten on the depth pass's depth map.

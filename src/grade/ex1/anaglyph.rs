@@ -10,7 +10,7 @@ use crate::framebuffer::Framebuffer;
 use crate::grade::fixture::Fixture;
 use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
 
-/// Seed 004's anaglyph matrices from stereolab's anaglyph module.
+/// The exercise slides' anaglyph matrices from stereolab's anaglyph module.
 pub fn reference_anaglyph(kind: AnaglyphKind) -> AnaglyphMatrices {
     kind.reference().matrices()
 }
@@ -33,7 +33,7 @@ fn swapped_pair(m: &AnaglyphMatrices) -> AnaglyphMatrices {
     }
 }
 
-/// The finalize shader's anaglyph pixel (stored 8-bit values, no sRGB decoding: seed 004).
+/// The finalize shader's anaglyph pixel (stored 8-bit values, no sRGB decoding: the exercise slides).
 fn mix(m: &AnaglyphMatrices, l: [u8; 4], r: [u8; 4]) -> [u8; 4] {
     anaglyph_pixel(m, l, r, false)
 }

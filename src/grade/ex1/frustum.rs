@@ -45,7 +45,7 @@ pub(super) fn frustum_task(fx: &Fixture) -> TaskSpec {
             },
             Mistake {
                 id: "wrong-ndc-range",
-                hint: "wrong NDC range: this maps depth to [0, 1] (Direct3D/Vulkan); seed 004's \
+                hint: "wrong NDC range: this maps depth to [0, 1] (Direct3D/Vulkan); the exercise slides' \
                        OpenGL matrix maps near to −1 and far to +1: (n+f)/(n−f) and 2nf/(n−f)",
                 answers: each(&|a| {
                     let mut m = frustum(a[0], a[1], a[2], a[3], a[4], a[5]);
@@ -112,7 +112,7 @@ pub(super) fn stereo_frustum_task(fx: &Fixture) -> TaskSpec {
                 id: "toe-in",
                 hint: "no shear: l and r are the mono frustum's. The off-axis rig shears each \
                        eye's frustum; rotating the eyes (toe-in) or parallel symmetric frusta \
-                       are not seed 004's stereo frusta",
+                       are not the exercise slides' stereo frusta",
                 answers: toe,
             },
             Mistake {

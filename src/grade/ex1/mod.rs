@@ -1,4 +1,4 @@
-//! Exercise 1 (seed 004): the tasks, their reference answers, known mistakes and image checks.
+//! Exercise 1 (the exercise slides): the tasks, their reference answers, known mistakes and image checks.
 //!
 //! One file per task group: `frustum` (mono and stereo frusta), `rig` (the stereo rig's view
 //! and projection matrices), `anaglyph` (anaglyph and Dubois matrices), `remap` (left-to-right
@@ -61,7 +61,7 @@ fn camera(setup: &StereoSetup, eye: [f32; 3], target: [f32; 3]) -> Camera {
     }
 }
 
-/// The setups the numeric stereo checks use: the fixture's, seed 003's worked example, and a
+/// The setups the numeric stereo checks use: the fixture's, the StereoGraphics guide's worked example, and a
 /// wide, close one.
 fn setups(fx: &Fixture) -> Vec<(StereoSetup, Camera)> {
     let seed003 = StereoSetup {

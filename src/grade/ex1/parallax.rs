@@ -143,7 +143,7 @@ pub(super) fn parallax_color_task(fx: &Fixture) -> TaskSpec {
         mistakes: vec![
             Mistake {
                 id: "parallax-colors-swapped",
-                hint: "colors swapped: seed 004 shows NEGATIVE parallax (in front of the screen) \
+                hint: "colors swapped: the exercise slides show NEGATIVE parallax (in front of the screen) \
                        blue and positive red",
                 answers: each(&|[p, m]| color_reference(p, m, true)),
             },

@@ -18,7 +18,7 @@ struct RemapVariant {
 }
 
 /// The known mistakes' answers (and, with no switch set, the same numbers as
-/// [`stereolab_remap`]): seed 004's chain in f64 from a texture coordinate.
+/// [`stereolab_remap`]): the exercise slides' chain in f64 from a texture coordinate.
 fn remap_reference(l: &Mat4, r: &Mat4, uv: [f32; 2], depth: f32, v: RemapVariant) -> Vec<f64> {
     let (l, r) = (l.as_dmat4(), r.as_dmat4());
     let m: DMat4 = if v.order_swapped {
@@ -146,7 +146,7 @@ pub(super) fn remap_task(fx: &Fixture) -> TaskSpec {
         tolerance: Tolerance {
             abs: 2e-4,
             rel: 0.0,
-            why: "seed 004's f32 chain (inverse in f32, two products) is off by 4.4e-7 at most \
+            why: "the exercise slides' f32 chain (inverse in f32, two products) is off by 4.4e-7 at most \
                   on these inputs against this f64 reference (measured); 2e-4 is a hundredth of \
                   a pixel at 64 pixels and leaves room for any evaluation order",
         },

@@ -144,7 +144,7 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
             Mistake {
                 id: "toe-in",
                 hint: "toe-in instead of shear: rotating each eye towards the fusion point gives \
-                       vertical parallax (seed 003); translate the eyes and shear the frusta",
+                       vertical parallax (the StereoGraphics guide (Akka)); translate the eyes and shear the frusta",
                 answers: toe,
             },
             Mistake {

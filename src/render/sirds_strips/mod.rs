@@ -1,4 +1,4 @@
-//! Seed 002's per-vertex strip algorithm (Petz, Goldlücke, Magnor §3–4) on stereolab's own
+//! The SIRDS paper's per-vertex strip algorithm (Petz, Goldlücke, Magnor §3–4) on stereolab's own
 //! rasterizer: starting from the pattern, each iteration renders the scene with every vertex
 //! shifted right by `d(v)/2` and textured from the current image `d(v)/2` to the left of the
 //! vertex (Fig. 4's vertex program), the z-buffer resolving visibility.
@@ -49,7 +49,7 @@ pub struct StripGeometry {
 impl StripGeometry {
     /// Transforms every object with the cyclopean `center` matrices, gives each vertex the
     /// separation of its eye-space distance (`clip.w`) mapped through `range`, and adds the
-    /// background plane at `range.back` covering the whole view (seed 002 §3).
+    /// background plane at `range.back` covering the whole view (the SIRDS paper's §3).
     pub fn new(
         scene: &Scene,
         center: &EyeMatrices,

@@ -101,7 +101,7 @@ impl Shader for RecordLink<'_> {
 /// Makes a SIRDS with the strip algorithm as k render passes: the definition the fast
 /// [`per_vertex`](super::per_vertex) is held to (same inputs, same result, byte for byte).
 ///
-/// Per strip (seed 002 §3–4, Fig. 4): render the scene into B, a copy of A, with every vertex
+/// Per strip (the SIRDS paper's §3–4, Fig. 4): render the scene into B, a copy of A, with every vertex
 /// `v` at `x + toward · d(v)/2` and every fragment at `x` colored from A at
 /// `x − toward · d`; copy B's strip into A. `toward` is +1 for strips going right from the start
 /// column, −1 for those going left (center start, Fig. 7).
@@ -210,7 +210,7 @@ mod tests {
         "[[mesh]]\nkind = \"sphere\"\nsize = 1.2\ndetail = 32\n",
     );
 
-    /// Seed 002 Fig. 5's ramp, a plane receding to the right (tests/sirds.rs `RAMP`).
+    /// The SIRDS paper's Fig. 5's ramp, a plane receding to the right (tests/sirds.rs `RAMP`).
     const RAMP: (&str, &str) = (
         "",
         "[[mesh]]\nkind = \"plane\"\nsize = 20.0\ndetail = 16\nrotate = [0.0, 35.0, 0.0]\n",
