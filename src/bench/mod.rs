@@ -58,7 +58,7 @@ pub struct BenchOptions {
 }
 
 /// The benchmark groups, in the order they run.
-pub const GROUPS: [&str; 6] = [
+pub(crate) const GROUPS: [&str; 6] = [
     "stereo",
     "raster",
     "chromadepth",
@@ -80,7 +80,7 @@ impl Default for BenchOptions {
 }
 
 /// Median milliseconds of `iters` runs of `f` (after one warm-up run).
-pub fn median_ms<T>(iters: usize, mut f: impl FnMut() -> T) -> f64 {
+pub(crate) fn median_ms<T>(iters: usize, mut f: impl FnMut() -> T) -> f64 {
     std::hint::black_box(f());
     let mut v: Vec<f64> = (0..iters.max(1))
         .map(|_| {

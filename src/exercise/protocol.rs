@@ -145,7 +145,7 @@ fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
 }
 
 /// Encodes one reply line.
-pub fn encode_reply(reply: &Result<Vec<f64>, String>) -> String {
+pub(crate) fn encode_reply(reply: &Result<Vec<f64>, String>) -> String {
     let v = match reply {
         Ok(nums) => {
             let arr = nums
@@ -165,7 +165,7 @@ pub fn encode_reply(reply: &Result<Vec<f64>, String>) -> String {
 }
 
 /// Decodes one reply line; `Err` carries the panic message (or why the line is unreadable).
-pub fn decode_reply(line: &str) -> Result<Vec<f64>, String> {
+pub(crate) fn decode_reply(line: &str) -> Result<Vec<f64>, String> {
     let v: Value = serde_json::from_str(line).map_err(|e| format!("unreadable reply: {e}"))?;
     if let Some(msg) = v.get("panic") {
         return Err(msg.as_str().unwrap_or("panicked").to_string());

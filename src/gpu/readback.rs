@@ -79,7 +79,7 @@ impl Target {
     }
 
     /// Hands targets back for later frames, keeping at most [`MAX_SPARE_TARGETS`].
-    pub fn give_back(r: &GpuRenderer, targets: impl IntoIterator<Item = Target>) {
+    pub(crate) fn give_back(r: &GpuRenderer, targets: impl IntoIterator<Item = Target>) {
         if let Ok(mut spare) = r.spare_targets.lock() {
             for t in targets {
                 if spare.len() == MAX_SPARE_TARGETS {
@@ -124,7 +124,7 @@ impl Target {
     }
 
     /// Records the copies of both textures into the readback buffers.
-    pub fn encode_copies(&self, encoder: &mut wgpu::CommandEncoder) {
+    pub(crate) fn encode_copies(&self, encoder: &mut wgpu::CommandEncoder) {
         let size = wgpu::Extent3d {
             width: self.width,
             height: self.height,

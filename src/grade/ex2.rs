@@ -21,7 +21,7 @@ use crate::scene::Scene;
 use crate::shade::to_rgba8;
 
 /// Every task of exercise 2.
-pub fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
+pub(crate) fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
     vec![ramp_task(), texgen_task(fx), depth_range_task()]
 }
 
@@ -31,13 +31,13 @@ fn hue_to_rgb(hue: f32) -> [f32; 3] {
 }
 
 /// The ChromaDepth article's ramp as stereolab computes it: hue 240° · clamp(t), red near, blue far.
-pub fn reference_ramp(t: f32) -> [f32; 3] {
+pub(crate) fn reference_ramp(t: f32) -> [f32; 3] {
     exact(RampKind::Hsv, t).to_array()
 }
 
 /// The ChromaDepth article's texgen plane `[A, B, C, D]` as stereolab's `Texgen::from_range` computes it; for
 /// `d1 ≥ d2`, which it refuses, the formula itself.
-pub fn reference_texgen(d1: f32, d2: f32) -> [f32; 4] {
+pub(crate) fn reference_texgen(d1: f32, d2: f32) -> [f32; 4] {
     Texgen::from_range(d1, d2).map_or_else(
         |_| [0.0, 0.0, -1.0 / (d2 - d1), -d1 / (d2 - d1)],
         |t| t.plane.to_array(),

@@ -17,13 +17,13 @@ use crate::exercise::{SirdsGeometry, SirdsSetup};
 use crate::framebuffer::Framebuffer;
 
 /// Every task of exercise 3.
-pub fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
+pub(crate) fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
     vec![direction_task(), eyes_task(), link_task(fx)]
 }
 
 /// The viewing set-up of the link checks: eyes 64 px apart, 240 px in front of the image,
 /// nearness spanning 20 … 60 px behind it (separations 4.9 … 12.8 px).
-pub const SETUP: SirdsSetup = SirdsSetup {
+pub(crate) const SETUP: SirdsSetup = SirdsSetup {
     eye_distance: 64.0,
     focal_length: 240.0,
     depth_near: 20.0,

@@ -6,12 +6,12 @@ use std::path::Path;
 use crate::error::{Error, Result};
 
 /// Lines between these markers (inclusive) are the instructor's and are dropped from the handout.
-pub const SOLUTION_BEGIN: &str = "solution-begin";
+pub(crate) const SOLUTION_BEGIN: &str = "solution-begin";
 /// See [`SOLUTION_BEGIN`].
-pub const SOLUTION_END: &str = "solution-end";
+pub(crate) const SOLUTION_END: &str = "solution-end";
 
 /// Removes every `solution-begin` … `solution-end` block (marker lines included).
-pub fn strip_solution(text: &str) -> String {
+pub(crate) fn strip_solution(text: &str) -> String {
     let mut out = String::new();
     let mut skipping = false;
     for line in text.lines() {

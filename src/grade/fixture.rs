@@ -15,7 +15,7 @@ use crate::scene::Scene;
 /// The built-in grading scene: small (fast, ASCII maps fit a terminal), with depth in front of
 /// and behind the screen (parallax of both signs), occluders in front of a backdrop (remapping,
 /// visibility) and a background plane behind everything (the SIRDS paper's SIRDS bound).
-pub const GRADING_SCENE: &str = r#"
+pub(crate) const GRADING_SCENE: &str = r#"
 outputs = ["left", "right"]
 [image]
 width = 64
@@ -64,7 +64,7 @@ pub fn grading_scene() -> Result<Scene> {
 }
 
 /// A scene and what the reference renders of it, shared by the tasks' image checks.
-pub struct Fixture {
+pub(crate) struct Fixture {
     /// The scene.
     pub scene: Scene,
     /// Its stereo parameters as the exercises take them.
@@ -83,7 +83,7 @@ pub struct Fixture {
 
 /// The reference rig of the exercises: off-axis with the scene's separation and screen distance,
 /// no user adjustments (the exercise slides' rig).
-pub fn reference_rig(setup: &StereoSetup, lighting: Lighting) -> StereoRig {
+pub(crate) fn reference_rig(setup: &StereoSetup, lighting: Lighting) -> StereoRig {
     StereoRig {
         separation: Separation::Absolute(setup.eye_separation),
         zero_parallax: ZeroParallax::Distance(setup.zero_parallax),
@@ -96,7 +96,7 @@ pub fn reference_rig(setup: &StereoSetup, lighting: Lighting) -> StereoRig {
 ///
 /// # Errors
 /// An invalid camera or rig.
-pub fn stereo_setup(scene: &Scene) -> Result<StereoSetup> {
+pub(crate) fn stereo_setup(scene: &Scene) -> Result<StereoSetup> {
     let aspect = scene.aspect();
     let resolved = scene.rig.resolve(&scene.camera, aspect)?;
     Ok(StereoSetup {
@@ -142,7 +142,7 @@ impl Fixture {
 
     /// A framebuffer of the scene's size filled with `color` at depth 0 (fully "covered"), for
     /// pictures that are not renders.
-    pub fn canvas(&self, color: [u8; 4]) -> Framebuffer {
+    pub(crate) fn canvas(&self, color: [u8; 4]) -> Framebuffer {
         let (w, h) = self.size();
         let mut fb = Framebuffer::new(w, h, color).expect("the scene's size was validated");
         fb.depth.fill(0.0);
@@ -155,13 +155,19 @@ impl Fixture {
     }
 
     /// Eye-space position of a covered pixel of a render made with `m` (`None` for background).
-    pub fn unproject(&self, m: &EyeMatrices, fb: &Framebuffer, x: u32, y: u32) -> Option<Vec3> {
+    pub(crate) fn unproject(
+        &self,
+        m: &EyeMatrices,
+        fb: &Framebuffer,
+        x: u32,
+        y: u32,
+    ) -> Option<Vec3> {
         unproject(m, fb, x, y)
     }
 }
 
 /// Texture coordinate (OpenGL: v = 0 at the bottom row) of pixel (x, y)'s center in a w × h image.
-pub fn pixel_uv(w: u32, h: u32, x: u32, y: u32) -> [f32; 2] {
+pub(crate) fn pixel_uv(w: u32, h: u32, x: u32, y: u32) -> [f32; 2] {
     [
         (x as f32 + 0.5) / w as f32,
         1.0 - (y as f32 + 0.5) / h as f32,
@@ -170,7 +176,7 @@ pub fn pixel_uv(w: u32, h: u32, x: u32, y: u32) -> [f32; 2] {
 
 /// Eye-space position (in `m.view`'s space) of a covered pixel of `fb`, rendered with `m`;
 /// `None` for background.
-pub fn unproject(m: &EyeMatrices, fb: &Framebuffer, x: u32, y: u32) -> Option<Vec3> {
+pub(crate) fn unproject(m: &EyeMatrices, fb: &Framebuffer, x: u32, y: u32) -> Option<Vec3> {
     let d = fb.depth[fb.index(x, y)];
     if d >= 1.0 {
         return None;

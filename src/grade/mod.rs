@@ -6,7 +6,7 @@
 //! in one subprocess; a panic costs that input, an endless loop the task (the child is killed
 //! after the time limit), NaN the inputs it spoils. The grader itself never panics on an answer.
 
-pub mod child;
+pub(crate) mod child;
 pub mod ex1;
 pub mod ex2;
 pub mod ex3;
@@ -47,7 +47,7 @@ impl Exercise {
     pub const ALL: [Exercise; 3] = [Exercise::Ex1, Exercise::Ex2, Exercise::Ex3];
 
     /// `ex1`, `ex2`, `ex3`.
-    pub fn id(self) -> &'static str {
+    pub(crate) fn id(self) -> &'static str {
         match self {
             Exercise::Ex1 => "ex1",
             Exercise::Ex2 => "ex2",
@@ -56,7 +56,7 @@ impl Exercise {
     }
 
     /// The crate (and its binary) under `exercises/`.
-    pub fn crate_name(self) -> &'static str {
+    pub(crate) fn crate_name(self) -> &'static str {
         match self {
             Exercise::Ex1 => "ex1_stereo",
             Exercise::Ex2 => "ex2_chromadepth",
@@ -80,7 +80,7 @@ impl Exercise {
     }
 
     /// The tasks, with reference answers computed for `fx`.
-    pub fn tasks(self, fx: &Fixture) -> Vec<TaskSpec> {
+    pub(crate) fn tasks(self, fx: &Fixture) -> Vec<TaskSpec> {
         match self {
             Exercise::Ex1 => ex1::tasks(fx),
             Exercise::Ex2 => ex2::tasks(fx),

@@ -8,9 +8,9 @@ use super::Exercise;
 use super::score::TaskResult;
 
 /// The course's rule (the exercise slides, "Passing Criteria"): at least this share of all points…
-pub const PASS_FRACTION: f64 = 0.5;
+pub(crate) const PASS_FRACTION: f64 = 0.5;
 /// …and at least this many points in each exercise.
-pub const MIN_POINTS_PER_EXERCISE: f64 = 2.0;
+pub(crate) const MIN_POINTS_PER_EXERCISE: f64 = 2.0;
 
 /// One exercise's results.
 #[derive(Clone, Debug, PartialEq)]

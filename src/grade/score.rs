@@ -42,7 +42,7 @@ pub struct TaskResult {
 
 impl TaskResult {
     /// A task not run because the crate did not build.
-    pub fn not_built(exercise: &'static str, spec: &TaskSpec) -> TaskResult {
+    pub(crate) fn not_built(exercise: &'static str, spec: &TaskSpec) -> TaskResult {
         TaskResult {
             exercise,
             name: spec.name,
@@ -111,7 +111,12 @@ fn check(expected: &[f64], actual: &[f64], tol: &Tolerance) -> Option<String> {
 
 /// Scores `spec` from `run`; failing pictures are written to `out_dir` as
 /// `expected | diff | actual` strips named `<exercise>_<picture>.png`.
-pub fn evaluate(exercise: &'static str, spec: &TaskSpec, run: &Run, out_dir: &Path) -> TaskResult {
+pub(crate) fn evaluate(
+    exercise: &'static str,
+    spec: &TaskSpec,
+    run: &Run,
+    out_dir: &Path,
+) -> TaskResult {
     let n = spec.cases.len();
     let mut details = Vec::new();
     let mut failing: Vec<(usize, Vec<f64>)> = Vec::new();

@@ -17,7 +17,7 @@ pub struct Tolerance {
 
 impl Tolerance {
     /// Exact equality (integers, booleans, indices).
-    pub const EXACT: Tolerance = Tolerance {
+    pub(crate) const EXACT: Tolerance = Tolerance {
         abs: 0.0,
         rel: 0.0,
         why: "exact: integers and booleans",
@@ -25,7 +25,7 @@ impl Tolerance {
 
     /// Whether `actual` matches `expected` element by element (same length, all finite where
     /// expected is finite).
-    pub fn accepts(&self, expected: &[f64], actual: &[f64]) -> bool {
+    pub(crate) fn accepts(&self, expected: &[f64], actual: &[f64]) -> bool {
         expected.len() == actual.len()
             && expected
                 .iter()
@@ -58,7 +58,7 @@ pub struct Case {
 /// A known wrong formula: what it answers for each case. When a student's failing answers all
 /// match it, the grader names it.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Mistake {
+pub(crate) struct Mistake {
     /// Short stable name, printed in brackets (`[swapped-eyes]`).
     pub id: &'static str,
     /// What to check, in words a student can act on.
@@ -69,7 +69,7 @@ pub struct Mistake {
 
 /// One image compared: the reference's and the one built from the student's answers.
 #[derive(Clone, Debug)]
-pub struct Picture {
+pub(crate) struct Picture {
     /// File-name-friendly name (`stereo_matrices_left_per_eye`).
     pub name: String,
     /// Reference.
@@ -80,10 +80,10 @@ pub struct Picture {
 
 /// Builds the student's pictures from the answers to [`ImageCheck::inputs`] (`None` where the
 /// student's code panicked or gave no answer).
-pub type PictureBuilder = Box<dyn Fn(&[Option<Vec<f64>>]) -> Vec<Picture>>;
+pub(crate) type PictureBuilder = Box<dyn Fn(&[Option<Vec<f64>>]) -> Vec<Picture>>;
 
 /// An image check: the student's functions plugged into the real pipeline vs the reference.
-pub struct ImageCheck {
+pub(crate) struct ImageCheck {
     /// Inputs whose answers the pictures are built from.
     pub inputs: Vec<Value>,
     /// The builder.
@@ -93,13 +93,13 @@ pub struct ImageCheck {
 /// Largest share of pixels whose coverage may differ, in percent. A matrix inside the numeric
 /// tolerance (1e-4 relative) moves an edge by well under 0.01 pixel at these sizes, which flips
 /// only pixels whose centers lie that close to an edge: a handful, far below 1%.
-pub const IMAGE_MAX_COVERAGE_PERCENT: f64 = 1.0;
+pub(crate) const IMAGE_MAX_COVERAGE_PERCENT: f64 = 1.0;
 /// Largest mean RGB difference (0..255). Answers inside the numeric tolerances change an 8-bit
 /// channel by at most one step on a few pixels; a real mistake changes whole regions.
-pub const IMAGE_MAX_MEAN_DIFF: f64 = 1.0;
+pub(crate) const IMAGE_MAX_MEAN_DIFF: f64 = 1.0;
 
 /// A task: one stub, scored on its own.
-pub struct TaskSpec {
+pub(crate) struct TaskSpec {
     /// The stub's name and the task name in the protocol.
     pub name: &'static str,
     /// Points for a complete answer.
@@ -117,7 +117,7 @@ pub struct TaskSpec {
 }
 
 /// Share of a task's points the image check carries when the task has one.
-pub const IMAGE_SHARE: f64 = 0.3;
+pub(crate) const IMAGE_SHARE: f64 = 0.3;
 
 #[cfg(test)]
 mod tests {

@@ -138,7 +138,7 @@ pub fn write_all(frame: &Frame, scene: &Scene, dir: &Path) -> Result<Vec<PathBuf
 ///
 /// # Errors
 /// The folder cannot be created, or an output fails.
-pub fn write_all_with(
+pub(crate) fn write_all_with(
     frame: &Frame,
     dir: &Path,
     mut make: impl FnMut(Output) -> Result<Image>,

@@ -62,7 +62,7 @@ pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
 ///
 /// # Errors
 /// As [`from_frame`], and whatever `strips` returns.
-pub fn from_frame_with(
+pub(crate) fn from_frame_with(
     frame: &Frame,
     scene: &Scene,
     strips: impl FnOnce(&StripGeometry, &Disparity) -> Result<StripResult>,

@@ -7,7 +7,7 @@ use std::arch::x86_64::*;
 use super::{Band, Plane, SetupTriangle};
 
 /// Whether this CPU runs the AVX2 loops; the bytes are the same either way.
-pub fn available() -> bool {
+pub(crate) fn available() -> bool {
     is_x86_feature_detected!("avx2") && is_x86_feature_detected!("popcnt")
 }
 

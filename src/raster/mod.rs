@@ -11,8 +11,8 @@ mod clip;
 mod setup;
 mod traverse;
 
-pub use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
-pub use setup::{Plane, Setup, SetupTriangle, WindowVertex, setup_triangle, snap};
+pub(crate) use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
+pub use setup::{Plane, Setup, SetupTriangle, WindowVertex, setup_triangle};
 pub use traverse::{Band, SmallBox, traverse};
 
 use rayon::prelude::*;
@@ -80,7 +80,7 @@ pub struct RasterStats {
 
 /// Rows per band when a pass is split across threads. Each band sees every triangle in
 /// submission order, so the result is the same for any number of threads.
-pub const BAND_ROWS: usize = 32;
+pub(crate) const BAND_ROWS: usize = 32;
 
 /// Rasterizes `triangles` (indices into the shader's vertices) into `fb`.
 ///
@@ -148,7 +148,7 @@ fn traverse_band<S: Shader>(
 /// The triangles of each band of `band_rows` rows (of a `height`-row target), in submission
 /// order: every band then walks its own short list instead of testing every triangle, which
 /// for thousands of small triangles read the whole setup array once per band.
-pub fn bin_rows(setups: &Setups, band_rows: u32, height: u32) -> Vec<Vec<&SetupTriangle>> {
+pub(crate) fn bin_rows(setups: &Setups, band_rows: u32, height: u32) -> Vec<Vec<&SetupTriangle>> {
     let band_rows = band_rows.max(1);
     let mut bins = vec![Vec::new(); height.div_ceil(band_rows) as usize];
     for t in setups {

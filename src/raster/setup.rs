@@ -24,7 +24,7 @@ impl WindowVertex {
     /// Perspective divide and viewport transform: `x_win = (x/w)·W/2 + W/2`,
     /// `y_win = (y/w)·(−H/2) + H/2` (NDC y = +1 is the top row), `z_win = (z/w)/2 + 1/2`.
     /// `None` when w ≤ 0 (only possible for unclipped input).
-    pub fn from_clip(v: &ClipVertex, width: u32, height: u32) -> Option<Self> {
+    pub(crate) fn from_clip(v: &ClipVertex, width: u32, height: u32) -> Option<Self> {
         let p = v.pos;
         if p.w <= 0.0 {
             return None;
@@ -50,7 +50,7 @@ impl WindowVertex {
 /// Snaps a window coordinate to the subpixel grid so that pixel `p` samples at `p << bits`:
 /// `round((c − 0.5) · 2^bits)`, rounding half to even as SSE `cvtps2dq` does.
 #[inline]
-pub fn snap(coord: f32, bits: u32) -> i64 {
+pub(crate) fn snap(coord: f32, bits: u32) -> i64 {
     round_ties_even((coord - 0.5) * (1u32 << bits) as f32) as i64
 }
 
@@ -268,13 +268,13 @@ impl SetupTriangle {
     /// Pixel column `x`'s center relative to the planes' origin (the `fx` of the `*_at`
     /// functions). Through `i32`, which converts to `f32` in vector lanes; exact below 2²⁴.
     #[inline]
-    pub fn fx(&self, x: u32) -> f32 {
+    pub(crate) fn fx(&self, x: u32) -> f32 {
         x as i32 as f32 + 0.5 - self.x0
     }
 
     /// Pixel row `y`'s center relative to the planes' origin.
     #[inline]
-    pub fn fy(&self, y: u32) -> f32 {
+    pub(crate) fn fy(&self, y: u32) -> f32 {
         y as i32 as f32 + 0.5 - self.y0
     }
 
@@ -284,30 +284,30 @@ impl SetupTriangle {
     }
 
     /// The window-depth plane (before clamping).
-    pub fn depth_plane(&self) -> Plane {
+    pub(crate) fn depth_plane(&self) -> Plane {
         self.z
     }
 
     /// The 1/w plane.
-    pub fn inv_w_plane(&self) -> Plane {
+    pub(crate) fn inv_w_plane(&self) -> Plane {
         self.inv_w
     }
 
     /// Varying `k`'s plane (of `a/w` when set up perspective-correct).
-    pub fn varying_plane(&self, k: usize) -> Plane {
+    pub(crate) fn varying_plane(&self, k: usize) -> Plane {
         self.var[k]
     }
 
     /// Window depth at (`fx`, `fy`), clamped to [0, 1]: what the depth test compares.
     #[inline]
-    pub fn depth_at(&self, fx: f32, fy: f32) -> f32 {
+    pub(crate) fn depth_at(&self, fx: f32, fy: f32) -> f32 {
         self.z.at(fx, fy).clamp(0.0, 1.0)
     }
 
     /// The factor that turns an interpolated `a/w` back into `a` at (`fx`, `fy`): `w`, the
     /// reciprocal of the interpolated `1/w` (1 for affine interpolation).
     #[inline]
-    pub fn w_at(&self, fx: f32, fy: f32, perspective_correct: bool) -> f32 {
+    pub(crate) fn w_at(&self, fx: f32, fy: f32, perspective_correct: bool) -> f32 {
         if perspective_correct {
             1.0 / self.inv_w.at(fx, fy)
         } else {
@@ -318,7 +318,7 @@ impl SetupTriangle {
     /// Varying `k` at (`fx`, `fy`), perspective-corrected when set up so (one reciprocal, one
     /// multiply, as the fragment stage of [`traverse`](super::traverse)).
     #[inline]
-    pub fn varying_at(&self, k: usize, fx: f32, fy: f32, perspective_correct: bool) -> f32 {
+    pub(crate) fn varying_at(&self, k: usize, fx: f32, fy: f32, perspective_correct: bool) -> f32 {
         self.var[k].at(fx, fy) * self.w_at(fx, fy, perspective_correct)
     }
 }

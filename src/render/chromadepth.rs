@@ -71,7 +71,7 @@ impl<'a> ChromaDepthShader<'a> {
 
     /// The texture coordinate of a fragment, before clamping.
     #[inline]
-    pub fn s_at(&self, f: &Fragment) -> f32 {
+    pub(crate) fn s_at(&self, f: &Fragment) -> f32 {
         match self.mode {
             TexgenMode::PerVertex => f.varyings[0],
             TexgenMode::PerPixel => {
@@ -166,7 +166,7 @@ pub fn resolve_texgen(
 ///
 /// # Errors
 /// As [`render_center_with`].
-pub fn render_center(scene: &Scene, m: &EyeMatrices) -> Result<(Framebuffer, RasterStats)> {
+pub(crate) fn render_center(scene: &Scene, m: &EyeMatrices) -> Result<(Framebuffer, RasterStats)> {
     render_center_with(scene, m, &scene.chromadepth)
 }
 

@@ -11,7 +11,7 @@ use crate::grade::fixture::Fixture;
 use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
 
 /// The exercise slides' anaglyph matrices from stereolab's anaglyph module.
-pub fn reference_anaglyph(kind: AnaglyphKind) -> AnaglyphMatrices {
+pub(crate) fn reference_anaglyph(kind: AnaglyphKind) -> AnaglyphMatrices {
     kind.reference().matrices()
 }
 

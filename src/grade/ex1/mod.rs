@@ -18,7 +18,6 @@ use crate::exercise::{Answer, StereoSetup};
 use crate::framebuffer::Framebuffer;
 use crate::math::{Camera, CameraMode, EyeMatrices, Lighting};
 
-pub use anaglyph::reference_anaglyph;
 pub(crate) use rig::{eye_matrices_from_answer, eye_view_input};
 
 pub(crate) fn flat<A: Answer>(a: &A) -> Vec<f64> {
@@ -28,7 +27,7 @@ pub(crate) fn flat<A: Answer>(a: &A) -> Vec<f64> {
 }
 
 /// Every task of exercise 1.
-pub fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
+pub(crate) fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
     vec![
         frustum::frustum_task(fx),
         frustum::stereo_frustum_task(fx),

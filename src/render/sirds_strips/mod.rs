@@ -304,7 +304,7 @@ impl Shader for StripVertices<'_> {
 }
 
 /// Rows per band: bands run in parallel. Fixed, so the bytes never depend on the thread count.
-pub const BAND_ROWS: u32 = 32;
+pub(crate) const BAND_ROWS: u32 = 32;
 
 /// What a span of fragments needs besides its triangle: the direction (+1: copies from
 /// `x − d`, −1: from `x + d`), the allowed sources `[lo, hi)`, and the filter and
