@@ -24,104 +24,21 @@
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod geometry;
 pub mod reference;
+
+pub use geometry::StripGeometry;
+use geometry::shift;
 
 use glam::Vec4;
 use rayon::prelude::*;
 
 use crate::effects::sirds::per_pixel::check_inputs;
-use crate::effects::sirds::{DepthRange, Disparity, Pattern};
+use crate::effects::sirds::{Disparity, Pattern};
 pub use crate::effects::sirds::{Filter, PerVertexOptions, Start};
 use crate::error::{Error, Result};
-use crate::math::EyeMatrices;
 use crate::raster::{RasterOptions, SetupTriangle, avx2_available, bin_rows, setup_triangles};
-use crate::scene::Scene;
 use crate::shade::{Fragment, Shader, Varyings};
-
-/// The scene as the strip passes see it: cyclopean clip positions, each vertex's separation,
-/// and the triangles, the background plane last (drawn last, most of it fails the depth test).
-pub struct StripGeometry {
-    clip: Vec<Vec4>,
-    separation: Vec<f32>,
-    triangles: Vec<[u32; 3]>,
-}
-
-impl StripGeometry {
-    /// Transforms every object with the cyclopean `center` matrices, gives each vertex the
-    /// separation of its eye-space distance (`clip.w`) mapped through `range`, and adds the
-    /// background plane at `range.back` covering the whole view (the SIRDS paper's §3).
-    pub fn new(
-        scene: &Scene,
-        center: &EyeMatrices,
-        range: &DepthRange,
-        d: &Disparity,
-        cross_eyed: bool,
-    ) -> StripGeometry {
-        let nearness = |distance: f32| {
-            let z = range.nearness(distance);
-            if cross_eyed { 1.0 - z } else { z }
-        };
-        let mut g = StripGeometry {
-            clip: Vec::new(),
-            separation: Vec::new(),
-            triangles: Vec::new(),
-        };
-        for o in &scene.objects {
-            let mvp = center.mvp * o.model;
-            let base = g.clip.len() as u32;
-            for p in &o.mesh.positions {
-                let c = mvp * p.extend(1.0);
-                g.clip.push(c);
-                g.separation.push(d.separation(nearness(c.w)));
-            }
-            g.triangles
-                .extend(o.mesh.triangles.iter().map(|t| t.map(|i| i + base)));
-        }
-        // The plane, 5% larger than the frustum's cross-section at its distance.
-        let [_, r, _, t, n, _] = center.frustum;
-        let (hx, hy) = (r * range.back / n * 1.05, t * range.back / n * 1.05);
-        let base = g.clip.len() as u32;
-        for (x, y) in [(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)] {
-            let c = center.projection * Vec4::new(x, y, -range.back, 1.0);
-            g.clip.push(c);
-            g.separation.push(d.separation(nearness(c.w)));
-        }
-        g.triangles.push([base, base + 1, base + 2]);
-        g.triangles.push([base, base + 2, base + 3]);
-        g
-    }
-
-    /// Per-vertex separation in pixels.
-    pub fn separation(&self) -> &[f32] {
-        &self.separation
-    }
-
-    /// Triangles (vertex indices), the background plane last.
-    pub fn triangles(&self) -> &[[u32; 3]] {
-        &self.triangles
-    }
-
-    /// Fig. 4's vertex shift for a `width`-pixel image: every clip position moved
-    /// `toward · s/2` pixels, i.e. `x + toward · s · w / W` in clip space (+1: right-going strips,
-    /// −1: left-going). The CPU and GPU strips both take their vertices from here.
-    pub fn shifted(&self, toward: f32, width: u32) -> Vec<Vec4> {
-        let wf = width as f32;
-        self.clip
-            .iter()
-            .zip(&self.separation)
-            .map(|(c, s)| shift(*c, *s, toward, wf))
-            .collect()
-    }
-}
-
-/// Fig. 4's vertex shift of one clip position `c` with separation `s` on a `wf`-pixel-wide
-/// image: `toward · s/2` pixels, `x + toward · s · w / W` in clip space (the NDC width 2 spans
-/// W pixels). [`StripGeometry::shifted`] and the reference's vertex stage
-/// ([`reference`]) both shift with it.
-#[inline]
-fn shift(c: Vec4, s: f32, toward: f32, wf: f32) -> Vec4 {
-    Vec4::new(c.x + toward * s * c.w / wf, c.y, c.z, c.w)
-}
 
 /// What a strip run produced.
 #[derive(Clone, Debug, PartialEq)]
@@ -569,142 +486,4 @@ pub fn per_vertex(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::effects::sirds::depth_range;
-    use crate::fixtures::table_scene;
-    use crate::math::StereoRig;
-    use crate::plan::Shading;
-    use crate::render::render_view;
-
-    /// A source reaching into the running strip or one still to come (in real scenes only
-    /// past a sliver's edge) reads the pattern there, as the paper's ping-pong textures would
-    /// give it: resolving in place, scalar and AVX2, equals a two-image reference, both
-    /// filters, both directions, sources anywhere in the row.
-    #[test]
-    fn reads_of_unfinished_pixels_see_the_pattern() {
-        let (w, sw) = (64usize, 8u32);
-        let pattern = Pattern::Gray { seed: 3 };
-        let y = 5;
-        let start: Vec<[u8; 4]> = (0..w as u32).map(|x| pattern.color(x, y)).collect();
-        for bilinear in [false, true] {
-            for toward in [1.0f32, -1.0] {
-                // Pseudo-random sources over the whole row, every fifth pixel without one.
-                let sources: Vec<f32> = (0..w)
-                    .map(|x| {
-                        let r = (x as u32).wrapping_mul(2_654_435_761) >> 7;
-                        if x % 5 == 0 {
-                            f32::NAN
-                        } else {
-                            (r % 6200) as f32 / 100.0
-                        }
-                    })
-                    .collect();
-                let strips: Vec<Strip> = (0..w as u32 / sw)
-                    .map(|k| {
-                        let x0 = if toward > 0.0 {
-                            k * sw
-                        } else {
-                            w as u32 - (k + 1) * sw
-                        };
-                        Strip {
-                            x0,
-                            width: sw,
-                            toward,
-                            lo: 0,
-                            hi: w as i64,
-                        }
-                    })
-                    .collect();
-                // Reference: each strip reads image A (as the earlier strips left it) and
-                // writes B, then B becomes A.
-                let mut a = start.clone();
-                for strip in &strips {
-                    let mut b = a.clone();
-                    for x in strip.x0 as usize..(strip.x0 + strip.width) as usize {
-                        let p = sources[x];
-                        if !p.is_nan() {
-                            let (i0, i1, t) = address(p, bilinear);
-                            b[x] = mix(a[i0], a[i1], t);
-                        }
-                    }
-                    a = b;
-                }
-                for simd in [false, true] {
-                    if simd && !avx2_available() {
-                        continue; // the scalar loop alone (see `avx2_to_compare`)
-                    }
-                    let mut row = vec![[0u8; 4]; w];
-                    for strip in &strips {
-                        let pat = |x: usize| pattern.color(x as u32, y);
-                        #[cfg(target_arch = "x86_64")]
-                        if simd {
-                            unsafe { avx2::resolve_row(&mut row, &sources, strip, bilinear, pat) };
-                            continue;
-                        }
-                        resolve_row(&mut row, &sources, strip, bilinear, pat);
-                    }
-                    assert!(
-                        row == a,
-                        "bilinear {bilinear}, toward {toward}, simd {simd}"
-                    );
-                }
-            }
-        }
-    }
-
-    /// The AVX2 loops only change the speed: for both starts and both filters, on an even and
-    /// an odd size (spans and strips that end mid-vector), they give the scalar loops' pixels
-    /// and links, byte for byte.
-    #[test]
-    fn avx2_strips_match_scalar_strips() {
-        if !crate::raster::avx2_to_compare("avx2_strips_match_scalar_strips") {
-            return;
-        }
-        for (w, h, tris) in [(512, 256, 2_500), (301, 77, 400)] {
-            let s = table_scene(w, h, tris, 10).expect("bench scene");
-            let center = StereoRig::center(&s.camera, s.aspect()).expect("camera");
-            let d = s.sirds.geometry.to_pixels().expect("geometry");
-            let (fb, _) = render_view(&s, &center, Shading::DepthOnly).expect("depth pass");
-            let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far).expect("range");
-            let g = StripGeometry::new(&s, &center, &range, &d, false);
-            for start in [Start::Left, Start::Center] {
-                for filter in [Filter::Nearest, Filter::Bilinear] {
-                    let opts = PerVertexOptions {
-                        start,
-                        filter,
-                        iterations: None,
-                        ..PerVertexOptions::default()
-                    };
-                    let run = |simd| {
-                        per_vertex(
-                            &g,
-                            w,
-                            h,
-                            &d,
-                            &s.sirds.pattern,
-                            &PerVertexOptions { simd, ..opts },
-                            true,
-                        )
-                        .expect("strips")
-                    };
-                    let (fast, plain) = (run(true), run(false));
-                    let differ = fast
-                        .pixels
-                        .iter()
-                        .zip(&plain.pixels)
-                        .filter(|(a, b)| a != b);
-                    assert_eq!(
-                        differ.count(),
-                        0,
-                        "{w}x{h} {start:?} {filter:?}: pixels differ"
-                    );
-                    assert_eq!(
-                        fast.links, plain.links,
-                        "{w}x{h} {start:?} {filter:?}: links"
-                    );
-                }
-            }
-        }
-    }
-}
+mod tests;
