@@ -233,8 +233,8 @@ impl Shader for UvShader<'_> {
         self.mvp * self.mesh.positions[i as usize].extend(1.0)
     }
     fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
-        // Keep the float: pack u into the color channels' bits is overkill; the benchmark
-        // reads `UV_OUT` instead via `collect_uv`.
+        // The color is only for looking at; the benchmark reads the exact floats through
+        // `RecordUv`, which wraps this shader.
         Some(crate::shade::to_rgba8(Vec3::new(
             f.varyings[0],
             f.varyings[1],

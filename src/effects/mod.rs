@@ -1,5 +1,7 @@
-//! Pure functions of framebuffers and the rig: layouts now; anaglyphs, remapping, parallax,
-//! ChromaDepth and SIRDS as they land.
+//! The effects: pure functions of framebuffers, matrices and their own settings types (never a
+//! `Scene`, `Frame`, `Plan` or `Output`): anaglyphs, remapping and the visibility check,
+//! occlusion, parallax and its budget, layouts, ChromaDepth's ramp, texgen and glasses, and the
+//! SIRDS pieces (pattern, disparity, TIW linking, depth maps, decoding).
 
 pub mod anaglyph;
 pub mod chromadepth;
