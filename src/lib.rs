@@ -21,8 +21,8 @@
 //! import that goes up or round in a cycle (`cargo test --test main architecture --
 //! --nocapture` prints the graph):
 //! [`error`] → [`math`], [`framebuffer`], [`shade`] → [`raster`] → [`effects`] → [`plan`] →
-//! [`scene`] → [`fixtures`] → [`render`] → [`output`] → [`info`], [`figures`], [`compare`] →
-//! `gpu` (feature `gpu`), [`exercise`] → [`grade`], [`bench`].
+//! [`scene`] → [`fixtures`] → [`render`](mod@render) → [`output`] → [`info`], [`figures`], [`compare`] →
+//! `gpu` (feature `gpu`), [`exercise`] → [`grade`], [`bench`](mod@bench).
 //!
 //! The repository's `docs/ARCHITECTURE.md` has the conventions (coordinates, llvmpipe's
 //! rasterization rules, determinism), `docs/sources.md` the course's five source documents.

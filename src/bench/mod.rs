@@ -96,7 +96,7 @@ pub(crate) fn median_ms<T>(iters: usize, mut f: impl FnMut() -> T) -> f64 {
 /// Runs every benchmark group `opts.only` asks for (all when empty).
 ///
 /// # Errors
-/// `Invalid` naming `bench.only` for a group not in [`GROUPS`]. The scene cannot be loaded or
+/// `Invalid` naming `bench.only` for a group not in `GROUPS`. The scene cannot be loaded or
 /// rendered.
 pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     if let Some(bad) = opts.only.iter().find(|g| !GROUPS.contains(&g.as_str())) {

@@ -5,7 +5,7 @@
 //!
 //! Every number comes from the CPU modules (matrices from [`AnaglyphKind::matrices`], rig values
 //! from [`ParallaxRig`], colors from `occlusion`, the tolerance from
-//! [`DEPTH_PRECISION`](crate::effects::remap::DEPTH_PRECISION)); the shaders hold formulas only.
+//! [`DEPTH_PRECISION`]); the shaders hold formulas only.
 
 use glam::{DMat4, Mat4};
 use image::RgbaImage;

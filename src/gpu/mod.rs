@@ -14,7 +14,7 @@
 //!
 //! Layout: [`device`] (adapter, device, pipeline cache), [`raster`] (scene passes),
 //! [`fullscreen`] (the generic full-screen pass that effects mirror), [`effects`] (the finalize
-//! effects in WGSL), [`readback`] (textures to
+//! effects in WGSL), `readback` (textures to
 //! framebuffers), [`sirds`] (the SIRDS paper's strips as render-to-texture ping-pong), [`parity`]
 //! (render both paths and compare, and the benchmark row).
 

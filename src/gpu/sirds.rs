@@ -1,7 +1,7 @@
 //! The SIRDS paper's per-vertex strip algorithm as the paper built it, on the GPU: render-to-texture
 //! ping-pong (§4). A mirror of [`per_vertex`](crate::render::sirds_strips::per_vertex)
 //! on the same [`StripGeometry`] and the same strips
-//! ([`plan_strips`](crate::effects::sirds::per_vertex)):
+//! ([`plan_strips`](crate::render::sirds_strips)):
 //!
 //! - texture A holds the image so far (the pattern at first), texture B is the render target;
 //! - each iteration draws the whole scene into B with the scissor rect = its strip (the CPU

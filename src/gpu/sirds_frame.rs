@@ -15,7 +15,7 @@ use super::device::GpuRenderer;
 use super::sirds::GpuStrips;
 
 /// The scene's SIRDS (output `sirds`) from `frame`'s depth pass, as
-/// [`sirds::from_frame`](crate::output::sirds::from_frame) but with the strips on the GPU.
+/// [`sirds::from_frame`] but with the strips on the GPU.
 /// The per-pixel algorithm (TIW: a serial chain of links along each row) has no WGSL mirror and
 /// runs on the CPU.
 ///
@@ -42,7 +42,7 @@ pub fn from_frame(
 }
 
 /// Strip parity apart from raster parity: the SIRDS of the CPU frame's own depth pass made by
-/// the CPU strips and by the WGSL strips (same [`StripGeometry`], same strips), as a row
+/// the CPU strips and by the WGSL strips (same [`StripGeometry`](crate::render::sirds_strips::StripGeometry), same strips), as a row
 /// `sirds (wgsl strips)`. Empty unless the plan makes a per-vertex `sirds`.
 ///
 /// # Errors

@@ -2,7 +2,7 @@
 //!
 //! The reference is stereolab's SIRDS module: its Eq. (3) separation and its per-pixel linking
 //! (`effects::sirds::per_pixel::RowLinker`, Thimbleby, Inglis and Witten's algorithm). The known
-//! mistakes are modelled by [`variant_links`], which a unit test holds equal to the module when
+//! mistakes are modelled by `variant_links`, which a unit test holds equal to the module when
 //! no mistake is switched on.
 
 use serde_json::json;

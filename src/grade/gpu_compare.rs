@@ -1,11 +1,11 @@
 //! `stereolab compare --exercise ex1 SCENE`: the student's stereo matrices rendered on the CPU
 //! against the reference rig rendered on the GPU. Compiled only with `--features gpu`.
 //!
-//! The student's crate is built and run exactly as the grader does ([`child::build`],
-//! [`child::run`], the `stereo_matrices` task's input per eye), and the answers become pictures
-//! as in `render --exercise` ([`ex1::eye_matrices_from_answer`], then
+//! The student's crate is built and run exactly as the grader does (`child::build`,
+//! `child::run`, the `stereo_matrices` task's input per eye), and the answers become pictures
+//! as in `render --exercise` (`ex1::eye_matrices_from_answer`, then
 //! [`crate::render::render_view`]). The expected pictures are the exercise slides' off-axis rig
-//! ([`reference_rig`]) with the scene's separation, screen distance and lighting, rendered by
+//! (`reference_rig`) with the scene's separation, screen distance and lighting, rendered by
 //! [`GpuRenderer::render_views`].
 
 use std::path::Path;

@@ -84,7 +84,7 @@ pub(crate) const BAND_ROWS: usize = 32;
 
 /// Rasterizes `triangles` (indices into the shader's vertices) into `fb`.
 ///
-/// Vertex stage and setup run once; traversal runs in parallel over bands of [`BAND_ROWS`]
+/// Vertex stage and setup run once; traversal runs in parallel over bands of `BAND_ROWS`
 /// rows, each band applying the triangles in order, so the bytes never depend on the thread
 /// count.
 pub fn rasterize<S: Shader>(

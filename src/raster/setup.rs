@@ -241,7 +241,7 @@ impl SetupTriangle {
     ///
     /// llvmpipe's rule (docs/ARCHITECTURE.md "Rasterization rules"): the vertices are snapped
     /// to a grid of `S = 2^bits` steps per pixel, placed so that pixel `p`'s center is grid
-    /// point `p·S` ([`snap`]), and ordered so that the inside is on the positive side. Edge `i`,
+    /// point `p·S` (`snap`), and ordered so that the inside is on the positive side. Edge `i`,
     /// from vertex `i` to vertex `i + 1`, has `dcdx = Y_i − Y_{i+1}`, `dcdy = X_i − X_{i+1}` and
     /// `c = dcdx·X_i − dcdy·Y_i`; the pixel is covered when, on all three edges,
     /// `c + bias + dcdy·py·S − dcdx·px·S − 1 ≥ 0`, in 64-bit integers.

@@ -7,11 +7,12 @@
 //!
 //! - [`disparity`]: eq. 1 and eq. 3, physical units → pixels in one place;
 //! - [`depthmap`]: nearness per pixel from the depth pass or an image file;
-//! - [`per_vertex`]: the SIRDS paper's strip algorithm on stereolab's rasterizer;
+//! - the SIRDS paper's strip algorithm on stereolab's rasterizer is a pass:
+//!   [`render::sirds_strips`](crate::render::sirds_strips);
 //! - [`per_pixel`]: TIW with hidden-surface removal and oversampling;
 //! - [`pattern`]: random dots, pattern images, guide dots;
 //! - [`decode`]: separation (and depth) back from a finished image;
-//! - [`animate`]: a rotating model as an animated GIF.
+//! - a rotating model as an animated GIF: [`output::animate`](crate::output::animate).
 
 pub mod decode;
 pub mod depthmap;

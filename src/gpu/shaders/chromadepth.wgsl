@@ -1,4 +1,4 @@
-// The ChromaDepth pass: a mirror of `ChromaDepthShader` in src/effects/chromadepth/shader.rs.
+// The ChromaDepth pass: a mirror of `ChromaDepthShader` in src/render/chromadepth.rs.
 // Eye-linear texgen `s = A x + B y + C z + D` on the eye-space vertex (per vertex, interpolated)
 // or from the fragment's own window depth (per pixel), then the ramp sampled like an OpenGL 1D
 // texture with GL_CLAMP_TO_EDGE (`Ramp::sample`), optionally scaled by a gray diffuse term.

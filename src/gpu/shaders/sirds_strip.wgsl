@@ -1,5 +1,5 @@
 // The SIRDS paper's strip pass (§3–4, Fig. 4) on the GPU: a mirror of `StripShader` in
-// src/effects/sirds/per_vertex.rs. The host uploads the shifted clip positions (x + toward·s·w/W,
+// src/render/sirds_strips/. The host uploads the shifted clip positions (x + toward·s·w/W,
 // computed exactly as the CPU does, z already in wgpu's [0, w]) and each vertex's separation s;
 // the scissor rect is the strip, so only its pixels are shaded. The fragment reads the previous
 // image (`image`, RGBA8 as 0..1) at x − toward·s with `textureLoad` (no sampler: exact texels).

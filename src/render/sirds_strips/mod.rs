@@ -375,7 +375,7 @@ fn resolve_strip(
 
 /// Makes a SIRDS with the strip algorithm.
 ///
-/// Triangle setup once per direction; then, per band of [`BAND_ROWS`] rows (in parallel: rows
+/// Triangle setup once per direction; then, per band of `BAND_ROWS` rows (in parallel: rows
 /// never interact), the winning fragment's source per pixel (`band_sources`) and the strips
 /// in order, each reading the image the earlier strips finished (`resolve_strip`). The
 /// result is the paper's k render passes, byte for byte (see the module notes).

@@ -7,7 +7,7 @@
 //!
 //! - A, the image so far: the random-dot pattern at first;
 //! - per strip, one pass renders the whole scene into B (a copy of A, depth cleared) with
-//!   Fig. 4's programs ([`StripPass`]): every vertex shifted by `toward · d(v)/2`, every
+//!   Fig. 4's programs (`StripPass`): every vertex shifted by `toward · d(v)/2`, every
 //!   fragment textured from A at `x − toward · d`, the depth test LESS deciding visibility;
 //! - B's strip is copied to A; the rest of B is dropped (a strip narrower than the front
 //!   separation `δ` reads only finished strips, so it never changes again, §3).
