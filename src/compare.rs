@@ -189,7 +189,7 @@ pub fn table(rows: &[Comparison]) -> String {
 }
 
 /// Limits past which `stereolab compare` exits non-zero. The defaults are the GPU parity
-/// targets (the README's "CPU vs GPU" section has the measured figures they leave room for).
+/// targets (docs/gpu-parity.md has the measured figures they leave room for).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Thresholds {
     /// Largest coverage mismatch, % of pixels (`coverage=`). Target: 0.1 (≥ 99.9% identical).

@@ -3,7 +3,7 @@
 //! difference here is the effect's alone, never rasterization's.
 //!
 //! Every tolerance is measured on this machine (lavapipe, Mesa 22.3.6, LLVM 15.0.6) and stated
-//! where it is asserted; the README's "CPU vs GPU" section has the figures.
+//! where it is asserted; docs/gpu-parity.md has the figures.
 
 use image::RgbaImage;
 use stereolab::Framebuffer;
@@ -188,7 +188,7 @@ fn wgsl_remap_and_occlusion_match_the_cpu_on_identical_eyes() {
 
 /// Pixels of a ChromaDepth pass allowed to differ by more than the sampling bound: where two
 /// faces meet at a crease, both depth planes reach the pixel center within a few ulps, the
-/// paths' depth evaluations differ by up to 3e-7 (README), so either face may win the depth
+/// paths' depth evaluations differ by up to 3e-7 (docs/gpu-parity.md), so either face may win the depth
 /// test. Unlit, both faces have the same `s` there and the color agrees; lit, the other face's
 /// diffuse shows. Measured: 0 pixels at 320×240 in every mode; 4 of 786 432 on
 /// chromadepth_fault.toml at 1024×768 (one crease of the fault, lit, max difference 132).

@@ -5,7 +5,7 @@
 //! because CI installs `mesa-vulkan-drivers` and a missing adapter there is a broken setup.
 //!
 //! Every tolerance names where its number came from: measured on this machine (lavapipe, Mesa
-//! 22.3.6, LLVM 15.0.6, 256 bits; x86-64 CPU path) and written up in the README's "CPU vs GPU" section.
+//! 22.3.6, LLVM 15.0.6, 256 bits; x86-64 CPU path) and written up in docs/gpu-parity.md.
 
 use std::io::Write as _;
 use std::path::Path;
@@ -187,7 +187,7 @@ fn assert_same_coverage(name: &str, cpu: &Framebuffer, gpu: &Framebuffer) {
 
 /// Largest channel difference on grid scenes. Measured here: 1 (over all 60 scenes); the
 /// difference is a rounding at a .5 boundary after pow/sqrt/rcp that llvmpipe computes with
-/// different precision than libm (the README's "CPU vs GPU" section), never more than one step.
+/// different precision than libm (docs/gpu-parity.md), never more than one step.
 const GRID_MAX_CHANNEL_DIFF: u8 = 1;
 /// Depth where both cover: the target of issue 6. Measured here: 9.6e-7 on the real model,
 /// 4.3e-7 on the clipped scene, up to 3.8e-6 on grid scenes whose triangles are no steeper

@@ -75,8 +75,8 @@ fn gpu_strips_match_cpu_strips_and_decode() {
                     rt.within_one * 100.0
                 );
                 report += &line;
-                // Measured on this machine (lavapipe, Mesa 22.3.6): see the README's "CPU vs
-                // GPU". The thresholds sit under the worst variant.
+                // Measured on this machine (lavapipe, Mesa 22.3.6): see docs/gpu-parity.md. The
+                // thresholds sit under the worst variant.
                 assert!(same >= MIN_IDENTICAL, "{line}{report}");
                 assert!(max <= MAX_DIFF, "{line}{report}");
                 // The CPU tests' floor (tests/sirds.rs RAMP_WITHIN_ONE, SPHERE_WITHIN_ONE).

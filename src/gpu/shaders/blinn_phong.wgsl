@@ -1,6 +1,6 @@
 // Blinn-Phong in eye space: a line-by-line mirror of `BlinnPhong` in src/shade.rs, so that the
 // GPU path differs from the CPU path only where the hardware rounds differently (fused
-// multiply-add, reciprocal, sqrt and pow precision: the README's "CPU vs GPU" section).
+// multiply-add, reciprocal, sqrt and pow precision: docs/gpu-parity.md).
 
 struct Uniforms {
     // view · model (`BlinnPhong::modelview`).
