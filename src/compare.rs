@@ -141,9 +141,7 @@ pub fn write_diff_strip(
     });
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let path = dir.join(format!("{name}.png"));
-    strip
-        .save(&path)
-        .map_err(|e| Error::io(&path, std::io::Error::other(e.to_string())))?;
+    crate::files::write_png(&path, &strip)?;
     Ok(path)
 }
 

@@ -51,8 +51,10 @@ fn dot(pm: &mut Pixmap, c: (f32, f32), r: f32, rgb: (u8, u8, u8)) {
 }
 
 fn save(pm: &Pixmap, path: &Path) -> Result<PathBuf> {
-    pm.save_png(path)
+    let png = pm
+        .encode_png()
         .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))?;
+    crate::files::write_bytes(path, &png)?;
     Ok(path.to_path_buf())
 }
 

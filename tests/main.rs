@@ -18,6 +18,7 @@ mod gpu_parity;
 mod gpu_sirds;
 mod grading;
 mod layout;
+mod reliability;
 mod rig;
 mod scene_hashes;
 mod sirds;

@@ -412,5 +412,5 @@ pub fn write_csv(rows: &[Row], path: &Path) -> Result<()> {
             q(&r.note)
         );
     }
-    std::fs::write(path, s).map_err(|e| Error::io(path, e))
+    crate::files::write_bytes(path, s.as_bytes())
 }

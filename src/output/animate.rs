@@ -1,7 +1,6 @@
 //! A rotating model as an animated SIRDS GIF (the SIRDS paper's §5: animated SIRDS stay fusable, and a
 //! pattern that changes every frame keeps the eyes on the object rather than the dots).
 
-use std::io::BufWriter;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
@@ -11,6 +10,7 @@ use image::{Delay, Frame};
 use super::sirds::from_frame;
 use crate::effects::sirds::Pattern;
 use crate::error::{Error, Result};
+use crate::files;
 use crate::plan::{Output, Plan};
 use crate::render::render;
 use crate::scene::Scene;
@@ -77,34 +77,50 @@ pub fn animate(
     );
     let models: Vec<Mat4> = scene.objects.iter().map(|o| o.model).collect();
     let plan = Plan::new(&[Output::Sirds]);
-    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    let mut gif = GifEncoder::new_with_speed(BufWriter::new(file), 10);
-    let gif_error = |e: image::ImageError| Error::io(path, std::io::Error::other(e.to_string()));
-    gif.set_repeat(Repeat::Infinite).map_err(gif_error)?;
     let seed_pattern = scene.sirds.pattern.clone();
-    for i in 0..opts.frames {
-        let angle = std::f32::consts::TAU * i as f32 / opts.frames as f32;
-        let turn = Mat4::from_translation(pivot)
-            * Mat4::from_rotation_y(angle)
-            * Mat4::from_translation(-pivot);
-        for (o, m) in s.objects.iter_mut().zip(&models) {
-            o.model = turn * *m;
-        }
-        if !opts.fixed_seed {
-            let seed = match &seed_pattern {
-                Pattern::BlackWhite { seed } | Pattern::Gray { seed } | Pattern::Color { seed } => {
-                    seed.wrapping_add(i as u64)
+    // The frames stream into a temporary file renamed onto `path` only once the last one is in:
+    // a failed or killed run never leaves a truncated GIF. A render error is kept here (the
+    // writer only sees that it stopped).
+    let mut failed = None;
+    let written = files::write_atomic(path, |w| {
+        let mut gif = GifEncoder::new_with_speed(w, 10);
+        gif.set_repeat(Repeat::Infinite)
+            .map_err(files::image_error)?;
+        let mut frame_of = |i: u32| -> Result<Frame> {
+            let angle = std::f32::consts::TAU * i as f32 / opts.frames as f32;
+            let turn = Mat4::from_translation(pivot)
+                * Mat4::from_rotation_y(angle)
+                * Mat4::from_translation(-pivot);
+            for (o, m) in s.objects.iter_mut().zip(&models) {
+                o.model = turn * *m;
+            }
+            if !opts.fixed_seed {
+                let seed = match &seed_pattern {
+                    Pattern::BlackWhite { seed }
+                    | Pattern::Gray { seed }
+                    | Pattern::Color { seed } => seed.wrapping_add(i as u64),
+                    Pattern::Image(_) => 0,
+                };
+                s.sirds.pattern = seed_pattern.reseeded(seed);
+            }
+            let sirds = from_frame(&render(&s, &plan)?, &s)?;
+            let delay = Delay::from_numer_denom_ms(opts.delay_ms, 1);
+            Ok(Frame::from_parts(sirds.to_rgba_image(), 0, 0, delay))
+        };
+        for i in 0..opts.frames {
+            match frame_of(i) {
+                Ok(f) => gif.encode_frame(f).map_err(files::image_error)?,
+                Err(e) => {
+                    failed = Some(e);
+                    return Err(std::io::Error::other("stopped"));
                 }
-                Pattern::Image(_) => 0,
-            };
-            s.sirds.pattern = seed_pattern.reseeded(seed);
+            }
+            on_frame(i + 1, opts.frames);
         }
-        let frame = render(&s, &plan)?;
-        let sirds = from_frame(&frame, &s)?;
-        let delay = Delay::from_numer_denom_ms(opts.delay_ms, 1);
-        gif.encode_frame(Frame::from_parts(sirds.to_rgba_image(), 0, 0, delay))
-            .map_err(gif_error)?;
-        on_frame(i + 1, opts.frames);
+        Ok(())
+    });
+    match (failed, written) {
+        (Some(e), _) => Err(e),
+        (None, r) => r,
     }
-    Ok(())
 }

@@ -10,6 +10,7 @@ use crate::effects::parallax::parallax_image;
 use crate::effects::remap::{Precision, remap_color};
 use crate::effects::{anaglyph, layout, occlusion};
 use crate::error::{Error, Result};
+use crate::files;
 use crate::framebuffer::Framebuffer;
 use crate::plan::{Output, View};
 use crate::render::Frame;
@@ -24,16 +25,15 @@ pub enum Image {
 }
 
 impl Image {
-    /// Writes the image as PNG.
+    /// Writes the image as PNG, all or nothing ([`files::write_atomic`]).
     ///
     /// # Errors
-    /// The file cannot be written.
+    /// The file cannot be written, or its name is a link or a special file.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        let r = match self {
-            Image::Rgba(i) => i.save_with_format(path, image::ImageFormat::Png),
-            Image::Gray16(i) => i.save_with_format(path, image::ImageFormat::Png),
-        };
-        r.map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
+        match self {
+            Image::Rgba(i) => files::write_png(path, i),
+            Image::Gray16(i) => files::write_png(path, i),
+        }
     }
 }
 
@@ -143,14 +143,23 @@ pub(crate) fn write_all_with(
     dir: &Path,
     mut make: impl FnMut(Output) -> Result<Image>,
 ) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    frame
+    // Every output is made (and every final name checked) before any is written: an output
+    // that fails leaves the folder as it was.
+    let outputs = frame
         .plan
         .outputs
         .iter()
         .map(|&o| {
             let path = dir.join(format!("{}.png", o.name()));
-            make(o)?.save_png(&path)?;
+            files::check_output_path(&path)?;
+            Ok((path, make(o)?))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    outputs
+        .into_iter()
+        .map(|(path, image)| {
+            image.save_png(&path)?;
             Ok(path)
         })
         .collect()

@@ -2,13 +2,13 @@
 //! and the algorithm the scene chose (the strips pass or TIW), guide dots last; and the SIRDS
 //! files (PNG or PPM, streamed for large depth maps).
 
-use std::io::Write as _;
 use std::path::Path;
 
 use crate::effects::sirds::{
     Algorithm, DepthMap, DepthRange, Disparity, Settings, Sirds, depth_range, pattern, per_pixel,
 };
 use crate::error::{Error, Result};
+use crate::files;
 use crate::framebuffer::Framebuffer;
 use crate::plan::View;
 use crate::render::Frame;
@@ -101,10 +101,11 @@ pub(crate) fn from_frame_with(
     })
 }
 
-/// Writes RGBA pixels as PNG, or as binary PPM (P6, no compression) for `.ppm`/`.pnm`.
+/// Writes RGBA pixels as PNG, or as binary PPM (P6, no compression) for `.ppm`/`.pnm`, all or
+/// nothing ([`files::write_atomic`]).
 ///
 /// # Errors
-/// The file cannot be written.
+/// The file cannot be written, or its name is a link or a special file.
 pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<()> {
     let ext = path
         .extension()
@@ -112,9 +113,7 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
         .unwrap_or("")
         .to_ascii_lowercase();
     if ext == "ppm" || ext == "pnm" {
-        let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
-        let mut write = || -> std::io::Result<()> {
+        files::write_atomic(path, |w| {
             write!(w, "P6\n{width} {height}\n255\n")?;
             let mut row = Vec::with_capacity(width as usize * 3);
             for line in pixels.chunks_exact(width.max(1) as usize) {
@@ -122,14 +121,17 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
                 row.extend(line.iter().flat_map(|p| [p[0], p[1], p[2]]));
                 w.write_all(&row)?;
             }
-            w.flush()
-        };
-        write().map_err(|e| Error::io(path, e))
+            Ok(())
+        })
     } else {
         let bytes = pixels.iter().flatten().copied().collect();
-        let img = image::RgbaImage::from_raw(width, height, bytes).expect("buffer size matches");
-        img.save(path)
-            .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
+        let img = image::RgbaImage::from_raw(width, height, bytes).ok_or_else(|| {
+            Error::internal(
+                "sirds",
+                format!("{} pixels for {width}x{height}", pixels.len()),
+            )
+        })?;
+        files::write_png(path, &img)
     }
 }
 
@@ -159,25 +161,35 @@ pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result
             if invert { 1.0 - z } else { z }
         }));
     };
-    let file = std::fs::File::create(out).map_err(|e| Error::io(out, e))?;
-    let mut writer = std::io::BufWriter::with_capacity(1 << 20, file);
-    write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| Error::io(out, e))?;
-    let mut bytes = Vec::new();
-    crate::effects::sirds::per_pixel::per_pixel_streamed(
-        width,
-        height,
-        depth_row,
-        &settings.geometry.to_pixels()?,
-        &settings.pattern,
-        &settings.per_pixel,
-        |rows| {
-            bytes.resize(rows.len() * 3, 0);
-            for (b, p) in bytes.chunks_exact_mut(3).zip(rows) {
-                b.copy_from_slice(&p[..3]);
-            }
-            writer.write_all(&bytes).map_err(|e| Error::io(out, e))
-        },
-    )?;
-    writer.flush().map_err(|e| Error::io(out, e))?;
-    Ok((width, height))
+    let d = settings.geometry.to_pixels()?;
+    // The rows stream into a temporary file; a failure in TIW (kept here, the writer only
+    // sees that it stopped) or in the writing leaves `out` as it was.
+    let mut failed = None;
+    let written = files::write_atomic(out, |writer| {
+        write!(writer, "P6\n{width} {height}\n255\n")?;
+        let mut bytes = Vec::new();
+        let streamed = crate::effects::sirds::per_pixel::per_pixel_streamed(
+            width,
+            height,
+            depth_row,
+            &d,
+            &settings.pattern,
+            &settings.per_pixel,
+            |rows| {
+                bytes.resize(rows.len() * 3, 0);
+                for (b, p) in bytes.chunks_exact_mut(3).zip(rows) {
+                    b.copy_from_slice(&p[..3]);
+                }
+                writer.write_all(&bytes).map_err(|e| Error::io(out, e))
+            },
+        );
+        streamed.map_err(|e| {
+            failed = Some(e);
+            std::io::Error::other("stopped")
+        })
+    });
+    match (failed, written) {
+        (Some(e), _) => Err(e),
+        (None, r) => r.map(|()| (width, height)),
+    }
 }

@@ -43,7 +43,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         opts.scene = s;
     }
     let rows = bench::run(&opts)?;
-    print!("{}", bench::table(&rows));
+    out!("{}", bench::table(&rows));
     if let Some(path) = csv {
         bench::write_csv(&rows, &path)?;
     }

@@ -93,12 +93,12 @@ pub fn run(args: CompareArgs) -> Result<()> {
             compare_scene(&s, out.as_deref())?
         }
     };
-    print!("{}", compare::table(&rows));
+    out!("{}", compare::table(&rows));
     for p in rows.iter().filter_map(|r| r.strip.as_ref()) {
-        println!("  wrote {}", p.display());
+        outln!("  wrote {}", p.display());
     }
     for p in &problems {
-        println!("  {p}");
+        outln!("  {p}");
     }
     let mut failed = limits.violations(&rows);
     failed.extend(problems);
@@ -128,7 +128,7 @@ fn parse_rgb(s: &str) -> Result<[u8; 4]> {
 #[cfg(feature = "gpu")]
 fn compare_scene(scene: &Scene, out: Option<&std::path::Path>) -> Result<Vec<Comparison>> {
     let r = stereolab::gpu::GpuRenderer::new()?;
-    println!("cpu (expected) vs gpu (actual): {}", r.adapter_name());
+    outln!("cpu (expected) vs gpu (actual): {}", r.adapter_name());
     stereolab::gpu::parity::compare_scene(&r, scene, &Plan::new(&scene.outputs), out)
 }
 
@@ -148,7 +148,7 @@ fn compare_exercise(
 ) -> Result<(Vec<Comparison>, Vec<String>)> {
     let dir = grade::exercises_dir(exercises)?;
     let r = stereolab::gpu::GpuRenderer::new()?;
-    println!(
+    outln!(
         "gpu reference (expected) vs your matrices on the cpu (actual): {}",
         r.adapter_name()
     );

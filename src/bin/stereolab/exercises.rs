@@ -33,6 +33,6 @@ pub fn run(command: ExercisesCommand) -> Result<()> {
         }
     });
     grade::export::export(&root, &dir)?;
-    println!("wrote the student handout to {}", dir.display());
+    outln!("wrote the student handout to {}", dir.display());
     Ok(())
 }

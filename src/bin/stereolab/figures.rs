@@ -22,7 +22,7 @@ pub struct FiguresArgs {
 pub fn run(args: FiguresArgs) -> Result<()> {
     let s = super::load_scene(&args.scene, &[], None)?;
     for p in figures::write_all(&s, &args.out)? {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display());
     }
     Ok(())
 }

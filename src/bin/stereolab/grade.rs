@@ -49,11 +49,11 @@ pub fn run(args: GradeArgs) -> Result<()> {
         out,
     };
     let report = grade::grade(&opts, grade::fixture::grading_scene()?)?;
-    print!("{}", report.text());
+    out!("{}", report.text());
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&report.gradescope())
             .map_err(|e| Error::io(&path, std::io::Error::other(e)))?;
-        std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+        stereolab::files::write_bytes(&path, text.as_bytes())?;
     }
     Ok(())
 }

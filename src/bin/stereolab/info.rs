@@ -22,6 +22,6 @@ pub struct InfoArgs {
 /// The scene cannot be loaded or its rig is invalid.
 pub fn run(args: InfoArgs) -> Result<()> {
     let s = super::load_scene(&args.scene, &args.sets, None)?;
-    print!("{}", info::describe(&s)?);
+    out!("{}", info::describe(&s)?);
     Ok(())
 }

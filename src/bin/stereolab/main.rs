@@ -2,6 +2,21 @@
 //! does the work; this binary parses arguments, prints, and sets process-wide things (the
 //! allocator, the thread pool, `STEREOLAB_SCALAR`).
 
+/// `print!` to standard output, but a closed pipe or a full disk comes back as an error (which
+/// `main` reports, or ends on quietly for a closed pipe) instead of a panic.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        crate::write_stdout(format_args!($($arg)*))?
+    };
+}
+
+/// `println!` as [`out!`] does it.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        crate::write_stdout(format_args!("{}\n", format_args!($($arg)*)))?
+    };
+}
+
 mod bench;
 mod compare;
 mod exercises;
@@ -11,6 +26,8 @@ mod info;
 mod render;
 mod sirds;
 
+use std::io::Write as _;
+use std::path::Path;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -97,6 +114,21 @@ fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Re
     Ok(s)
 }
 
+/// Writes to standard output and flushes, reporting what the write met.
+fn write_stdout(args: std::fmt::Arguments) -> Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_fmt(args)
+        .and_then(|()| stdout.flush())
+        .map_err(|e| Error::io(Path::new("standard output"), e))
+}
+
+/// Whether `e` is a write to standard output whose reader went away (`stereolab info … | head`):
+/// the normal end of a pipeline, not a failure.
+fn is_closed_pipe(e: &Error) -> bool {
+    matches!(e, Error::Io { source, .. } if source.kind() == std::io::ErrorKind::BrokenPipe)
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render(args) => render::run(args),
@@ -123,8 +155,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if is_closed_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // Standard error may be gone too; nothing more can be said then.
+            let _ = writeln!(std::io::stderr(), "error: {e}");
             ExitCode::FAILURE
         }
     }

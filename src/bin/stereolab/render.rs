@@ -71,13 +71,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let dir = grade::exercises_dir(exercises)?;
         let timeout = Duration::from_secs(30);
         for line in grade::render_exercise(ex, s, &dir, solution, timeout, &out)? {
-            println!("{line}");
+            outln!("{line}");
         }
         return Ok(());
     }
     let plan = Plan::new(&s.outputs);
     if explain {
-        print!("{}", plan.explain());
+        out!("{}", plan.explain());
         return Ok(());
     }
     let (frame, paths) = match backend {
@@ -88,20 +88,20 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         Backend::Gpu => render_gpu(&s, &plan, &out)?,
     };
-    println!("rendered {} ({}x{})", scene.display(), s.width, s.height);
+    outln!("rendered {} ({}x{})", scene.display(), s.width, s.height);
     if backend == Backend::Gpu {
         let ms = frame
             .passes
             .first()
             .map_or(0.0, |p| p.time.as_secs_f64() * 1e3);
-        println!(
+        outln!(
             "  {} passes on the GPU in one submission: {ms:.2} ms including readback \
              and, on this first frame, shader compilation",
             frame.passes.len()
         );
     }
     for p in frame.passes.iter().filter(|_| backend == Backend::Cpu) {
-        println!(
+        outln!(
             "  pass {:?} {:?}: {:.2} ms, {} triangles, {} fragments, {} clipped, {} culled",
             p.pass.view,
             p.pass.shading,
@@ -113,10 +113,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
         );
     }
     if let Some(report) = info::frame_budget_report(&frame, &s)? {
-        print!("{report}");
+        out!("{report}");
     }
     for p in paths {
-        println!("  wrote {}", p.display());
+        outln!("  wrote {}", p.display());
     }
     Ok(())
 }
@@ -135,7 +135,7 @@ pub enum Backend {
 fn render_gpu(scene: &Scene, plan: &Plan, out: &Path) -> Result<(Frame, Vec<PathBuf>)> {
     use stereolab::gpu::{GpuRenderer, GpuScene};
     let r = GpuRenderer::new()?;
-    println!("gpu: {}", r.adapter_name());
+    outln!("gpu: {}", r.adapter_name());
     let frame = r.render(&GpuScene::upload(&r, scene)?, plan)?;
     let paths = stereolab::gpu::output::write_all(&r, &frame, scene, out)?;
     Ok((frame, paths))

@@ -66,7 +66,7 @@ fn settings_from_sets(sets: &[String]) -> Result<Settings> {
 /// # Errors
 /// Any input, render or write error.
 pub fn run(args: &SirdsArgs) -> Result<()> {
-    print!("{}", report(args)?);
+    out!("{}", report(args)?);
     Ok(())
 }
 
@@ -92,14 +92,20 @@ fn report(args: &SirdsArgs) -> Result<String> {
                 }
             })
             .collect();
-        DepthMap {
+        let depth = DepthMap {
             width: w,
             height: h,
             z,
         }
-        .to_image()
-        .save(&args.out)
-        .map_err(|e| Error::io(&args.out, std::io::Error::other(e.to_string())))?;
+        .to_image();
+        let format = image::ImageFormat::from_path(&args.out).map_err(|e| {
+            Error::invalid("--out", args.out.display(), format!("no image format: {e}"))
+        })?;
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        image::DynamicImage::ImageLuma16(depth)
+            .write_to(&mut bytes, format)
+            .map_err(|e| Error::invalid("--out", args.out.display(), e.to_string()))?;
+        stereolab::files::write_bytes(&args.out, bytes.get_ref())?;
         return Ok(format!(
             "{}: {:.1}% of pixels matched a separation in {}..={} px: {}\n  wrote {}\n",
             path.display(),

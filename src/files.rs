@@ -1,0 +1,172 @@
+//! Writing output files so that nothing is lost and nothing half-written is left behind.
+//!
+//! Every file stereolab writes goes through [`write_atomic`]: the bytes go to a temporary file
+//! in the same folder, every write error (including the last flush, which a `BufWriter`'s drop
+//! would swallow) is reported, the data is synced, and only then is the temporary file renamed
+//! onto the final name. A failed or killed run therefore leaves the old file (or none) under
+//! the final name, never a truncated one; a leftover `.NAME.tmp-…` is all a kill can leave.
+//! A final name that is a symbolic link, or exists and is not a regular file, is refused: an
+//! output never writes through a link planted in the output folder.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::error::{Error, Result};
+
+/// Refuses `path` as an output when it is a symbolic link or exists as anything but a regular
+/// file (a folder, a device such as `/dev/full`, a FIFO).
+///
+/// # Errors
+/// `Io` naming the path, saying what it is and what to do.
+pub fn check_output_path(path: &Path) -> Result<()> {
+    let refuse = |what: &str| {
+        Error::io(
+            path,
+            std::io::Error::other(format!(
+                "refusing to write the output: it is {what}; remove it or choose another name"
+            )),
+        )
+    };
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => Err(refuse("a symbolic link")),
+        Ok(m) if m.is_dir() => Err(refuse("a folder")),
+        Ok(m) if !m.is_file() => Err(refuse("a special file (device, FIFO or socket)")),
+        _ => Ok(()),
+    }
+}
+
+/// A temporary name beside `path`: `.NAME.tmp-PID-N` in the same folder (so the rename is
+/// atomic: same file system), unique within the process.
+fn temporary_beside(path: &Path) -> PathBuf {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map_or_else(|| "output".into(), |n| n.to_string_lossy());
+    path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()))
+}
+
+/// Writes the file `path` with `write`, all or nothing: through a temporary file beside it,
+/// renamed onto `path` only after `write` succeeded and the data reached the disk.
+///
+/// # Errors
+/// `path` is refused ([`check_output_path`]), or creating, writing, flushing, syncing or
+/// renaming failed (the temporary file is removed; `path` is as it was).
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut (dyn Write + Send)) -> std::io::Result<()>,
+) -> Result<()> {
+    check_output_path(path)?;
+    let tmp = temporary_beside(path);
+    let result = (|| -> std::io::Result<()> {
+        let file = File::options().write(true).create_new(true).open(&tmp)?;
+        let mut w = BufWriter::with_capacity(1 << 20, file);
+        write(&mut w)?;
+        // `into_inner` flushes and reports what the flush met; a drop would discard it.
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::io(path, e));
+    }
+    Ok(())
+}
+
+/// [`write_atomic`] of `bytes`.
+///
+/// # Errors
+/// As [`write_atomic`].
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic(path, |w| w.write_all(bytes))
+}
+
+/// An image encoding error as an I/O error, so encoders can run inside [`write_atomic`].
+pub fn image_error(e: image::ImageError) -> std::io::Error {
+    match e {
+        image::ImageError::IoError(e) => e,
+        other => std::io::Error::other(other.to_string()),
+    }
+}
+
+/// Writes an image as PNG, all or nothing ([`write_atomic`]).
+///
+/// # Errors
+/// As [`write_atomic`], or the encoder refused the image.
+pub fn write_png<P, C>(path: &Path, image: &image::ImageBuffer<P, C>) -> Result<()>
+where
+    P: image::PixelWithColorType,
+    [P::Subpixel]: image::EncodableLayout,
+    C: std::ops::Deref<Target = [P::Subpixel]>,
+{
+    write_atomic(path, |w| {
+        image
+            .write_with_encoder(image::codecs::png::PngEncoder::new(w))
+            .map_err(image_error)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("stereolab-files-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).expect("temp dir");
+        d
+    }
+
+    fn leftovers(d: &Path) -> Vec<String> {
+        std::fs::read_dir(d)
+            .expect("read dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .filter(|n| n.contains(".tmp-"))
+            .collect()
+    }
+
+    #[test]
+    fn a_failed_write_keeps_the_old_file_and_leaves_no_temporary() {
+        let d = dir("failed");
+        let path = d.join("precious.ppm");
+        std::fs::write(&path, b"precious").expect("seed file");
+        let err = write_atomic(&path, |w| {
+            w.write_all(b"P6\n1 1\n255\n")?;
+            Err(std::io::Error::other("the encoder gave up half way"))
+        })
+        .expect_err("must fail");
+        assert!(err.to_string().contains("half way"), "{err}");
+        assert_eq!(std::fs::read(&path).expect("still there"), b"precious");
+        assert!(leftovers(&d).is_empty(), "{:?}", leftovers(&d));
+    }
+
+    #[test]
+    fn a_successful_write_replaces_the_file_whole() {
+        let d = dir("ok");
+        let path = d.join("out.bin");
+        std::fs::write(&path, b"old and longer").expect("seed file");
+        write_bytes(&path, b"new").expect("write");
+        assert_eq!(std::fs::read(&path).expect("read"), b"new");
+        assert!(leftovers(&d).is_empty());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn symbolic_links_and_special_files_are_refused() {
+        let d = dir("links");
+        let target = d.join("victim.txt");
+        std::fs::write(&target, b"keep me").expect("victim");
+        let link = d.join("left.png");
+        std::os::unix::fs::symlink(&target, &link).expect("symlink");
+        let err = write_bytes(&link, b"png").expect_err("a link must be refused");
+        assert!(err.to_string().contains("symbolic link"), "{err}");
+        assert_eq!(std::fs::read(&target).expect("victim"), b"keep me");
+        let err = write_bytes(Path::new("/dev/full"), b"x").expect_err("a device");
+        assert!(err.to_string().contains("special file"), "{err}");
+        let err = write_bytes(&d, b"x").expect_err("a folder");
+        assert!(err.to_string().contains("a folder"), "{err}");
+    }
+}

@@ -1,0 +1,160 @@
+//! Nothing lost, nothing half-written (issue 14, items 1, 2, 5 and 9): every output goes through
+//! a temporary file renamed into place only when complete, a link planted in the output folder
+//! is refused, every output of a render is made before any is written, and a closed or full
+//! standard output ends the command cleanly instead of a panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+use crate::common::{asset, out_dir};
+
+fn stereolab(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(args)
+        .output()
+        .expect("run stereolab")
+}
+
+fn s(p: &Path) -> String {
+    p.to_string_lossy().into_owned()
+}
+
+fn names(dir: &Path) -> Vec<String> {
+    let mut n: Vec<String> = std::fs::read_dir(dir)
+        .expect("read dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    n.sort();
+    n
+}
+
+/// A 1×1 depth map: too narrow for any SIRDS, so `sirds --depth` fails after reading it.
+fn one_pixel_depth_map(dir: &Path) -> PathBuf {
+    let p = dir.join("one.pgm");
+    std::fs::write(&p, b"P5\n1 1\n255\n\x80").expect("write pgm");
+    p
+}
+
+#[cfg(unix)]
+#[test]
+fn a_link_planted_in_the_output_folder_is_refused_and_nothing_is_written() {
+    let dir = out_dir("reliability-link");
+    let victim = dir.join("victim.txt");
+    std::fs::write(&victim, b"keep me").expect("victim");
+    // The third output's name is a link: before, left.png and right.png were written and the
+    // link followed; now the run fails before writing anything.
+    std::os::unix::fs::symlink(&victim, dir.join("side_by_side.png")).expect("symlink");
+    let out = stereolab(&[
+        "render",
+        &s(&asset("scenes/wuson.toml")),
+        "--size",
+        "64x48",
+        "--out",
+        &s(&dir),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "a refused output must fail the run");
+    assert!(stderr.contains("symbolic link"), "{stderr}");
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("wrote"));
+    assert_eq!(std::fs::read(&victim).expect("victim"), b"keep me");
+    assert_eq!(names(&dir), ["side_by_side.png", "victim.txt"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_device_as_output_is_refused_instead_of_reported_as_written() {
+    let dir = out_dir("reliability-device");
+    std::os::unix::fs::symlink("/dev/full", dir.join("left.png")).expect("symlink");
+    let out = stereolab(&[
+        "render",
+        &s(&asset("scenes/wuson.toml")),
+        "--size",
+        "64x48",
+        "--out",
+        &s(&dir),
+    ]);
+    assert!(!out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("wrote"));
+}
+
+#[test]
+fn a_failed_sirds_keeps_the_file_it_would_have_replaced() {
+    let dir = out_dir("reliability-precious");
+    let depth = one_pixel_depth_map(&dir);
+    for name in ["precious.ppm", "precious.png"] {
+        let precious = dir.join(name);
+        std::fs::write(&precious, b"precious").expect("precious");
+        let out = stereolab(&["sirds", "--depth", &s(&depth), "-o", &s(&precious)]);
+        assert!(!out.status.success(), "{name}: a 1-pixel map must fail");
+        assert_eq!(std::fs::read(&precious).expect("still there"), b"precious");
+    }
+    // Nor does a failed decode leave an empty file in place of the old one.
+    let precious = dir.join("decoded.png");
+    std::fs::write(&precious, b"precious").expect("precious");
+    let out = stereolab(&["sirds", "--decode", &s(&depth), "-o", &s(&precious)]);
+    assert!(
+        !out.status.success(),
+        "a 1-pixel image is no autostereogram"
+    );
+    assert_eq!(std::fs::read(&precious).expect("still there"), b"precious");
+    assert_eq!(
+        names(&dir),
+        ["decoded.png", "one.pgm", "precious.png", "precious.ppm"],
+        "no temporary file may stay behind"
+    );
+}
+
+#[test]
+fn a_successful_render_leaves_only_its_outputs() {
+    let dir = out_dir("reliability-clean");
+    let out = stereolab(&[
+        "render",
+        &s(&asset("scenes/wuson.toml")),
+        "--size",
+        "64x48",
+        "--out",
+        &s(&dir),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(names(&dir), ["left.png", "right.png", "side_by_side.png"]);
+    let img = image::open(dir.join("side_by_side.png")).expect("a whole PNG");
+    assert_eq!((img.width(), img.height()), (128, 48));
+}
+
+#[test]
+fn a_closed_pipe_ends_the_command_quietly() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(["info", &s(&asset("scenes/wuson.toml"))])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // Close the reading end before the command writes (it loads the model first).
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_standard_output_is_an_error_not_a_panic() {
+    let full = std::fs::File::options()
+        .write(true)
+        .open("/dev/full")
+        .expect("/dev/full");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(["info", &s(&asset("scenes/wuson.toml"))])
+        .stdout(full)
+        .output()
+        .expect("run");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("standard output"), "{stderr}");
+}
