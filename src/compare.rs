@@ -313,6 +313,7 @@ pub fn framebuffer_from_image(img: &RgbaImage, background: [u8; 4]) -> Framebuff
 /// # Errors
 /// The file cannot be read or decoded.
 pub fn load_image(path: &Path) -> Result<RgbaImage> {
+    crate::files::check_input(path)?;
     image::open(path)
         .map(|i| i.to_rgba8())
         .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))

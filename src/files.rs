@@ -1,4 +1,9 @@
-//! Writing output files so that nothing is lost and nothing half-written is left behind.
+//! Reading input files within bounds, and writing output files so that nothing is lost and
+//! nothing half-written is left behind.
+//!
+//! Every input file (scene, OBJ, terrain CSV, images) is checked by [`check_input`]: a regular
+//! file, not a FIFO that would block forever or a device such as `/dev/zero` that never ends;
+//! text inputs are read by [`read_input`] with a size limit that holds even if the file grows.
 //!
 //! Every file stereolab writes goes through [`write_atomic`]: the bytes go to a temporary file
 //! in the same folder, every write error (including the last flush, which a `BufWriter`'s drop
@@ -9,7 +14,7 @@
 //! output never writes through a link planted in the output folder.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -35,6 +40,54 @@ pub fn check_output_path(path: &Path) -> Result<()> {
         Ok(m) if !m.is_file() => Err(refuse("a special file (device, FIFO or socket)")),
         _ => Ok(()),
     }
+}
+
+/// Checks that `path` is a regular file (links followed) and returns its size.
+///
+/// # Errors
+/// `Io` naming the path: it does not exist, or it is a folder, a FIFO, a device or a socket.
+pub fn check_input(path: &Path) -> Result<u64> {
+    let m = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if m.is_file() {
+        return Ok(m.len());
+    }
+    let what = if m.is_dir() {
+        "a folder"
+    } else {
+        "a special file (device, FIFO or socket), which may never end"
+    };
+    Err(Error::io(
+        path,
+        std::io::Error::other(format!(
+            "refusing to read it: it is {what}; give a regular file"
+        )),
+    ))
+}
+
+/// Reads the regular file `path` whole, refusing it when it is larger than `max_bytes`.
+///
+/// # Errors
+/// As [`check_input`]; `Parse` naming the size and the limit; or the read failed.
+pub fn read_input(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
+    let too_large = |size: u64| {
+        Error::parse(
+            path,
+            None,
+            format!("file is {size} bytes, more than the {max_bytes} accepted"),
+        )
+    };
+    let size = check_input(path)?;
+    if size > max_bytes {
+        return Err(too_large(size));
+    }
+    let mut bytes = Vec::with_capacity(size as usize);
+    File::open(path)
+        .and_then(|f| f.take(max_bytes + 1).read_to_end(&mut bytes))
+        .map_err(|e| Error::io(path, e))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_large(bytes.len() as u64)); // it grew while being read
+    }
+    Ok(bytes)
 }
 
 /// A temporary name beside `path`: `.NAME.tmp-PID-N` in the same folder (so the rename is

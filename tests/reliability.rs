@@ -158,3 +158,57 @@ fn a_full_standard_output_is_an_error_not_a_panic() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("standard output"), "{stderr}");
 }
+
+/// Runs stereolab, killing it after `secs`: `None` when it had to be killed (it hung).
+fn stereolab_within(args: &[&str], secs: u64) -> Option<Output> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let start = std::time::Instant::now();
+    while start.elapsed().as_secs() < secs {
+        if child.try_wait().expect("wait").is_some() {
+            return Some(child.wait_with_output().expect("output"));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    None
+}
+
+/// Issue 14 item 3: a FIFO blocked forever and `/dev/zero` grew past 6 GB; both are refused
+/// before a byte is read.
+#[cfg(target_os = "linux")]
+#[test]
+fn fifos_and_devices_as_inputs_are_refused_at_once() {
+    let dir = out_dir("reliability-special");
+    let fifo = dir.join("scene.toml");
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+    assert!(made.success(), "mkfifo failed");
+    let wuson = s(&asset("scenes/wuson.toml"));
+    let cases: Vec<Vec<String>> = vec![
+        vec!["info".into(), s(&fifo)],
+        vec!["info".into(), "/dev/zero".into()],
+        vec![
+            "render".into(),
+            wuson.clone(),
+            "--set".into(),
+            "mesh.0.path=\"/dev/zero\"".into(),
+            "--out".into(),
+            s(&dir),
+        ],
+        vec!["sirds".into(), "--depth".into(), "/dev/urandom".into()],
+        vec!["compare".into(), "/dev/zero".into(), s(&fifo)],
+    ];
+    for args in cases {
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = stereolab_within(&argv, 20)
+            .unwrap_or_else(|| panic!("{argv:?} hung and was killed after 20 s"));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{argv:?} must fail");
+        assert!(stderr.contains("refusing to read"), "{argv:?}: {stderr}");
+    }
+}

@@ -141,6 +141,7 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
 /// # Errors
 /// The depth map cannot be read or is too large, or the file cannot be written.
 pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u32, u32)> {
+    crate::files::check_input(depth)?;
     let img = image::open(depth)
         .map_err(|e| Error::parse(depth, None, format!("cannot read depth map: {e}")))?;
     let (width, height) = (img.width(), img.height());

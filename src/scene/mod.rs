@@ -68,13 +68,24 @@ pub struct Scene {
     pub sirds: crate::effects::sirds::Settings,
 }
 
+/// The largest scene file accepted (a scene is a few kilobytes of TOML; models and terrain are
+/// separate files with their own limits).
+const MAX_SCENE_BYTES: u64 = 16 * 1024 * 1024;
+
 impl Scene {
     /// Reads a scene file, applies `--set key=value` overrides, loads its models, validates it.
     ///
     /// # Errors
     /// Any I/O, TOML, OBJ or validation error, naming the file and the field.
     pub fn load(path: &Path, sets: &[String]) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let bytes = crate::files::read_input(path, MAX_SCENE_BYTES)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            Error::parse(
+                path,
+                None,
+                format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+            )
+        })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Scene::from_toml(&text, path, &base, sets)
     }

@@ -17,17 +17,7 @@ const MAX_OBJ_BYTES: u64 = 512 * 1024 * 1024;
 /// Unreadable file, a vertex coordinate that is not a finite number, a face index out of range
 /// or malformed, or no triangles at all: each names the file and line.
 pub fn load_obj(path: &Path) -> Result<Mesh> {
-    let size = std::fs::metadata(path)
-        .map_err(|e| Error::io(path, e))?
-        .len();
-    if size > MAX_OBJ_BYTES {
-        return Err(Error::parse(
-            path,
-            None,
-            format!("file is {size} bytes, more than the {MAX_OBJ_BYTES} accepted"),
-        ));
-    }
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::files::read_input(path, MAX_OBJ_BYTES)?;
     let text = String::from_utf8(bytes).map_err(|e| {
         Error::parse(
             path,

@@ -52,17 +52,14 @@ pub fn map_to_world(x: f64, y: f64, height: f64) -> Vec3 {
 /// Unreadable or oversized file, and everything [`parse_csv`] and [`triangulate`] refuse, each
 /// naming the file (and line).
 pub fn load_terrain_csv(path: &Path) -> Result<Terrain> {
-    let size = std::fs::metadata(path)
-        .map_err(|e| Error::io(path, e))?
-        .len();
-    if size > MAX_CSV_BYTES {
-        return Err(Error::parse(
+    let bytes = crate::files::read_input(path, MAX_CSV_BYTES)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        Error::parse(
             path,
             None,
-            format!("file is {size} bytes, more than the {MAX_CSV_BYTES} accepted"),
-        ));
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        )
+    })?;
     triangulate(path, &parse_csv(path, &text)?)
 }
 

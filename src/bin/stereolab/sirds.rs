@@ -74,6 +74,7 @@ pub fn run(args: &SirdsArgs) -> Result<()> {
 fn report(args: &SirdsArgs) -> Result<String> {
     if let Some(path) = &args.decode {
         let settings = settings_from_sets(&args.sets)?;
+        stereolab::files::check_input(path)?;
         let img = image::open(path)
             .map_err(|e| Error::parse(path, None, format!("cannot read image: {e}")))?
             .to_rgba8();

@@ -157,6 +157,7 @@ impl DepthMap {
     /// # Errors
     /// The file cannot be read or decoded, or has a zero side.
     pub fn load(path: &Path) -> Result<DepthMap> {
+        crate::files::check_input(path)?;
         let img = image::open(path)
             .map_err(|e| Error::parse(path, None, format!("cannot read depth map: {e}")))?;
         let gray = img.to_luma16();

@@ -47,6 +47,7 @@ impl Pattern {
     /// # Errors
     /// The file cannot be read or decoded.
     pub fn load_image(path: &Path) -> Result<Pattern> {
+        crate::files::check_input(path)?;
         let img = image::open(path)
             .map_err(|e| Error::parse(path, None, format!("cannot read pattern image: {e}")))?;
         Ok(Pattern::Image(Arc::new(img.to_rgba8())))
