@@ -212,3 +212,48 @@ fn fifos_and_devices_as_inputs_are_refused_at_once() {
         assert!(stderr.contains("refusing to read"), "{argv:?}: {stderr}");
     }
 }
+
+/// Issue 14 item 8: `layout.blank_interval = 4294967295` wrapped past the check (and panicked
+/// in a debug build); now it is refused, naming the field.
+#[test]
+fn a_huge_blank_interval_is_refused_not_wrapped() {
+    let dir = out_dir("reliability-blank");
+    for blank in ["4294967295", "2147483647", "767"] {
+        let out = stereolab(&[
+            "render",
+            &s(&asset("scenes/wuson.toml")),
+            "--size",
+            "64x48",
+            "--set",
+            "outputs=[\"above_below_squashed\"]",
+            "--set",
+            &format!("layout.blank_interval={blank}"),
+            "--out",
+            &s(&dir),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{blank}: {stderr}");
+        assert!(!out.status.success(), "{blank}: must be refused");
+        assert!(
+            stderr.contains("layout.blank_interval"),
+            "{blank}: {stderr}"
+        );
+    }
+    let ok = stereolab(&[
+        "render",
+        &s(&asset("scenes/wuson.toml")),
+        "--size",
+        "64x48",
+        "--set",
+        "outputs=[\"above_below_squashed\"]",
+        "--set",
+        "layout.blank_interval=46",
+        "--out",
+        &s(&dir),
+    ]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+}

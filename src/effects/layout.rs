@@ -65,7 +65,7 @@ pub fn above_below_squashed(
 ) -> Result<RgbaImage> {
     same_size(left, right)?;
     let (w, h) = (left.width, left.height);
-    if blank + 2 > h {
+    if u64::from(blank) + 2 > u64::from(h) {
         return Err(Error::invalid(
             "layout.blank_interval",
             blank,

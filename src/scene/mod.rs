@@ -159,7 +159,8 @@ impl Scene {
             specular: f.light.specular,
             shininess: f.light.shininess,
         };
-        if f.image.height < 2 * f.layout.blank_interval + 2
+        // The layout needs two rows besides the blank (u64: no wrap for any u32 the file holds).
+        if u64::from(f.layout.blank_interval) + 2 > u64::from(f.image.height)
             && f.outputs.iter().any(|o| o == "above_below_squashed")
         {
             return Err(Error::invalid(
