@@ -257,3 +257,43 @@ fn a_huge_blank_interval_is_refused_not_wrapped() {
         String::from_utf8_lossy(&ok.stderr)
     );
 }
+
+/// Issue 14 item 10: `--frames 3 -o x.png` wrote a GIF under a PNG name, and `--decode … -o
+/// x.ppm` wrote a PAM. An animation must be named .gif; a decoded depth map is a real PPM (P6)
+/// or, for .pgm, a 16-bit PGM (P5).
+#[test]
+fn each_output_gets_the_container_its_name_says() {
+    let dir = out_dir("reliability-container");
+    let scene = s(&asset("scenes/sirds_sphere.toml"));
+    let png = dir.join("anim.png");
+    let out = stereolab(&["sirds", &scene, "--frames", "2", "-o", &s(&png)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "a GIF named .png must be refused");
+    assert!(
+        stderr.contains("--out") && stderr.contains(".gif"),
+        "{stderr}"
+    );
+    assert!(!png.exists());
+    let sirds = dir.join("s.png");
+    assert!(
+        stereolab(&["sirds", &scene, "-o", &s(&sirds)])
+            .status
+            .success()
+    );
+    for (name, magic) in [
+        ("d.ppm", &b"P6\n"[..]),
+        ("d.pgm", &b"P5\n512 256\n65535\n"[..]),
+    ] {
+        let path = dir.join(name);
+        let out = stereolab(&["sirds", "--decode", &s(&sirds), "-o", &s(&path)]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = std::fs::read(&path).expect("decoded");
+        assert!(bytes.starts_with(magic), "{name}: {:?}", &bytes[..16]);
+        let img = image::open(&path).expect("netpbm readers can open it");
+        assert_eq!((img.width(), img.height()), (512, 256));
+    }
+}

@@ -24,9 +24,10 @@ pub struct SirdsArgs {
     /// one at all.
     #[arg(long, conflicts_with_all = ["scene", "depth"])]
     pub decode: Option<PathBuf>,
-    /// Output file: .png, or .ppm (uncompressed); .gif with --frames.
-    #[arg(long, short, default_value = "sirds.png")]
-    pub out: PathBuf,
+    /// Output file: .png, or .ppm (uncompressed); with --frames a .gif. Default sirds.png, or
+    /// sirds.gif with --frames.
+    #[arg(long, short)]
+    pub out: Option<PathBuf>,
     /// Override a `[sirds]` field, e.g. --set sirds.dpi=100 (repeatable; with a scene any
     /// scene field).
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -61,6 +62,13 @@ fn settings_from_sets(sets: &[String]) -> Result<Settings> {
     Settings::from_spec(&spec, Path::new("."))
 }
 
+/// Whether `path` ends in one of `extensions` (ASCII case ignored).
+fn has_extension(path: &Path, extensions: &[&str]) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
+}
+
 /// Runs `stereolab sirds`.
 ///
 /// # Errors
@@ -72,6 +80,20 @@ pub fn run(args: &SirdsArgs) -> Result<()> {
 
 /// What `stereolab sirds` prints, after doing the work.
 fn report(args: &SirdsArgs) -> Result<String> {
+    // An animation is a GIF (default sirds.gif), everything else an image (default sirds.png):
+    // a GIF under another name would be a wrong container.
+    let out = match (&args.out, args.frames) {
+        (Some(out), Some(_)) if !has_extension(out, &["gif"]) => {
+            return Err(Error::invalid(
+                "--out",
+                out.display(),
+                "an animation (--frames) is written as GIF: name the file .gif",
+            ));
+        }
+        (Some(out), _) => out.clone(),
+        (None, Some(_)) => PathBuf::from("sirds.gif"),
+        (None, None) => PathBuf::from("sirds.png"),
+    };
     if let Some(path) = &args.decode {
         let settings = settings_from_sets(&args.sets)?;
         stereolab::files::check_input(path)?;
@@ -99,14 +121,31 @@ fn report(args: &SirdsArgs) -> Result<String> {
             z,
         }
         .to_image();
-        let format = image::ImageFormat::from_path(&args.out).map_err(|e| {
-            Error::invalid("--out", args.out.display(), format!("no image format: {e}"))
-        })?;
+        let format = image::ImageFormat::from_path(&out)
+            .map_err(|e| Error::invalid("--out", out.display(), format!("no image format: {e}")))?;
         let mut bytes = std::io::Cursor::new(Vec::new());
-        image::DynamicImage::ImageLuma16(depth)
-            .write_to(&mut bytes, format)
-            .map_err(|e| Error::invalid("--out", args.out.display(), e.to_string()))?;
-        stereolab::files::write_bytes(&args.out, bytes.get_ref())?;
+        let encoded = if format == image::ImageFormat::Pnm {
+            // The image crate would pick PAM for 16-bit gray: a .ppm gets binary P6 (8-bit gray
+            // in RGB), a .pgm binary P5 at 16 bits, as netpbm writes them.
+            use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
+            if has_extension(&out, &["pgm"]) {
+                // P5 with maxval 65535: two bytes a sample, most significant first (netpbm).
+                let (w, h) = depth.dimensions();
+                let b = bytes.get_mut();
+                b.extend_from_slice(format!("P5\n{w} {h}\n65535\n").as_bytes());
+                b.extend(depth.as_raw().iter().flat_map(|v| v.to_be_bytes()));
+                Ok(())
+            } else {
+                let sub = PnmSubtype::Pixmap(SampleEncoding::Binary);
+                image::DynamicImage::ImageLuma16(depth)
+                    .into_rgb8()
+                    .write_with_encoder(PnmEncoder::new(&mut bytes).with_subtype(sub))
+            }
+        } else {
+            image::DynamicImage::ImageLuma16(depth).write_to(&mut bytes, format)
+        };
+        encoded.map_err(|e| Error::invalid("--out", out.display(), e.to_string()))?;
+        stereolab::files::write_bytes(&out, bytes.get_ref())?;
         return Ok(format!(
             "{}: {:.1}% of pixels matched a separation in {}..={} px: {}\n  wrote {}\n",
             path.display(),
@@ -118,21 +157,21 @@ fn report(args: &SirdsArgs) -> Result<String> {
             } else {
                 "not an autostereogram (no consistent repetition)"
             },
-            args.out.display()
+            out.display()
         ));
     }
     if let Some(path) = &args.depth {
         let settings = settings_from_sets(&args.sets)?;
         let d = settings.geometry.to_pixels()?;
         let is_ppm = matches!(
-            args.out.extension().and_then(|e| e.to_str()),
+            out.extension().and_then(|e| e.to_str()),
             Some("ppm" | "pnm")
         );
         let (w, h) = if is_ppm && !settings.guide_dots {
-            stream_depth_map(path, &settings, &args.out)?
+            stream_depth_map(path, &settings, &out)?
         } else {
             let sirds = from_depth_map(DepthMap::load(path)?, &settings)?;
-            save(&sirds.pixels, sirds.width, sirds.height, &args.out)?;
+            save(&sirds.pixels, sirds.width, sirds.height, &out)?;
             (sirds.width, sirds.height)
         };
         return Ok(format!(
@@ -140,7 +179,7 @@ fn report(args: &SirdsArgs) -> Result<String> {
             path.display(),
             d.min_separation(),
             d.max_separation(),
-            args.out.display()
+            out.display()
         ));
     }
     let scene_path = args
@@ -159,19 +198,19 @@ fn report(args: &SirdsArgs) -> Result<String> {
             ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        animate(&scene, &opts, &args.out, |done, _| {
+        animate(&scene, &opts, &out, |done, _| {
             bar.set_position(u64::from(done))
         })?;
         bar.finish_and_clear();
         return Ok(format!(
             "animated {frames} frames of {}\n  wrote {}\n",
             scene_path.display(),
-            args.out.display()
+            out.display()
         ));
     }
     let frame = render(&scene, &Plan::new(&[Output::Sirds]))?;
     let sirds = from_frame(&frame, &scene)?;
-    save(&sirds.pixels, sirds.width, sirds.height, &args.out)?;
+    save(&sirds.pixels, sirds.width, sirds.height, &out)?;
     Ok(format!(
         "{:?} SIRDS of {} ({}x{}){}\n  wrote {}\n",
         scene.sirds.algorithm,
@@ -182,6 +221,6 @@ fn report(args: &SirdsArgs) -> Result<String> {
             .iterations
             .map(|k| format!(", k = {k} strip iterations"))
             .unwrap_or_default(),
-        args.out.display()
+        out.display()
     ))
 }
