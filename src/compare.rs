@@ -313,10 +313,13 @@ pub fn framebuffer_from_image(img: &RgbaImage, background: [u8; 4]) -> Framebuff
 /// # Errors
 /// The file cannot be read or decoded.
 pub fn load_image(path: &Path) -> Result<RgbaImage> {
-    crate::files::check_input(path)?;
-    image::open(path)
-        .map(|i| i.to_rgba8())
-        .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))
+    let img = crate::files::open_image(
+        path,
+        "image",
+        crate::framebuffer::MAX_IMAGE_SIDE,
+        crate::framebuffer::MAX_IMAGE_PIXELS,
+    )?;
+    Ok(img.to_rgba8())
 }
 
 /// Compares two image files (a student's screenshot against the reference render, say). Each

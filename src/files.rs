@@ -90,6 +90,48 @@ pub fn read_input(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// Opens and decodes the image file `path` (`what` names it in errors, e.g. `depth map`),
+/// reading its size from the header first: an image over `max_side` pixels a side or
+/// `max_pixels` in all is refused before a pixel is decoded (a 388 KB PNG can claim
+/// 20000×20000), and the decoder's allocations are capped to match.
+///
+/// # Errors
+/// As [`check_input`]; `Parse` naming the size and the limit, or what the decoder said.
+pub fn open_image(
+    path: &Path,
+    what: &str,
+    max_side: u32,
+    max_pixels: u64,
+) -> Result<image::DynamicImage> {
+    check_input(path)?;
+    let unreadable =
+        |e: &dyn std::fmt::Display| Error::parse(path, None, format!("cannot read {what}: {e}"));
+    let reader = || -> Result<image::ImageReader<std::io::BufReader<File>>> {
+        image::ImageReader::open(path)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| Error::io(path, e))
+    };
+    let (w, h) = reader()?.into_dimensions().map_err(|e| unreadable(&e))?;
+    if w > max_side || h > max_side || u64::from(w) * u64::from(h) > max_pixels {
+        return Err(Error::parse(
+            path,
+            None,
+            format!(
+                "{what} is {w}x{h}: more than the {max_side} pixels a side or {max_pixels} \
+                 pixels in all accepted"
+            ),
+        ));
+    }
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(max_side);
+    limits.max_image_height = Some(max_side);
+    // 16-bit RGBA, the widest layout a decoder produces, plus the same again for conversion.
+    limits.max_alloc = Some(max_pixels.saturating_mul(16));
+    let mut r = reader()?;
+    r.limits(limits);
+    r.decode().map_err(|e| unreadable(&e))
+}
+
 /// A temporary name beside `path`: `.NAME.tmp-PID-N` in the same folder (so the rename is
 /// atomic: same file system), unique within the process.
 fn temporary_beside(path: &Path) -> PathBuf {

@@ -297,3 +297,80 @@ fn each_output_gets_the_container_its_name_says() {
         assert_eq!((img.width(), img.height()), (512, 256));
     }
 }
+
+/// A PNG that claims `width`×`height` 8-bit gray pixels and holds no image data (an empty IDAT):
+/// 57 bytes that a decoder would have to allocate the whole image for.
+fn png_header_only(width: u32, height: u32) -> Vec<u8> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = 0xffff_ffffu32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xedb8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend(width.to_be_bytes());
+    ihdr.extend(height.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]); // 8 bits, grayscale, deflate, no filter, no interlace
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    for chunk in [&ihdr[..], b"IDAT", b"IEND"] {
+        png.extend((chunk.len() as u32 - 4).to_be_bytes());
+        png.extend(chunk);
+        png.extend(crc32(chunk).to_be_bytes());
+    }
+    png
+}
+
+/// Issue 14 item 6 (part): `sirds --decode` of a 20000×20000 PNG of 388 KB grew past 4.6 GB,
+/// `compare` of two such images to 15.3 GB. The size is now read from the header and refused
+/// before decoding; `--frames` has a limit.
+#[test]
+fn oversized_images_are_refused_from_their_header() {
+    let dir = out_dir("reliability-huge");
+    let huge = dir.join("huge.png");
+    std::fs::write(&huge, png_header_only(20_000, 20_000)).expect("png");
+    let cases: Vec<Vec<String>> = vec![
+        vec![
+            "sirds".into(),
+            "--decode".into(),
+            s(&huge),
+            "-o".into(),
+            s(&dir.join("d.png")),
+        ],
+        vec![
+            "sirds".into(),
+            "--depth".into(),
+            s(&huge),
+            "-o".into(),
+            s(&dir.join("s.png")),
+        ],
+        vec!["compare".into(), s(&huge), s(&huge)],
+    ];
+    for args in cases {
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = stereolab_within(&argv, 20).unwrap_or_else(|| panic!("{argv:?} hung"));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{argv:?} must fail");
+        assert!(stderr.contains("20000x20000"), "{argv:?}: {stderr}");
+    }
+    let out = stereolab(&[
+        "sirds",
+        &s(&asset("scenes/sirds_sphere.toml")),
+        "--frames",
+        "100000",
+        "-o",
+        &s(&dir.join("a.gif")),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("--frames"),
+        "{stderr}"
+    );
+}

@@ -15,6 +15,10 @@ use crate::plan::{Output, Plan};
 use crate::render::render;
 use crate::scene::Scene;
 
+/// The most frames an animation may have: every frame is a full render and a GIF frame, and the
+/// count is a number on the command line (a typo of 100000 would run for hours and fill a disk).
+pub const MAX_FRAMES: u32 = 720;
+
 /// Animation settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AnimationOptions {
@@ -49,8 +53,12 @@ pub fn animate(
     path: &Path,
     mut on_frame: impl FnMut(u32, u32),
 ) -> Result<()> {
-    if opts.frames == 0 {
-        return Err(Error::invalid("--frames", 0, "must be at least 1"));
+    if opts.frames == 0 || opts.frames > MAX_FRAMES {
+        return Err(Error::invalid(
+            "--frames",
+            opts.frames,
+            format!("must be 1 to {MAX_FRAMES} (two frames per degree of the turn)"),
+        ));
     }
     let points: Vec<Vec3> = scene.world_points().collect();
     if points.is_empty() {

@@ -141,9 +141,12 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
 /// # Errors
 /// The depth map cannot be read or is too large, or the file cannot be written.
 pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u32, u32)> {
-    crate::files::check_input(depth)?;
-    let img = image::open(depth)
-        .map_err(|e| Error::parse(depth, None, format!("cannot read depth map: {e}")))?;
+    let img = crate::files::open_image(
+        depth,
+        "depth map",
+        crate::framebuffer::MAX_IMAGE_SIDE,
+        crate::framebuffer::MAX_IMAGE_PIXELS,
+    )?;
     let (width, height) = (img.width(), img.height());
     crate::framebuffer::check_size(width, height).map_err(|e| e.in_file(depth))?;
     let (samples, max): (Vec<u16>, f32) = match img {

@@ -96,10 +96,13 @@ fn report(args: &SirdsArgs) -> Result<String> {
     };
     if let Some(path) = &args.decode {
         let settings = settings_from_sets(&args.sets)?;
-        stereolab::files::check_input(path)?;
-        let img = image::open(path)
-            .map_err(|e| Error::parse(path, None, format!("cannot read image: {e}")))?
-            .to_rgba8();
+        let img = stereolab::files::open_image(
+            path,
+            "image",
+            stereolab::framebuffer::MAX_IMAGE_SIDE,
+            stereolab::framebuffer::MAX_IMAGE_PIXELS,
+        )?
+        .to_rgba8();
         let (w, h) = img.dimensions();
         let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
         let d = settings.geometry.to_pixels()?;

@@ -157,9 +157,12 @@ impl DepthMap {
     /// # Errors
     /// The file cannot be read or decoded, or has a zero side.
     pub fn load(path: &Path) -> Result<DepthMap> {
-        crate::files::check_input(path)?;
-        let img = image::open(path)
-            .map_err(|e| Error::parse(path, None, format!("cannot read depth map: {e}")))?;
+        let img = crate::files::open_image(
+            path,
+            "depth map",
+            crate::framebuffer::MAX_IMAGE_SIDE,
+            crate::framebuffer::MAX_IMAGE_PIXELS,
+        )?;
         let gray = img.to_luma16();
         let (w, h) = gray.dimensions();
         let z = gray

@@ -47,9 +47,12 @@ impl Pattern {
     /// # Errors
     /// The file cannot be read or decoded.
     pub fn load_image(path: &Path) -> Result<Pattern> {
-        crate::files::check_input(path)?;
-        let img = image::open(path)
-            .map_err(|e| Error::parse(path, None, format!("cannot read pattern image: {e}")))?;
+        let img = crate::files::open_image(
+            path,
+            "pattern image",
+            crate::framebuffer::MAX_IMAGE_SIDE,
+            crate::framebuffer::MAX_IMAGE_PIXELS,
+        )?;
         Ok(Pattern::Image(Arc::new(img.to_rgba8())))
     }
 
