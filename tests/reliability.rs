@@ -19,6 +19,17 @@ fn s(p: &Path) -> String {
     p.to_string_lossy().into_owned()
 }
 
+/// `stereolab render` of the Wuson scene at 64×48 into `dir`, with `--set` overrides.
+fn render_small(dir: &Path, sets: &[&str]) -> Output {
+    let scene = s(&asset("scenes/wuson.toml"));
+    let out = s(dir);
+    let mut args = vec!["render", &scene, "--size", "64x48", "--out", &out];
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    stereolab(&args)
+}
+
 fn names(dir: &Path) -> Vec<String> {
     let mut n: Vec<String> = std::fs::read_dir(dir)
         .expect("read dir")
@@ -44,14 +55,7 @@ fn a_link_planted_in_the_output_folder_is_refused_and_nothing_is_written() {
     // The third output's name is a link: before, left.png and right.png were written and the
     // link followed; now the run fails before writing anything.
     std::os::unix::fs::symlink(&victim, dir.join("side_by_side.png")).expect("symlink");
-    let out = stereolab(&[
-        "render",
-        &s(&asset("scenes/wuson.toml")),
-        "--size",
-        "64x48",
-        "--out",
-        &s(&dir),
-    ]);
+    let out = render_small(&dir, &[]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "a refused output must fail the run");
     assert!(stderr.contains("symbolic link"), "{stderr}");
@@ -65,14 +69,7 @@ fn a_link_planted_in_the_output_folder_is_refused_and_nothing_is_written() {
 fn a_device_as_output_is_refused_instead_of_reported_as_written() {
     let dir = out_dir("reliability-device");
     std::os::unix::fs::symlink("/dev/full", dir.join("left.png")).expect("symlink");
-    let out = stereolab(&[
-        "render",
-        &s(&asset("scenes/wuson.toml")),
-        "--size",
-        "64x48",
-        "--out",
-        &s(&dir),
-    ]);
+    let out = render_small(&dir, &[]);
     assert!(!out.status.success());
     assert!(!String::from_utf8_lossy(&out.stdout).contains("wrote"));
 }
@@ -107,14 +104,7 @@ fn a_failed_sirds_keeps_the_file_it_would_have_replaced() {
 #[test]
 fn a_successful_render_leaves_only_its_outputs() {
     let dir = out_dir("reliability-clean");
-    let out = stereolab(&[
-        "render",
-        &s(&asset("scenes/wuson.toml")),
-        "--size",
-        "64x48",
-        "--out",
-        &s(&dir),
-    ]);
+    let out = render_small(&dir, &[]);
     assert!(
         out.status.success(),
         "{}",
@@ -219,18 +209,13 @@ fn fifos_and_devices_as_inputs_are_refused_at_once() {
 fn a_huge_blank_interval_is_refused_not_wrapped() {
     let dir = out_dir("reliability-blank");
     for blank in ["4294967295", "2147483647", "767"] {
-        let out = stereolab(&[
-            "render",
-            &s(&asset("scenes/wuson.toml")),
-            "--size",
-            "64x48",
-            "--set",
-            "outputs=[\"above_below_squashed\"]",
-            "--set",
-            &format!("layout.blank_interval={blank}"),
-            "--out",
-            &s(&dir),
-        ]);
+        let out = render_small(
+            &dir,
+            &[
+                "outputs=[\"above_below_squashed\"]",
+                &format!("layout.blank_interval={blank}"),
+            ],
+        );
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!stderr.contains("panicked"), "{blank}: {stderr}");
         assert!(!out.status.success(), "{blank}: must be refused");
@@ -239,18 +224,13 @@ fn a_huge_blank_interval_is_refused_not_wrapped() {
             "{blank}: {stderr}"
         );
     }
-    let ok = stereolab(&[
-        "render",
-        &s(&asset("scenes/wuson.toml")),
-        "--size",
-        "64x48",
-        "--set",
-        "outputs=[\"above_below_squashed\"]",
-        "--set",
-        "layout.blank_interval=46",
-        "--out",
-        &s(&dir),
-    ]);
+    let ok = render_small(
+        &dir,
+        &[
+            "outputs=[\"above_below_squashed\"]",
+            "layout.blank_interval=46",
+        ],
+    );
     assert!(
         ok.status.success(),
         "{}",
