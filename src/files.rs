@@ -144,31 +144,37 @@ fn temporary_beside(path: &Path) -> PathBuf {
 }
 
 /// Writes the file `path` with `write`, all or nothing: through a temporary file beside it,
-/// renamed onto `path` only after `write` succeeded and the data reached the disk.
+/// renamed onto `path` only after `write` succeeded and the data reached the disk. `write` may
+/// fail with any error (a render that fails half way through an animation, say); that error is
+/// returned as it is.
 ///
 /// # Errors
-/// `path` is refused ([`check_output_path`]), or creating, writing, flushing, syncing or
-/// renaming failed (the temporary file is removed; `path` is as it was).
+/// `path` is refused ([`check_output_path`]), `write` failed, or creating, flushing, syncing
+/// or renaming failed (the temporary file is removed; `path` is as it was).
 pub fn write_atomic(
     path: &Path,
-    write: impl FnOnce(&mut (dyn Write + Send)) -> std::io::Result<()>,
+    write: impl FnOnce(&mut (dyn Write + Send)) -> Result<()>,
 ) -> Result<()> {
     check_output_path(path)?;
     let tmp = temporary_beside(path);
-    let result = (|| -> std::io::Result<()> {
-        let file = File::options().write(true).create_new(true).open(&tmp)?;
+    let io = |e: std::io::Error| Error::io(path, e);
+    let result = (|| -> Result<()> {
+        let file = File::options()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+            .map_err(io)?;
         let mut w = BufWriter::with_capacity(1 << 20, file);
         write(&mut w)?;
         // `into_inner` flushes and reports what the flush met; a drop would discard it.
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
+        let file = w.into_inner().map_err(|e| io(e.into_error()))?;
+        file.sync_all().map_err(io)?;
+        std::fs::rename(&tmp, path).map_err(io)
     })();
-    if let Err(e) = result {
+    if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
-        return Err(Error::io(path, e));
     }
-    Ok(())
+    result
 }
 
 /// [`write_atomic`] of `bytes`.
@@ -176,14 +182,14 @@ pub fn write_atomic(
 /// # Errors
 /// As [`write_atomic`].
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
-    write_atomic(path, |w| w.write_all(bytes))
+    write_atomic(path, |w| w.write_all(bytes).map_err(|e| Error::io(path, e)))
 }
 
-/// An image encoding error as an I/O error, so encoders can run inside [`write_atomic`].
-pub fn image_error(e: image::ImageError) -> std::io::Error {
+/// An image encoder's error while writing `path`, as the `Io` error it is.
+pub fn image_error(path: &Path, e: image::ImageError) -> Error {
     match e {
-        image::ImageError::IoError(e) => e,
-        other => std::io::Error::other(other.to_string()),
+        image::ImageError::IoError(e) => Error::io(path, e),
+        other => Error::io(path, std::io::Error::other(other.to_string())),
     }
 }
 
@@ -200,7 +206,7 @@ where
     write_atomic(path, |w| {
         image
             .write_with_encoder(image::codecs::png::PngEncoder::new(w))
-            .map_err(image_error)
+            .map_err(|e| image_error(path, e))
     })
 }
 
@@ -229,8 +235,9 @@ mod tests {
         let path = d.join("precious.ppm");
         std::fs::write(&path, b"precious").expect("seed file");
         let err = write_atomic(&path, |w| {
-            w.write_all(b"P6\n1 1\n255\n")?;
-            Err(std::io::Error::other("the encoder gave up half way"))
+            w.write_all(b"P6\n1 1\n255\n")
+                .map_err(|e| Error::io(&path, e))?;
+            Err(Error::invalid("test", "encoder", "gave up half way"))
         })
         .expect_err("must fail");
         assert!(err.to_string().contains("half way"), "{err}");

@@ -87,13 +87,11 @@ pub fn animate(
     let plan = Plan::new(&[Output::Sirds]);
     let seed_pattern = scene.sirds.pattern.clone();
     // The frames stream into a temporary file renamed onto `path` only once the last one is in:
-    // a failed or killed run never leaves a truncated GIF. A render error is kept here (the
-    // writer only sees that it stopped).
-    let mut failed = None;
-    let written = files::write_atomic(path, |w| {
+    // a failed or killed run never leaves a truncated GIF.
+    files::write_atomic(path, |w| {
+        let gif_error = |e| files::image_error(path, e);
         let mut gif = GifEncoder::new_with_speed(w, 10);
-        gif.set_repeat(Repeat::Infinite)
-            .map_err(files::image_error)?;
+        gif.set_repeat(Repeat::Infinite).map_err(gif_error)?;
         let mut frame_of = |i: u32| -> Result<Frame> {
             let angle = std::f32::consts::TAU * i as f32 / opts.frames as f32;
             let turn = Mat4::from_translation(pivot)
@@ -116,19 +114,9 @@ pub fn animate(
             Ok(Frame::from_parts(sirds.to_rgba_image(), 0, 0, delay))
         };
         for i in 0..opts.frames {
-            match frame_of(i) {
-                Ok(f) => gif.encode_frame(f).map_err(files::image_error)?,
-                Err(e) => {
-                    failed = Some(e);
-                    return Err(std::io::Error::other("stopped"));
-                }
-            }
+            gif.encode_frame(frame_of(i)?).map_err(gif_error)?;
             on_frame(i + 1, opts.frames);
         }
         Ok(())
-    });
-    match (failed, written) {
-        (Some(e), _) => Err(e),
-        (None, r) => r,
-    }
+    })
 }

@@ -114,14 +114,17 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
         .to_ascii_lowercase();
     if ext == "ppm" || ext == "pnm" {
         files::write_atomic(path, |w| {
-            write!(w, "P6\n{width} {height}\n255\n")?;
-            let mut row = Vec::with_capacity(width as usize * 3);
-            for line in pixels.chunks_exact(width.max(1) as usize) {
-                row.clear();
-                row.extend(line.iter().flat_map(|p| [p[0], p[1], p[2]]));
-                w.write_all(&row)?;
-            }
-            Ok(())
+            let mut ppm = || -> std::io::Result<()> {
+                write!(w, "P6\n{width} {height}\n255\n")?;
+                let mut row = Vec::with_capacity(width as usize * 3);
+                for line in pixels.chunks_exact(width.max(1) as usize) {
+                    row.clear();
+                    row.extend(line.iter().flat_map(|p| [p[0], p[1], p[2]]));
+                    w.write_all(&row)?;
+                }
+                Ok(())
+            };
+            ppm().map_err(|e| Error::io(path, e))
         })
     } else {
         let bytes = pixels.iter().flatten().copied().collect();
@@ -166,13 +169,12 @@ pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result
         }));
     };
     let d = settings.geometry.to_pixels()?;
-    // The rows stream into a temporary file; a failure in TIW (kept here, the writer only
-    // sees that it stopped) or in the writing leaves `out` as it was.
-    let mut failed = None;
-    let written = files::write_atomic(out, |writer| {
-        write!(writer, "P6\n{width} {height}\n255\n")?;
+    // The rows stream into a temporary file: a failure in TIW or in the writing leaves `out`
+    // as it was.
+    files::write_atomic(out, |writer| {
+        write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| Error::io(out, e))?;
         let mut bytes = Vec::new();
-        let streamed = crate::effects::sirds::per_pixel::per_pixel_streamed(
+        crate::effects::sirds::per_pixel::per_pixel_streamed(
             width,
             height,
             depth_row,
@@ -186,14 +188,7 @@ pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result
                 }
                 writer.write_all(&bytes).map_err(|e| Error::io(out, e))
             },
-        );
-        streamed.map_err(|e| {
-            failed = Some(e);
-            std::io::Error::other("stopped")
-        })
-    });
-    match (failed, written) {
-        (Some(e), _) => Err(e),
-        (None, r) => r.map(|()| (width, height)),
-    }
+        )
+    })?;
+    Ok((width, height))
 }

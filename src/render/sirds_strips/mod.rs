@@ -373,6 +373,24 @@ fn resolve_strip(
     }
 }
 
+/// The inputs of a strip run checked (separations that fit `width`, a pattern wide enough,
+/// an image size any framebuffer accepts) and its strips planned: what [`per_vertex`] and
+/// [`reference::k_passes`] both start with.
+///
+/// # Errors
+/// As [`check_inputs`], [`crate::framebuffer::check_size`] and [`plan_strips`].
+fn checked_strips(
+    width: u32,
+    height: u32,
+    d: &Disparity,
+    pattern: &Pattern,
+    opts: &PerVertexOptions,
+) -> Result<Vec<Strip>> {
+    check_inputs(width, d, pattern)?;
+    crate::framebuffer::check_size(width, height)?;
+    plan_strips(width, d, opts)
+}
+
 /// Makes a SIRDS with the strip algorithm.
 ///
 /// Triangle setup once per direction; then, per band of `BAND_ROWS` rows (in parallel: rows
@@ -393,10 +411,7 @@ pub fn per_vertex(
 ) -> Result<StripResult> {
     // The AVX2 loops where the options allow them and this CPU has them.
     let simd = opts.simd && avx2_available();
-    check_inputs(width, d, pattern)?;
-    // The same size checks as any framebuffer.
-    crate::framebuffer::check_size(width, height)?;
-    let strips = plan_strips(width, d, opts)?;
+    let strips = checked_strips(width, height, d, pattern, opts)?;
     let w = width as usize;
     let raster = RasterOptions::default();
     let setups = |toward: f32| {

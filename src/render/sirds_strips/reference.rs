@@ -22,12 +22,11 @@
 use glam::Vec4;
 
 use super::{
-    Filter, PerVertexOptions, Strip, StripGeometry, StripResult, address, in_bounds, mix,
-    plan_strips, shift, source_coordinate,
+    Filter, PerVertexOptions, Strip, StripGeometry, StripResult, address, checked_strips,
+    in_bounds, mix, shift, source_coordinate,
 };
 use crate::effects::sirds::disparity::Disparity;
 use crate::effects::sirds::pattern::Pattern;
-use crate::effects::sirds::per_pixel::check_inputs;
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 use crate::raster::{RasterOptions, rasterize};
@@ -119,9 +118,7 @@ pub fn k_passes(
     opts: &PerVertexOptions,
     record_links: bool,
 ) -> Result<StripResult> {
-    check_inputs(width, d, pattern)?;
-    crate::framebuffer::check_size(width, height)?;
-    let strips = plan_strips(width, d, opts)?;
+    let strips = checked_strips(width, height, d, pattern, opts)?;
     let bilinear = opts.filter == Filter::Bilinear;
     let mut a = pattern.fill(width, height);
     // −1 (no link) where the pattern stays, as the fast path records.
