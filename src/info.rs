@@ -9,7 +9,7 @@ use crate::plan::{Shading, View};
 use crate::render::{Frame, render_view};
 use crate::scene::Scene;
 
-pub use crate::effects::parallax::PARALLAX_BUDGET_PERCENT;
+use crate::effects::parallax::PARALLAX_BUDGET_PERCENT;
 
 /// Horizontal and vertical parallax range over the scene's vertices, in percent of image width
 /// (horizontal) and height (vertical): `(x_right − x_left)` in NDC / 2 · 100.

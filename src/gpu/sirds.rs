@@ -28,10 +28,9 @@ use glam::Vec4;
 
 use crate::effects::sirds::per_pixel::check_inputs;
 use crate::effects::sirds::{Disparity, Pattern};
+use crate::effects::sirds::{Filter, PerVertexOptions};
 use crate::error::Result;
-use crate::render::sirds_strips::{
-    Filter, PerVertexOptions, StripGeometry, StripResult, plan_strips,
-};
+use crate::render::sirds_strips::{StripGeometry, StripResult, plan_strips};
 
 use super::device::GpuRenderer;
 use super::readback::{COLOR_FORMAT, padded_row_bytes};

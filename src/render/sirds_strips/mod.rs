@@ -35,7 +35,7 @@ use rayon::prelude::*;
 
 use crate::effects::sirds::per_pixel::check_inputs;
 use crate::effects::sirds::{Disparity, Pattern};
-pub use crate::effects::sirds::{Filter, PerVertexOptions, Start};
+use crate::effects::sirds::{Filter, PerVertexOptions, Start};
 use crate::error::{Error, Result};
 use crate::raster::{RasterOptions, SetupTriangle, avx2_available, bin_rows, setup_triangles};
 use crate::shade::{Fragment, Shader, Varyings};

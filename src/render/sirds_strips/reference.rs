@@ -188,12 +188,13 @@ mod tests {
     use std::path::Path;
 
     use super::*;
+    use crate::effects::sirds::Start;
     use crate::effects::sirds::depth_range;
     use crate::math::StereoRig;
     use crate::plan::Shading;
     use crate::raster::avx2_available;
     use crate::render::render_view;
-    use crate::render::sirds_strips::{Start, per_vertex};
+    use crate::render::sirds_strips::per_vertex;
     use crate::scene::Scene;
 
     /// The camera of tests/sirds.rs.
