@@ -313,12 +313,7 @@ pub fn framebuffer_from_image(img: &RgbaImage, background: [u8; 4]) -> Framebuff
 /// # Errors
 /// The file cannot be read or decoded.
 pub fn load_image(path: &Path) -> Result<RgbaImage> {
-    let img = crate::files::open_image(
-        path,
-        "image",
-        crate::framebuffer::MAX_IMAGE_SIDE,
-        crate::framebuffer::MAX_IMAGE_PIXELS,
-    )?;
+    let img = crate::framebuffer::open_image(path, "image")?;
     Ok(img.to_rgba8())
 }
 

@@ -82,6 +82,15 @@ impl Framebuffer {
     }
 }
 
+/// Opens the image file `path` (`what` names it in errors), refusing from its header alone
+/// one larger than a framebuffer may be ([`MAX_IMAGE_SIDE`], [`MAX_IMAGE_PIXELS`]).
+///
+/// # Errors
+/// As [`crate::files::open_image`].
+pub fn open_image(path: &std::path::Path, what: &str) -> Result<image::DynamicImage> {
+    crate::files::open_image(path, what, MAX_IMAGE_SIDE, MAX_IMAGE_PIXELS)
+}
+
 /// Checks an image size before anything is allocated.
 ///
 /// # Errors

@@ -20,7 +20,7 @@
 //! Modules import lower layers only; `tests/architecture.rs` reads the source and fails on an
 //! import that goes up or round in a cycle (`cargo test --test main architecture --
 //! --nocapture` prints the graph):
-//! [`error`] → [`files`], [`math`], [`framebuffer`], [`shade`] → [`raster`] → [`effects`] → [`plan`] →
+//! [`error`] → [`files`] → [`math`], [`framebuffer`], [`shade`] → [`raster`] → [`effects`] → [`plan`] →
 //! [`scene`] → [`fixtures`] → [`render`](mod@render) → [`output`] → [`info`], [`figures`], [`compare`] →
 //! `gpu` (feature `gpu`), [`exercise`] → [`grade`], [`bench`](mod@bench).
 //!

@@ -6,8 +6,9 @@
 //! The layers, lowest first. A module may import modules of lower layers only (and the same
 //! layer never: no two modules of one layer import each other).
 //! - `error`: the one error type.
-//! - `files`, `math`, `framebuffer`, `shade`: all-or-nothing file writes, matrices and the rig,
-//!   the render target, the shader stages.
+//! - `files`: bounded reads and all-or-nothing writes.
+//! - `math`, `framebuffer`, `shade`: matrices and the rig, the render target (and the image
+//!   sizes it accepts), the shader stages.
 //! - `raster`: fixed-point setup and traversal; knows nothing of scenes or stereo.
 //! - `effects`: pure functions of framebuffers, matrices and their own settings types (never a
 //!   `Scene`, `Frame`, `Plan` or `Output`).
@@ -27,7 +28,8 @@ use crate::common::root;
 
 const LAYERS: &[&[&str]] = &[
     &["error"],
-    &["files", "math", "framebuffer", "shade"],
+    &["files"],
+    &["math", "framebuffer", "shade"],
     &["raster"],
     &["effects"],
     &["plan"],

@@ -144,12 +144,7 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
 /// # Errors
 /// The depth map cannot be read or is too large, or the file cannot be written.
 pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u32, u32)> {
-    let img = crate::files::open_image(
-        depth,
-        "depth map",
-        crate::framebuffer::MAX_IMAGE_SIDE,
-        crate::framebuffer::MAX_IMAGE_PIXELS,
-    )?;
+    let img = crate::framebuffer::open_image(depth, "depth map")?;
     let (width, height) = (img.width(), img.height());
     crate::framebuffer::check_size(width, height).map_err(|e| e.in_file(depth))?;
     let (samples, max): (Vec<u16>, f32) = match img {

@@ -96,13 +96,7 @@ fn report(args: &SirdsArgs) -> Result<String> {
     };
     if let Some(path) = &args.decode {
         let settings = settings_from_sets(&args.sets)?;
-        let img = stereolab::files::open_image(
-            path,
-            "image",
-            stereolab::framebuffer::MAX_IMAGE_SIDE,
-            stereolab::framebuffer::MAX_IMAGE_PIXELS,
-        )?
-        .to_rgba8();
+        let img = stereolab::framebuffer::open_image(path, "image")?.to_rgba8();
         let (w, h) = img.dimensions();
         let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
         let d = settings.geometry.to_pixels()?;

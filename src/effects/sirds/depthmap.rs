@@ -157,12 +157,7 @@ impl DepthMap {
     /// # Errors
     /// The file cannot be read or decoded, or has a zero side.
     pub fn load(path: &Path) -> Result<DepthMap> {
-        let img = crate::files::open_image(
-            path,
-            "depth map",
-            crate::framebuffer::MAX_IMAGE_SIDE,
-            crate::framebuffer::MAX_IMAGE_PIXELS,
-        )?;
+        let img = crate::framebuffer::open_image(path, "depth map")?;
         let gray = img.to_luma16();
         let (w, h) = gray.dimensions();
         let z = gray

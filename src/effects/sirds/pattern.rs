@@ -47,12 +47,7 @@ impl Pattern {
     /// # Errors
     /// The file cannot be read or decoded.
     pub fn load_image(path: &Path) -> Result<Pattern> {
-        let img = crate::files::open_image(
-            path,
-            "pattern image",
-            crate::framebuffer::MAX_IMAGE_SIDE,
-            crate::framebuffer::MAX_IMAGE_PIXELS,
-        )?;
+        let img = crate::framebuffer::open_image(path, "pattern image")?;
         Ok(Pattern::Image(Arc::new(img.to_rgba8())))
     }
 
