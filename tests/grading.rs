@@ -16,7 +16,7 @@ use crate::common::{out_dir, root};
 
 static BUILDS: Mutex<()> = Mutex::new(());
 
-fn take_turn() -> MutexGuard<'static, ()> {
+pub(crate) fn take_turn() -> MutexGuard<'static, ()> {
     BUILDS.lock().unwrap_or_else(|e| e.into_inner())
 }
 
@@ -25,7 +25,7 @@ fn take_turn() -> MutexGuard<'static, ()> {
 const TIMEOUT: &str = "4";
 
 /// Runs `stereolab grade WHAT --json …` on `exercises`, with `STEREOLAB_MUTANT` when given.
-fn grade(
+pub(crate) fn grade(
     what: &str,
     extra: &[&str],
     exercises: &Path,
@@ -63,7 +63,7 @@ fn grade(
 
 /// The target folder this test binary was built in (`<target>/debug/stereolab`): nested builds
 /// use it too, so the compiled dependencies are shared whatever `CARGO_TARGET_DIR` CI sets.
-fn target_dir() -> PathBuf {
+pub(crate) fn target_dir() -> PathBuf {
     let exe = Path::new(env!("CARGO_BIN_EXE_stereolab"));
     exe.parent()
         .and_then(Path::parent)
@@ -71,15 +71,15 @@ fn target_dir() -> PathBuf {
         .to_path_buf()
 }
 
-fn repo_exercises() -> PathBuf {
+pub(crate) fn repo_exercises() -> PathBuf {
     root().join("exercises")
 }
 
-fn tests_of(v: &Value) -> &Vec<Value> {
+pub(crate) fn tests_of(v: &Value) -> &Vec<Value> {
     v["tests"].as_array().expect("tests array")
 }
 
-fn test_named<'a>(v: &'a Value, name: &str) -> &'a Value {
+pub(crate) fn test_named<'a>(v: &'a Value, name: &str) -> &'a Value {
     tests_of(v)
         .iter()
         .find(|t| {
@@ -402,7 +402,7 @@ fn bad_grade_arguments_get_clear_errors() {
         (vec!["grade", "ex1", "--timeout", "0"], "--timeout"),
         (
             vec!["grade", "ex1", "--exercises", "/nonexistent"],
-            "no exercise crates there",
+            "no exercise there",
         ),
         (
             vec!["render", "assets/scenes/wuson.toml", "--exercise", "all"],

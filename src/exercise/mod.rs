@@ -1,17 +1,39 @@
-//! What exercise crates and the grader share: the wire protocol and the types the stubs see.
+//! What exercise crates and the grader share, seen from stereolab: the `exercise-api` crate
+//! (`exercises/exercise-api`: the wire protocol and the types the stubs take and return), plus
+//! the conversions between its types and stereolab's.
 //!
-//! An exercise is a crate in `exercises/` whose library holds the stubs a student completes and
-//! whose binary serves them to the grader ([`protocol::serve`]). The grader (`crate::grade`)
-//! builds that binary, runs it in a subprocess per task, and scores the answers.
-//!
-//! Conventions every stub states again: right-handed eye space looking down −Z, Y up, OpenGL
-//! NDC with Z in [−1, 1], window depth and texture coordinates in [0, 1] (v = 0 at the bottom
-//! row, as in OpenGL textures), eye index 0 = left, 1 = right (the exercise slides).
+//! A student's crate depends on `exercise-api` and `glam` only, never on stereolab: the reference
+//! answers live here, in the grader.
 
-pub mod protocol;
-pub mod types;
-
-pub use protocol::{Answer, Task, serve, task};
-pub use types::{
-    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, SirdsGeometry, SirdsSetup, StereoSetup,
+pub use exercise_api::{
+    AnaglyphKind, AnaglyphMatrices, Answer, ColorMatrix, EyeView, SirdsGeometry, SirdsSetup,
+    StereoSetup, decode_reply, protocol,
 };
+
+use crate::effects::anaglyph;
+
+/// The same anaglyph kind in stereolab's anaglyph module (the reference).
+pub(crate) fn reference_kind(kind: AnaglyphKind) -> anaglyph::AnaglyphKind {
+    match kind {
+        AnaglyphKind::True => anaglyph::AnaglyphKind::True,
+        AnaglyphKind::Gray => anaglyph::AnaglyphKind::Gray,
+        AnaglyphKind::Color => anaglyph::AnaglyphKind::Color,
+        AnaglyphKind::HalfColor => anaglyph::AnaglyphKind::HalfColor,
+    }
+}
+
+/// stereolab's matrices as the exercise's type (the same numbers, row-major).
+pub(crate) fn exercise_matrices(m: anaglyph::AnaglyphMatrices) -> AnaglyphMatrices {
+    AnaglyphMatrices {
+        left: m.left,
+        right: m.right,
+    }
+}
+
+/// The exercise's matrices as stereolab's type.
+pub(crate) fn reference_matrices(m: AnaglyphMatrices) -> anaglyph::AnaglyphMatrices {
+    anaglyph::AnaglyphMatrices {
+        left: m.left,
+        right: m.right,
+    }
+}

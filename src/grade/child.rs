@@ -1,103 +1,154 @@
-//! Building an exercise crate and running its binary in a subprocess with a time limit.
+//! Running one task of a student's binary, isolated: its answers on a pipe of their own (fd 3,
+//! never stdout), its stdout and stderr drained while it runs and kept up to a cap, a fresh
+//! empty working folder, its own process group killed as a whole when the task ends, and
+//! limits on memory, CPU time, file size and core dumps. Every way the child can end is told
+//! apart ([`Ending`]), so a crash is not reported as a wrong picture.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::sync::mpsc;
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, mpsc};
 use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
-use crate::exercise::protocol::decode_reply;
+use crate::exercise::decode_reply;
+use crate::exercise::protocol::ANSWER_FD_ENV;
+
+/// What a task's process may use.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limits {
+    /// Wall-clock time for the task's inputs (CPU time is limited to the same, rounded up).
+    pub time: Duration,
+    /// Address space of the process, in bytes.
+    pub memory: u64,
+}
+
+impl Limits {
+    /// 10 s and 1 GiB: every task answers in milliseconds within a few MiB.
+    pub const DEFAULT: Limits = Limits {
+        time: Duration::from_secs(10),
+        memory: 1 << 30,
+    };
+}
+
+/// The bytes of stdout and of stderr kept for the report (the rest is read and counted).
+const KEPT_OUTPUT: usize = 8 << 10;
+/// The longest answer line read (a longer one is a broken answer, not a reason to run out of
+/// memory in the grader).
+const MAX_ANSWER_LINE: u64 = 16 << 20;
+/// The largest file the task may write (in its scratch folder).
+const MAX_FILE_BYTES: u64 = 16 << 20;
+
+/// How a task's process ended, when not by answering every input and exiting with 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ending {
+    /// The hint's id: `timeout`, `cpu-limit`, `out-of-memory`, `stack-overflow`, `abort`,
+    /// `crash`, `killed`, `exit`, `no-start`.
+    pub kind: &'static str,
+    /// What happened, for the details.
+    pub message: String,
+    /// What to check, for the hint.
+    pub hint: &'static str,
+}
 
 /// What one run of a task produced.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Run {
     /// One entry per input answered, in order: the flattened answer or the panic message.
     pub replies: Vec<Result<Vec<f64>, String>>,
-    /// The binary ran past the time limit and was killed.
-    pub timed_out: bool,
-    /// The binary died or misbehaved (exit status and stderr), after the replies it gave.
-    pub failure: Option<String>,
+    /// `None` when every input was answered and the process exited cleanly.
+    pub ending: Option<Ending>,
+    /// What the task printed to stdout (capped) and how many bytes in all.
+    pub stdout: (String, u64),
+    /// What the task printed to stderr (capped) and how many bytes in all.
+    pub stderr: (String, u64),
 }
 
-/// Builds `crate_dir`'s binary (named like the crate) with cargo, in the dev profile so it shares
-/// the workspace's compiled dependencies. `Ok(path)` is the executable; `Err` the compiler's
-/// messages (a compile error in the student's code is a result to report, not a crash).
-/// stereolab is built with the features this grader has (`gpu`), so the build the grader came
-/// from is reused instead of compiled again with other features.
-pub fn build(crate_dir: &Path, name: &str, solution: bool) -> Result<PathBuf, String> {
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let mut cmd = Command::new(cargo);
-    cmd.arg("build")
-        .arg("--manifest-path")
-        .arg(crate_dir.join("Cargo.toml"))
-        .args(["--bin", name, "--message-format=json-render-diagnostics"]);
-    if solution {
-        cmd.args(["--features", "solution"]);
-    }
-    if cfg!(feature = "gpu") {
-        cmd.args(["--features", "stereolab/gpu"]);
-    }
-    let out = cmd
-        .stdin(Stdio::null())
-        .output()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success() {
-        return Err(compiler_errors(&stderr));
-    }
-    String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
-        .filter(|v| v["reason"] == "compiler-artifact" && v["target"]["name"] == name)
-        .find_map(|v| v["executable"].as_str().map(PathBuf::from))
-        .ok_or_else(|| format!("cargo built no executable named {name}:\n{stderr}"))
+/// A pipe drained on a thread, keeping the first [`KEPT_OUTPUT`] bytes.
+struct Drain {
+    kept: Arc<Mutex<(Vec<u8>, u64)>>,
 }
 
-/// The error lines of a failed build (warnings and progress left out), at most 40 lines.
-fn compiler_errors(stderr: &str) -> String {
-    let mut lines: Vec<&str> = Vec::new();
-    let mut in_error = false;
-    for l in stderr.lines() {
-        if l.starts_with("error") {
-            in_error = true;
-        } else if l.starts_with("warning") || l.trim_start().starts_with("Compiling") {
-            in_error = false;
+impl Drain {
+    fn start(source: Option<impl Read + Send + 'static>) -> Drain {
+        let kept = Arc::new(Mutex::new((Vec::new(), 0u64)));
+        if let Some(mut source) = source {
+            let k = Arc::clone(&kept);
+            std::thread::spawn(move || {
+                let mut buf = [0u8; 8192];
+                while let Ok(n) = source.read(&mut buf) {
+                    if n == 0 {
+                        break;
+                    }
+                    let mut g = k.lock().unwrap_or_else(|e| e.into_inner());
+                    let room = KEPT_OUTPUT.saturating_sub(g.0.len()).min(n);
+                    g.0.extend_from_slice(&buf[..room]);
+                    g.1 += n as u64;
+                }
+            });
         }
-        if in_error {
-            lines.push(l);
-        }
+        Drain { kept }
     }
-    if lines.is_empty() {
-        lines = stderr.lines().collect();
+
+    fn take(&self) -> (String, u64) {
+        let g = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        (String::from_utf8_lossy(&g.0).into_owned(), g.1)
     }
-    lines.truncate(40);
-    lines.join("\n")
 }
 
-/// Runs `binary TASK` with `inputs` on stdin; kills it after `limit`. Never panics: every way the
-/// child can fail is described in the returned [`Run`].
-pub fn run(binary: &Path, task: &str, inputs: &[Value], limit: Duration) -> Run {
+/// A fresh, empty working folder for one task, removed when dropped.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new() -> std::io::Result<Scratch> {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        let dir = std::env::temp_dir().join(format!(
+            "stereolab-task-{}-{}",
+            std::process::id(),
+            NEXT.fetch_add(1, Ordering::Relaxed)
+        ));
+        std::fs::create_dir_all(&dir)?;
+        Ok(Scratch(dir))
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Runs `binary TASK` with `inputs` on stdin under `limits`. Never panics: every way the child
+/// can fail is described in the returned [`Run`].
+pub fn run(binary: &Path, task: &str, inputs: &[Value], limits: Limits) -> Run {
     let mut run = Run {
         replies: Vec::new(),
-        timed_out: false,
-        failure: None,
+        ending: None,
+        stdout: (String::new(), 0),
+        stderr: (String::new(), 0),
     };
-    let child = Command::new(binary)
-        .arg(task)
-        .env("RUST_BACKTRACE", "0")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn();
-    let mut child = match child {
-        Ok(c) => c,
+    let no_start = |e: String| Ending {
+        kind: "no-start",
+        message: format!("cannot start {}: {e}", binary.display()),
+        hint: "the grader could not start your program (see above)",
+    };
+    let scratch = match Scratch::new() {
+        Ok(s) => s,
         Err(e) => {
-            run.failure = Some(format!("cannot start {}: {e}", binary.display()));
+            run.ending = Some(no_start(e.to_string()));
             return run;
         }
     };
+    let (answers, mut child) = match spawn(binary, task, &scratch.0, limits) {
+        Ok(x) => x,
+        Err(e) => {
+            run.ending = Some(no_start(e.to_string()));
+            return run;
+        }
+    };
+    let pid = child.id();
     let text = Value::Array(inputs.to_vec()).to_string();
     // A writer thread: a child that never reads must not block the grader.
     if let Some(mut stdin) = child.stdin.take() {
@@ -105,51 +156,313 @@ pub fn run(binary: &Path, task: &str, inputs: &[Value], limit: Duration) -> Run 
             let _ = stdin.write_all(text.as_bytes());
         });
     }
+    let out = Drain::start(child.stdout.take());
+    let err = Drain::start(child.stderr.take());
     let (tx, rx) = mpsc::channel();
-    if let Some(stdout) = child.stdout.take() {
-        std::thread::spawn(move || {
-            for line in BufReader::new(stdout).lines() {
-                let Ok(line) = line else { break };
-                if tx.send(decode_reply(&line)).is_err() {
-                    break;
+    std::thread::spawn(move || {
+        let mut reader = BufReader::new(answers);
+        loop {
+            let mut line = Vec::new();
+            match (&mut reader)
+                .take(MAX_ANSWER_LINE)
+                .read_until(b'\n', &mut line)
+            {
+                Ok(0) | Err(_) => break,
+                Ok(_) => {
+                    let reply = if line.ends_with(b"\n") {
+                        decode_reply(&String::from_utf8_lossy(&line))
+                    } else if line.len() as u64 >= MAX_ANSWER_LINE {
+                        Err(format!("an answer longer than {MAX_ANSWER_LINE} bytes"))
+                    } else {
+                        decode_reply(&String::from_utf8_lossy(&line))
+                    };
+                    if tx.send(reply).is_err() {
+                        break;
+                    }
                 }
             }
-        });
-    }
-    let stderr = child.stderr.take();
-    let deadline = Instant::now() + limit;
+        }
+    });
+    let deadline = Instant::now() + limits.time;
+    let mut timed_out = false;
     while run.replies.len() < inputs.len() {
         let left = deadline.saturating_duration_since(Instant::now());
         match rx.recv_timeout(left) {
             Ok(reply) => run.replies.push(reply),
             Err(mpsc::RecvTimeoutError::Timeout) => {
-                run.timed_out = true;
+                timed_out = true;
                 break;
             }
             Err(mpsc::RecvTimeoutError::Disconnected) => break,
         }
     }
-    if run.timed_out {
-        let _ = child.kill();
-        let _ = child.wait();
-        return run;
-    }
-    match child.wait() {
-        Ok(status) if status.success() && run.replies.len() == inputs.len() => {}
-        Ok(status) => {
-            let mut err = String::new();
-            if let Some(mut s) = stderr {
-                let _ = std::io::Read::read_to_string(&mut s, &mut err);
-            }
-            let err: String = err.lines().take(5).collect::<Vec<_>>().join("\n");
-            run.failure = Some(format!(
-                "the exercise binary exited with {status} after {} of {} answers{}{err}",
+    // Every input answered (or the channel closed): give the process a moment to exit.
+    let status = if timed_out {
+        None
+    } else {
+        wait_until(&mut child, Instant::now() + Duration::from_secs(2))
+    };
+    kill_group(pid);
+    let status = status.or_else(|| child.wait().ok());
+    untrack(pid);
+    reap_orphans();
+    // What the drains hold by now (a grandchild that escaped the group may hold the pipes).
+    std::thread::sleep(Duration::from_millis(20));
+    run.stdout = out.take();
+    run.stderr = err.take();
+    run.ending = if timed_out {
+        Some(Ending {
+            kind: "timeout",
+            message: format!(
+                "killed after the time limit of {:?} ({} of {} inputs answered)",
+                limits.time,
                 run.replies.len(),
-                inputs.len(),
-                if err.is_empty() { "" } else { ": " }
-            ));
-        }
-        Err(e) => run.failure = Some(format!("waiting for the exercise binary: {e}")),
-    }
+                inputs.len()
+            ),
+            hint: "your code ran past the time limit: an endless loop?",
+        })
+    } else {
+        status.and_then(|s| classify(s, &run.stderr.0, run.replies.len(), inputs.len(), limits))
+    };
     run
+}
+
+/// Waits for `child` until `deadline`; `None` if it is still running.
+fn wait_until(child: &mut Child, deadline: Instant) -> Option<ExitStatus> {
+    loop {
+        match child.try_wait() {
+            Ok(Some(s)) => return Some(s),
+            Ok(None) if Instant::now() < deadline => std::thread::sleep(Duration::from_millis(2)),
+            _ => return None,
+        }
+    }
+}
+
+/// Tells apart the ways a process ends early. `None`: it answered everything and exited with 0.
+fn classify(
+    status: ExitStatus,
+    stderr: &str,
+    answered: usize,
+    expected: usize,
+    limits: Limits,
+) -> Option<Ending> {
+    let progress = format!("after {answered} of {expected} answers");
+    #[cfg(unix)]
+    if let Some(sig) = std::os::unix::process::ExitStatusExt::signal(&status) {
+        let (kind, message, hint) = match sig {
+            libc::SIGXCPU => (
+                "cpu-limit",
+                format!(
+                    "stopped at the CPU-time limit of {:?} {progress}",
+                    limits.time
+                ),
+                "your code used more CPU time than allowed: an endless loop?",
+            ),
+            libc::SIGABRT if stderr.contains("memory allocation of") => (
+                "out-of-memory",
+                format!(
+                    "ran out of memory (limit {} MiB) {progress}",
+                    limits.memory >> 20
+                ),
+                "your code allocates without bound: a loop that pushes forever, or a size \
+                 computed from a wrong value?",
+            ),
+            libc::SIGABRT | libc::SIGSEGV if stderr.contains("overflowed its stack") => (
+                "stack-overflow",
+                format!("overflowed its stack {progress}"),
+                "endless recursion: does a function call itself without a base case?",
+            ),
+            libc::SIGABRT => (
+                "abort",
+                format!("aborted (SIGABRT) {progress}"),
+                "your code called abort(), or panicked while panicking",
+            ),
+            libc::SIGSEGV | libc::SIGBUS | libc::SIGILL | libc::SIGFPE => (
+                "crash",
+                format!("crashed with signal {sig} {progress}"),
+                "your program crashed: unsafe code, or a pointer gone wrong?",
+            ),
+            _ => (
+                "killed",
+                format!("killed by signal {sig} {progress}"),
+                "your program was killed from outside (out of memory on the machine?)",
+            ),
+        };
+        return Some(Ending {
+            kind,
+            message,
+            hint,
+        });
+    }
+    if status.success() && answered == expected {
+        return None;
+    }
+    let code = status.code().unwrap_or(-1);
+    Some(Ending {
+        kind: "exit",
+        message: if code == 3 {
+            format!("could not write its answers {progress}")
+        } else {
+            format!("exited with code {code} {progress}")
+        },
+        hint: "your code ended the program (std::process::exit?) before answering every input",
+    })
+}
+
+/// Starts `binary task` in `dir`: fd 3 the write end of the answer pipe, its own process group,
+/// a clean environment and the limits.
+#[cfg(unix)]
+fn spawn(
+    binary: &Path,
+    task: &str,
+    dir: &Path,
+    limits: Limits,
+) -> std::io::Result<(std::io::PipeReader, Child)> {
+    use std::os::fd::AsRawFd;
+    use std::os::unix::process::CommandExt;
+
+    let (reader, writer) = std::io::pipe()?;
+    let wfd = writer.as_raw_fd();
+    let cpu = limits.time.as_secs() + 1;
+    let memory = limits.memory;
+    let mut cmd = Command::new(binary);
+    cmd.arg(task)
+        .current_dir(dir)
+        .env_clear()
+        .env("PATH", "/usr/bin:/bin")
+        .env("HOME", dir)
+        .env("RUST_BACKTRACE", "0")
+        .env(ANSWER_FD_ENV, "3")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .process_group(0);
+    // The mutation tests plant mistakes in the instructor's solution through this variable.
+    if let Some(m) = std::env::var_os("STEREOLAB_MUTANT") {
+        cmd.env("STEREOLAB_MUTANT", m);
+    }
+    // SAFETY: between fork and exec only async-signal-safe calls (dup2, fcntl, setrlimit).
+    unsafe {
+        cmd.pre_exec(move || {
+            if wfd == 3 {
+                if libc::fcntl(3, libc::F_SETFD, 0) < 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+            } else if libc::dup2(wfd, 3) < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            let limit = |what, soft: u64, hard: u64| {
+                let l = libc::rlimit {
+                    rlim_cur: soft as libc::rlim_t,
+                    rlim_max: hard as libc::rlim_t,
+                };
+                if libc::setrlimit(what, &l) < 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            };
+            limit(libc::RLIMIT_AS, memory, memory)?;
+            limit(libc::RLIMIT_CPU, cpu, cpu + 1)?;
+            limit(libc::RLIMIT_FSIZE, MAX_FILE_BYTES, MAX_FILE_BYTES)?;
+            limit(libc::RLIMIT_CORE, 0, 0)?;
+            Ok(())
+        });
+    }
+    let child = spawn_tracked(&mut cmd)?;
+    drop(writer); // the child holds the only write end: EOF when it (and its group) is gone
+    Ok((reader, child))
+}
+
+#[cfg(not(unix))]
+fn spawn(
+    _binary: &Path,
+    _task: &str,
+    _dir: &Path,
+    _limits: Limits,
+) -> std::io::Result<(std::io::PipeReader, Child)> {
+    Err(std::io::Error::other(
+        "the grader isolates tasks with Unix process groups and limits: grade on Linux or macOS",
+    ))
+}
+
+/// Kills the task's whole process group (the task and whatever it started).
+fn kill_group(pid: u32) {
+    #[cfg(unix)]
+    if let Ok(pid) = i32::try_from(pid) {
+        // SAFETY: plain syscall; ESRCH (already gone) is fine.
+        unsafe {
+            libc::kill(-pid, libc::SIGKILL);
+        }
+    }
+}
+
+/// Makes this process the reaper of its orphaned descendants (Linux), so a process a task
+/// starts in a new session of its own, to outlive the task, comes back to the grader and is
+/// killed ([`reap_orphans`]).
+pub(crate) fn become_subreaper() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: plain syscall with constant arguments.
+    unsafe {
+        libc::prctl(libc::PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0);
+    }
+}
+
+/// The grader's own children (tasks, cargo) while they run: everything else whose parent is
+/// the grader is an orphan a task left behind.
+static CHILDREN: Mutex<Vec<u32>> = Mutex::new(Vec::new());
+
+/// Spawns `cmd` and records it as one of the grader's own children until [`untrack`].
+pub(crate) fn spawn_tracked(cmd: &mut Command) -> std::io::Result<Child> {
+    let mut children = CHILDREN.lock().unwrap_or_else(|e| e.into_inner());
+    let child = cmd.spawn()?;
+    children.push(child.id());
+    Ok(child)
+}
+
+/// Forgets a child [`spawn_tracked`] started, once it has been waited for.
+pub(crate) fn untrack(pid: u32) {
+    CHILDREN
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .retain(|p| *p != pid);
+}
+
+/// Kills and reaps every child of this process the grader did not start itself: orphans a task
+/// left behind, re-parented here (see [`become_subreaper`]).
+pub(crate) fn reap_orphans() {
+    #[cfg(target_os = "linux")]
+    {
+        let children = CHILDREN.lock().unwrap_or_else(|e| e.into_inner());
+        let me = std::process::id().to_string();
+        let Ok(entries) = std::fs::read_dir("/proc") else {
+            return;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name();
+            let Some(pid) = name.to_str().and_then(|s| s.parse::<u32>().ok()) else {
+                continue;
+            };
+            if children.contains(&pid) {
+                continue;
+            }
+            let Ok(stat) = std::fs::read_to_string(e.path().join("stat")) else {
+                continue;
+            };
+            // `pid (comm) state ppid …`: comm may hold spaces and parentheses.
+            let Some(rest) = stat.rfind(')').map(|i| &stat[i + 1..]) else {
+                continue;
+            };
+            if rest.split_whitespace().nth(1) != Some(me.as_str()) {
+                continue;
+            }
+            let Ok(pid) = i32::try_from(pid) else {
+                continue;
+            };
+            // SAFETY: plain syscalls on a process that is our child and not one we wait for.
+            unsafe {
+                libc::kill(pid, libc::SIGKILL);
+                libc::waitpid(pid, std::ptr::null_mut(), 0);
+            }
+        }
+    }
 }

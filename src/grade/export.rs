@@ -89,26 +89,44 @@ pub fn export(root: &Path, dir: &Path) -> Result<()> {
             &|_| false,
         )?;
     }
-    for f in ["LICENSE", "Cargo.lock"] {
-        let from = root.join(f);
-        let to = if f == "Cargo.lock" {
-            dir.join(f)
-        } else {
-            lib.join(f)
-        };
+    // The lock file twice: the handout's workspace resolves from it, and the grader compiles it
+    // in (every build of a submission resolves from the same versions).
+    for (from, to) in [
+        (root.join("LICENSE"), lib.join("LICENSE")),
+        (root.join("Cargo.lock"), dir.join("Cargo.lock")),
+        (root.join("Cargo.lock"), lib.join("Cargo.lock")),
+    ] {
         std::fs::copy(&from, &to).map_err(io(&from))?;
     }
+    // The grader's templates (manifest, lib.rs, main.rs of each exercise) and exercise-api, the
+    // one crate a student's crate depends on besides glam.
+    copy_tree(
+        &root.join("exercises/exercise-api"),
+        &lib.join("exercises/exercise-api"),
+        &|_| false,
+    )?;
     let mut members = Vec::new();
     for ex in super::Exercise::ALL {
         let name = ex.crate_name();
-        let (from, to) = (root.join("exercises").join(name), dir.join(name));
+        let from = root.join("exercises").join(name);
+        for file in ["Cargo.toml", "src/lib.rs", "src/main.rs"] {
+            let (src, dst) = (from.join(file), lib.join("exercises").join(name).join(file));
+            if let Some(parent) = dst.parent() {
+                std::fs::create_dir_all(parent).map_err(io(parent))?;
+            }
+            std::fs::copy(&src, &dst).map_err(io(&src))?;
+        }
+        let to = dir.join(name);
         copy_tree(&from, &to, &|p| {
             p.file_name().is_some_and(|n| n == "solution.rs")
         })?;
         for file in ["Cargo.toml", "src/lib.rs"] {
             let p = to.join(file);
             let text = std::fs::read_to_string(&p).map_err(io(&p))?;
-            let text = text.replace("path = \"../..\"", "path = \"../stereolab\"");
+            let text = text.replace(
+                "path = \"../exercise-api\"",
+                "path = \"../stereolab/exercises/exercise-api\"",
+            );
             std::fs::write(&p, strip_solution(&text)).map_err(io(&p))?;
         }
         members.push(format!("\"{name}\""));

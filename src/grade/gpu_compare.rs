@@ -1,7 +1,7 @@
 //! `stereolab compare --exercise ex1 SCENE`: the student's stereo matrices rendered on the CPU
 //! against the reference rig rendered on the GPU. Compiled only with `--features gpu`.
 //!
-//! The student's crate is built and run exactly as the grader does (`child::build`,
+//! The student's crate is built and run exactly as the grader does (`submission_binary`,
 //! `child::run`, the `stereo_matrices` task's input per eye), and the answers become pictures
 //! as in `render --exercise` (`ex1::eye_matrices_from_answer`, then
 //! [`crate::render::render_view`]). The expected pictures are the exercise slides' off-axis rig
@@ -9,10 +9,9 @@
 //! [`GpuRenderer::render_views`].
 
 use std::path::Path;
-use std::time::Duration;
 
 use super::fixture::{reference_rig, stereo_setup};
-use super::{Exercise, child, crate_dir, ex1};
+use super::{Exercise, Limits, child, default_work_dir, ex1, submission_binary};
 use crate::compare::{Comparison, compare, write_diff_strip};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuRenderer, GpuScene};
@@ -48,7 +47,7 @@ pub fn compare_exercise(
     scene: &Scene,
     dir: &Path,
     solution: bool,
-    timeout: Duration,
+    limits: Limits,
     out: Option<&Path>,
 ) -> Result<ExerciseComparison> {
     if ex != Exercise::Ex1 {
@@ -66,10 +65,10 @@ pub fn compare_exercise(
     let inputs: Vec<_> = (0..2)
         .map(|eye| ex1::eye_view_input(&setup, &modelview, eye, lighting))
         .collect();
-    let crate_dir = crate_dir(dir, ex)?;
-    let binary = child::build(&crate_dir, ex.crate_name(), solution)
-        .map_err(|log| Error::invalid(ex.crate_name(), "does not compile", log))?;
-    let run = child::run(&binary, TASK, &inputs, timeout);
+    child::become_subreaper();
+    let binary = submission_binary(dir, ex, solution, &default_work_dir())
+        .map_err(|log| Error::invalid(ex.crate_name(), "cannot be built", log))?;
+    let run = child::run(&binary, TASK, &inputs, limits);
     let expected = r.render_views(
         &GpuScene::upload(r, scene)?,
         &[
@@ -90,11 +89,10 @@ pub fn compare_exercise(
                 "your code panicked: {}",
                 panic.chars().take(160).collect::<String>()
             )),
-            None if run.timed_out => Err(format!("no answer within {timeout:?} (endless loop?)")),
-            None => Err(run
-                .failure
-                .clone()
-                .unwrap_or_else(|| "no answer".to_string())),
+            None => Err(run.ending.as_ref().map_or_else(
+                || "no answer".to_string(),
+                |e| format!("your program {}", e.message),
+            )),
         };
         let actual = answer.and_then(|m| {
             render_view(scene, &m, Shading::Color)

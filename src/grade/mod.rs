@@ -6,6 +6,7 @@
 //! in one subprocess; a panic costs that input, an endless loop the task (the child is killed
 //! after the time limit), NaN the inputs it spoils. The grader itself never panics on an answer.
 
+pub(crate) mod build;
 pub(crate) mod child;
 pub mod ex1;
 pub mod ex2;
@@ -19,13 +20,13 @@ pub mod score;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 use serde_json::Value;
 
 use crate::compare::{compare, write_diff_strip};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
+pub use child::Limits;
 use fixture::Fixture;
 use report::{ExerciseResult, Report};
 use score::TaskResult;
@@ -94,14 +95,86 @@ impl Exercise {
 pub struct GradeOptions {
     /// Which exercises.
     pub exercises: Vec<Exercise>,
-    /// The folder holding the exercise crates (`exercises/` of the repository or the handout).
+    /// The submission: a folder holding `<crate>/src/stubs.rs` for each exercise (the handout's
+    /// layout; `exercises/` of the repository). Only those files are taken from it.
     pub dir: PathBuf,
-    /// Build with the `solution` feature (the instructor's solution).
+    /// Grade `<crate>/src/solution.rs` instead of the stubs (the instructor's solution).
     pub solution: bool,
-    /// Time limit of one task's subprocess.
-    pub timeout: Duration,
+    /// Limits of one task's subprocess.
+    pub limits: Limits,
     /// Where diff images of failing image checks go.
     pub out: PathBuf,
+    /// The grader's build folder (shared compiled dependencies, one folder per build).
+    pub work: PathBuf,
+}
+
+/// Removes the pictures an earlier run left in `out` (`ex1_….png` and the like: only the
+/// grader's own names, never anything else in the folder).
+fn clear_old_pictures(out: &Path) {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        let ours = Exercise::ALL
+            .iter()
+            .any(|ex| name.starts_with(&format!("{}_", ex.id())))
+            && name.ends_with(".png");
+        if ours && e.file_type().is_ok_and(|t| t.is_file()) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// The build folder when none is given: `$CARGO_TARGET_DIR/stereolab-grade`, else
+/// `target/stereolab-grade`.
+pub fn default_work_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| PathBuf::from("target"), PathBuf::from)
+        .join("stereolab-grade")
+}
+
+/// The file of `ex` a submission in `dir` provides: `<crate>/src/stubs.rs` (or `solution.rs`),
+/// also looked for under `exercises/`.
+pub(crate) fn stubs_path(dir: &Path, ex: Exercise, solution: bool) -> PathBuf {
+    let file = if solution { "solution.rs" } else { "stubs.rs" };
+    let direct = dir.join(ex.crate_name()).join("src").join(file);
+    let nested = dir
+        .join("exercises")
+        .join(ex.crate_name())
+        .join("src")
+        .join(file);
+    if !direct.is_file() && nested.is_file() {
+        nested
+    } else {
+        direct
+    }
+}
+
+/// Builds the binary of `ex` from the submission in `dir` (see [`build`]); `Err` is what to
+/// tell the student: the compiler's messages, or the file that is missing.
+pub(crate) fn submission_binary(
+    dir: &Path,
+    ex: Exercise,
+    solution: bool,
+    work: &Path,
+) -> std::result::Result<PathBuf, String> {
+    let path = stubs_path(dir, ex, solution);
+    let stubs = crate::files::read_input(&path, build::MAX_STUBS_BYTES).map_err(|e| {
+        if solution && !path.exists() {
+            format!(
+                "no {} here: the instructor's solution is not part of a handout ({e})",
+                path.display()
+            )
+        } else {
+            format!("the submission's {}: {e}", path.display())
+        }
+    })?;
+    let stubs =
+        String::from_utf8(stubs).map_err(|_| format!("{} is not UTF-8 text", path.display()))?;
+    let sources = build::Sources::new(ex, stubs)?;
+    build::build(ex, &sources, work)
 }
 
 /// The exercises folder: `given`, else `./exercises`, else `.` when it holds `ex1_stereo`.
@@ -116,16 +189,17 @@ pub fn exercises_dir(given: Option<PathBuf>) -> Result<PathBuf> {
     candidates
         .iter()
         .find(|d| {
-            d.join(Exercise::Ex1.crate_name())
-                .join("Cargo.toml")
-                .is_file()
+            Exercise::ALL
+                .iter()
+                .any(|ex| stubs_path(d, *ex, false).is_file())
         })
         .cloned()
         .ok_or_else(|| {
             Error::invalid(
                 "--exercises",
                 candidates[0].display(),
-                "no exercise crates there (expected ex1_stereo/Cargo.toml)",
+                "no exercise there (expected ex1_stereo/src/stubs.rs, ex2_chromadepth/src/stubs.rs \
+                 or ex3_sirds/src/stubs.rs)",
             )
         })
 }
@@ -146,11 +220,12 @@ fn inputs_of(spec: &TaskSpec) -> Vec<Value> {
 /// error, panic, endless loop or NaN is a result in the report.
 pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
     let fx = Fixture::new(scene)?;
+    child::become_subreaper();
+    clear_old_pictures(&opts.out);
     let mut exercises = Vec::new();
     for &ex in &opts.exercises {
-        let crate_dir = crate_dir(&opts.dir, ex)?;
         let specs = ex.tasks(&fx);
-        let result = match child::build(&crate_dir, ex.crate_name(), opts.solution) {
+        let result = match submission_binary(&opts.dir, ex, opts.solution, &opts.work) {
             Err(log) => ExerciseResult {
                 exercise: ex,
                 build_error: Some(log),
@@ -165,7 +240,7 @@ pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
                 tasks: specs
                     .iter()
                     .map(|s| {
-                        let run = child::run(&binary, s.name, &inputs_of(s), opts.timeout);
+                        let run = child::run(&binary, s.name, &inputs_of(s), opts.limits);
                         score::evaluate(ex.id(), s, &run, &opts.out)
                     })
                     .collect(),
@@ -174,19 +249,6 @@ pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
         exercises.push(result);
     }
     Ok(Report { exercises })
-}
-
-pub(crate) fn crate_dir(dir: &Path, ex: Exercise) -> Result<PathBuf> {
-    let d = dir.join(ex.crate_name());
-    if d.join("Cargo.toml").is_file() {
-        Ok(d)
-    } else {
-        Err(Error::invalid(
-            "--exercises",
-            dir.display(),
-            format!("no {}/Cargo.toml there", ex.crate_name()),
-        ))
-    }
 }
 
 /// `stereolab render --exercise`: runs the image checks of `ex` on `scene` and writes, for every
@@ -200,17 +262,17 @@ pub fn render_exercise(
     scene: Scene,
     dir: &Path,
     solution: bool,
-    timeout: Duration,
+    limits: Limits,
     out: &Path,
 ) -> Result<Vec<String>> {
     let fx = Fixture::new(scene)?;
-    let crate_dir = crate_dir(dir, ex)?;
-    let binary = child::build(&crate_dir, ex.crate_name(), solution)
-        .map_err(|log| Error::invalid(ex.crate_name(), "does not compile", log))?;
+    child::become_subreaper();
+    let binary = submission_binary(dir, ex, solution, &default_work_dir())
+        .map_err(|log| Error::invalid(ex.crate_name(), "cannot be built", log))?;
     let mut lines = Vec::new();
     for spec in ex.tasks(&fx) {
         let Some(img) = &spec.image else { continue };
-        let run = child::run(&binary, spec.name, &img.inputs, timeout);
+        let run = child::run(&binary, spec.name, &img.inputs, limits);
         let answers: Vec<Option<Vec<f64>>> = (0..img.inputs.len())
             .map(|k| run.replies.get(k).and_then(|r| r.as_ref().ok().cloned()))
             .collect();
@@ -225,8 +287,8 @@ pub fn render_exercise(
                 path.display()
             ));
         }
-        if run.timed_out {
-            lines.push(format!("{}: timed out after {timeout:?}", spec.name));
+        if let Some(e) = &run.ending {
+            lines.push(format!("{}: your program {}", spec.name, e.message));
         }
         let panics: Vec<&String> = run
             .replies

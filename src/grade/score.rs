@@ -160,8 +160,13 @@ pub(crate) fn evaluate(
             failed - SHOWN_FAILURES
         ));
     }
-    if let Some(f) = &run.failure {
-        details.push(f.clone());
+    if let Some(e) = &run.ending {
+        details.push(format!("your program {}", e.message));
+    }
+    for (what, (text, total)) in [("stdout", &run.stdout), ("stderr", &run.stderr)] {
+        if *total > 0 {
+            details.push(printed(what, text, *total));
+        }
     }
 
     let all_todo = n > 0 && todo == n;
@@ -200,11 +205,8 @@ pub(crate) fn evaluate(
     let lost = score < spec.points;
     let hint = if !lost {
         None
-    } else if run.timed_out {
-        Some((
-            "timeout".into(),
-            "the binary ran past the time limit and was killed: an endless loop?".into(),
-        ))
+    } else if let Some(e) = &run.ending {
+        Some((e.kind.into(), e.hint.into()))
     } else if todo > 0 && todo == panics && failing.is_empty() {
         Some((
             "todo".into(),
@@ -244,6 +246,23 @@ pub(crate) fn evaluate(
         details,
         hint,
     }
+}
+
+/// Lines of the task's own output shown with its result.
+const SHOWN_OUTPUT_LINES: usize = 6;
+
+/// What the program printed on `what`: the first lines, and how much there was in all.
+fn printed(what: &str, text: &str, total: u64) -> String {
+    let lines: Vec<String> = text
+        .lines()
+        .take(SHOWN_OUTPUT_LINES)
+        .map(|l| format!("    {}", shorten(l)))
+        .collect();
+    format!(
+        "your program printed {total} bytes on {what} (shown to you, never read as answers; \
+         the first lines):\n{}",
+        lines.join("\n")
+    )
 }
 
 /// The first known mistake that reproduces every failing answer (and is not the right answer).

@@ -3,50 +3,53 @@
 
 use std::process::ExitCode;
 
+use exercise_api::Lighting;
+use exercise_api::{AnaglyphKind, StereoSetup, serve, task};
 use glam::{Mat4, Vec2};
-use stereolab::exercise::{AnaglyphKind, StereoSetup, serve, task};
-use stereolab::math::Lighting;
 
 fn main() -> ExitCode {
-    serve(vec![
-        task("frustum", |[l, r, b, t, n, f]: [f32; 6]| {
-            ex1_stereo::frustum(l, r, b, t, n, f)
-        }),
-        task("stereo_frustum", |(s, eye): (StereoSetup, usize)| {
-            ex1_stereo::stereo_frustum(&s, eye)
-        }),
-        task(
-            "stereo_matrices",
-            |(s, mv, eye, lighting): (StereoSetup, [f32; 16], usize, Lighting)| {
-                ex1_stereo::stereo_matrices(&s, Mat4::from_cols_array(&mv), eye, lighting)
-            },
-        ),
-        task("anaglyph_matrices", |kind: AnaglyphKind| {
-            ex1_stereo::anaglyph_matrices(kind)
-        }),
-        task("dubois_matrices", |(): ()| ex1_stereo::dubois_matrices()),
-        task(
-            "remap",
-            |(l, r, uv, depth): ([f32; 16], [f32; 16], [f32; 2], f32)| {
-                ex1_stereo::remap(
-                    Mat4::from_cols_array(&l),
-                    Mat4::from_cols_array(&r),
-                    Vec2::from(uv),
-                    depth,
-                )
-            },
-        ),
-        task(
-            "visible",
-            |(uv, remapped, stored, tol): (Option<[f32; 2]>, f32, f32, f32)| {
-                ex1_stereo::visible(uv.map(Vec2::from), remapped, stored, tol)
-            },
-        ),
-        task("parallax", |[z, z0, d]: [f32; 3]| {
-            ex1_stereo::parallax(z, z0, d)
-        }),
-        task("parallax_color", |[p, max]: [f32; 2]| {
-            ex1_stereo::parallax_color(p, max)
-        }),
-    ])
+    serve(
+        ex1_stereo::SOURCE_HASH,
+        vec![
+            task("frustum", |[l, r, b, t, n, f]: [f32; 6]| {
+                ex1_stereo::frustum(l, r, b, t, n, f)
+            }),
+            task("stereo_frustum", |(s, eye): (StereoSetup, usize)| {
+                ex1_stereo::stereo_frustum(&s, eye)
+            }),
+            task(
+                "stereo_matrices",
+                |(s, mv, eye, lighting): (StereoSetup, [f32; 16], usize, Lighting)| {
+                    ex1_stereo::stereo_matrices(&s, Mat4::from_cols_array(&mv), eye, lighting)
+                },
+            ),
+            task("anaglyph_matrices", |kind: AnaglyphKind| {
+                ex1_stereo::anaglyph_matrices(kind)
+            }),
+            task("dubois_matrices", |(): ()| ex1_stereo::dubois_matrices()),
+            task(
+                "remap",
+                |(l, r, uv, depth): ([f32; 16], [f32; 16], [f32; 2], f32)| {
+                    ex1_stereo::remap(
+                        Mat4::from_cols_array(&l),
+                        Mat4::from_cols_array(&r),
+                        Vec2::from(uv),
+                        depth,
+                    )
+                },
+            ),
+            task(
+                "visible",
+                |(uv, remapped, stored, tol): (Option<[f32; 2]>, f32, f32, f32)| {
+                    ex1_stereo::visible(uv.map(Vec2::from), remapped, stored, tol)
+                },
+            ),
+            task("parallax", |[z, z0, d]: [f32; 3]| {
+                ex1_stereo::parallax(z, z0, d)
+            }),
+            task("parallax_color", |[p, max]: [f32; 2]| {
+                ex1_stereo::parallax_color(p, max)
+            }),
+        ],
+    )
 }

@@ -4,9 +4,9 @@
 //! (tests/grading.rs): `swapped-eyes`, `toe-in`, `full-separation`, `transposed-anaglyph`,
 //! `opengl-depth`, `hang-parallax`, `nan-parallax`.
 
+use exercise_api::{AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, StereoSetup};
+use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use stereolab::exercise::{AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, StereoSetup};
-use stereolab::math::{Lighting, look_at};
 
 fn planted(mistake: &str) -> bool {
     std::env::var("STEREOLAB_MUTANT").is_ok_and(|v| v.split(',').any(|m| m == mistake))

@@ -1,9 +1,9 @@
 //! Your code: complete every `todo!`. Each doc comment states the task, where its formula comes
 //! from, and the conventions; `stereolab grade ex1` scores each function on its own.
 
+use exercise_api::Lighting;
+use exercise_api::{AnaglyphKind, AnaglyphMatrices, EyeView, StereoSetup};
 use glam::{Mat4, Vec2, Vec3};
-use stereolab::exercise::{AnaglyphKind, AnaglyphMatrices, EyeView, StereoSetup};
-use stereolab::math::Lighting;
 
 /// Task `frustum` (2 points): the projection matrix `P_frustum(l, r, b, t, n, f)`.
 ///

@@ -1,9 +1,9 @@
 //! Checks you can run yourself (`cargo test -p ex1_stereo`): the worked examples of the source
 //! documents. They fail until your functions are complete; `stereolab grade ex1` scores more.
 
+use exercise_api::{AnaglyphKind, StereoSetup};
+use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec3, Vec4Swizzles};
-use stereolab::exercise::{AnaglyphKind, StereoSetup};
-use stereolab::math::{Lighting, look_at};
 
 /// The StereoGraphics guide's §5: camera at (0, 0, 9), 90° fov, separation 1, screen at the xy plane.
 fn seed003() -> (StereoSetup, Mat4) {

@@ -3,17 +3,20 @@
 
 use std::process::ExitCode;
 
+use exercise_api::{serve, task};
 use glam::Vec3;
-use stereolab::exercise::{serve, task};
 
 fn main() -> ExitCode {
-    serve(vec![
-        task("hsv_ramp", ex2_chromadepth::hsv_ramp),
-        task("texgen", |[d1, d2]: [f32; 2]| {
-            ex2_chromadepth::texgen(d1, d2)
-        }),
-        task("depth_range", |(c, r): ([f32; 3], f32)| {
-            ex2_chromadepth::depth_range(Vec3::from(c), r)
-        }),
-    ])
+    serve(
+        ex2_chromadepth::SOURCE_HASH,
+        vec![
+            task("hsv_ramp", ex2_chromadepth::hsv_ramp),
+            task("texgen", |[d1, d2]: [f32; 2]| {
+                ex2_chromadepth::texgen(d1, d2)
+            }),
+            task("depth_range", |(c, r): ([f32; 3], f32)| {
+                ex2_chromadepth::depth_range(Vec3::from(c), r)
+            }),
+        ],
+    )
 }

@@ -3,21 +3,24 @@
 
 use std::process::ExitCode;
 
-use stereolab::exercise::{SirdsGeometry, SirdsSetup, serve, task};
+use exercise_api::{SirdsGeometry, SirdsSetup, serve, task};
 
 fn main() -> ExitCode {
-    serve(vec![
-        task("disparity_constant_direction", |[z, phi]: [f32; 2]| {
-            ex3_sirds::disparity_constant_direction(z, phi)
-        }),
-        task("disparity_constant_eyes", |(z, g): (f32, SirdsGeometry)| {
-            ex3_sirds::disparity_constant_eyes(z, &g)
-        }),
-        task(
-            "link_row",
-            |(nearness, row, setup): (Vec<f32>, u32, SirdsSetup)| {
-                ex3_sirds::link_row(&nearness, row, &setup)
-            },
-        ),
-    ])
+    serve(
+        ex3_sirds::SOURCE_HASH,
+        vec![
+            task("disparity_constant_direction", |[z, phi]: [f32; 2]| {
+                ex3_sirds::disparity_constant_direction(z, phi)
+            }),
+            task("disparity_constant_eyes", |(z, g): (f32, SirdsGeometry)| {
+                ex3_sirds::disparity_constant_eyes(z, &g)
+            }),
+            task(
+                "link_row",
+                |(nearness, row, setup): (Vec<f32>, u32, SirdsSetup)| {
+                    ex3_sirds::link_row(&nearness, row, &setup)
+                },
+            ),
+        ],
+    )
 }

@@ -3,7 +3,7 @@
 //! `STEREOLAB_MUTANT=name[,name]` plants a known mistake for the grader's mutation tests:
 //! `full-disparity` (pairs at x ∓ s instead of x ∓ s/2), `no-hidden-surfaces`.
 
-use stereolab::exercise::{SirdsGeometry, SirdsSetup};
+use exercise_api::{SirdsGeometry, SirdsSetup};
 
 fn planted(mistake: &str) -> bool {
     std::env::var("STEREOLAB_MUTANT").is_ok_and(|v| v.split(',').any(|m| m == mistake))

@@ -1,7 +1,7 @@
 //! Your code: complete every `todo!`. Each doc comment states the task, where its formula comes
 //! from, and the conventions; `stereolab grade ex3` scores each function on its own.
 
-use stereolab::exercise::{SirdsGeometry, SirdsSetup};
+use exercise_api::{SirdsGeometry, SirdsSetup};
 
 /// Task `disparity_constant_direction` (1 point): the distance between the two projections of a
 /// point at depth `z` behind the image plane, assuming every eye ray meets the image plane at

@@ -1,6 +1,6 @@
 //! Checks you can run yourself (`cargo test -p ex3_sirds`).
 
-use stereolab::exercise::{SirdsGeometry, SirdsSetup};
+use exercise_api::{SirdsGeometry, SirdsSetup};
 
 #[test]
 fn flat_row_links_every_pixel_to_the_one_s_to_its_right() {

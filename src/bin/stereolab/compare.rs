@@ -1,10 +1,12 @@
 //! `stereolab compare`: CPU against GPU for a scene, or any two images: metrics and diff strips.
 
 use std::path::PathBuf;
+#[cfg(feature = "gpu")]
 use std::time::Duration;
 
 use clap::Args;
 use stereolab::compare::{self, Comparison, Thresholds};
+#[cfg(feature = "gpu")]
 use stereolab::plan::Plan;
 use stereolab::scene::Scene;
 use stereolab::{Error, Result, grade};
@@ -158,7 +160,10 @@ fn compare_exercise(
         scene,
         &dir,
         solution,
-        Duration::from_secs(30),
+        grade::Limits {
+            time: Duration::from_secs(30),
+            ..grade::Limits::DEFAULT
+        },
         out,
     )?;
     Ok((c.rows, c.problems))

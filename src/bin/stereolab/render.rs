@@ -69,8 +69,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
             ));
         };
         let dir = grade::exercises_dir(exercises)?;
-        let timeout = Duration::from_secs(30);
-        for line in grade::render_exercise(ex, s, &dir, solution, timeout, &out)? {
+        let limits = grade::Limits {
+            time: Duration::from_secs(30),
+            ..grade::Limits::DEFAULT
+        };
+        for line in grade::render_exercise(ex, s, &dir, solution, limits, &out)? {
             outln!("{line}");
         }
         return Ok(());

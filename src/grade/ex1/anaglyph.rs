@@ -5,14 +5,17 @@ use serde_json::{Value, json};
 use super::flat;
 use crate::effects::anaglyph::AnaglyphKind::DuboisRedCyan;
 use crate::effects::anaglyph::anaglyph_pixel;
-use crate::exercise::{AnaglyphKind, AnaglyphMatrices, ColorMatrix};
+use crate::exercise::{
+    AnaglyphKind, AnaglyphMatrices, ColorMatrix, exercise_matrices, reference_kind,
+    reference_matrices,
+};
 use crate::framebuffer::Framebuffer;
 use crate::grade::fixture::Fixture;
 use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
 
 /// The exercise slides' anaglyph matrices from stereolab's anaglyph module.
 pub(crate) fn reference_anaglyph(kind: AnaglyphKind) -> AnaglyphMatrices {
-    kind.reference().matrices()
+    exercise_matrices(reference_kind(kind).matrices())
 }
 
 fn transposed(m: &ColorMatrix) -> ColorMatrix {
@@ -35,7 +38,7 @@ fn swapped_pair(m: &AnaglyphMatrices) -> AnaglyphMatrices {
 
 /// The finalize shader's anaglyph pixel (stored 8-bit values, no sRGB decoding: the exercise slides).
 fn mix(m: &AnaglyphMatrices, l: [u8; 4], r: [u8; 4]) -> [u8; 4] {
-    anaglyph_pixel(m, l, r, false)
+    anaglyph_pixel(&reference_matrices(*m), l, r, false)
 }
 
 fn matrices_from(a: &[f64]) -> Option<AnaglyphMatrices> {
@@ -131,7 +134,7 @@ pub(super) fn anaglyph_task(fx: &Fixture) -> TaskSpec {
 }
 
 pub(super) fn dubois_task() -> TaskSpec {
-    let dubois = DuboisRedCyan.matrices();
+    let dubois = exercise_matrices(DuboisRedCyan.matrices());
     let mut typo = dubois;
     typo.left[1][0] = -0.400822;
     TaskSpec {

@@ -18,6 +18,7 @@ use crate::exercise::{Answer, StereoSetup};
 use crate::framebuffer::Framebuffer;
 use crate::math::{Camera, CameraMode, EyeMatrices, Lighting};
 
+#[cfg(feature = "gpu")]
 pub(crate) use rig::{eye_matrices_from_answer, eye_view_input};
 
 pub(crate) fn flat<A: Answer>(a: &A) -> Vec<f64> {

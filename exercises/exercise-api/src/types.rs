@@ -4,8 +4,44 @@ use glam::Mat4;
 use serde::{Deserialize, Serialize};
 
 use super::protocol::Answer;
-use crate::effects::anaglyph;
-pub use crate::effects::anaglyph::{AnaglyphMatrices, ColorMatrix};
+
+/// A 3×3 color matrix, row-major as on the slides: `out[i] = Σ_j m[i][j] · in[j]`; rows are the
+/// output R, G, B.
+pub type ColorMatrix = [[f32; 3]; 3];
+
+/// The pair of matrices of one anaglyph: `ML` for the left eye's color, `MR` for the right's.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AnaglyphMatrices {
+    /// `ML`, applied to the left eye's color.
+    pub left: ColorMatrix,
+    /// `MR`, applied to the right eye's color.
+    pub right: ColorMatrix,
+}
+
+/// Which modelview the shading sees (the exercise slides' "Effect on lighting").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Lighting {
+    /// `view = T±·MV`, `projection = P±`: each eye lights from its own position.
+    #[default]
+    PerEye,
+    /// `view = MV`, `projection = P±·T±`: both eyes shade as the cyclopean eye does.
+    Cyclopic,
+}
+
+/// The view matrix of a camera at `eye` looking at `target` with `up` roughly up
+/// (`gluLookAt`: right-handed, the camera looks down −Z).
+pub fn look_at(eye: glam::Vec3, target: glam::Vec3, up: glam::Vec3) -> Mat4 {
+    let f = (target - eye).normalize();
+    let s = f.cross(up).normalize();
+    let u = s.cross(f);
+    Mat4::from_cols(
+        glam::Vec4::new(s.x, u.x, -f.x, 0.0),
+        glam::Vec4::new(s.y, u.y, -f.y, 0.0),
+        glam::Vec4::new(s.z, u.z, -f.z, 0.0),
+        glam::Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
+    )
+}
 
 /// A mono camera's symmetric frustum plus the stereo rig (the exercise slides' parameters).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -63,16 +99,6 @@ impl AnaglyphKind {
         AnaglyphKind::Color,
         AnaglyphKind::HalfColor,
     ];
-
-    /// The same kind in stereolab's anaglyph module (the reference).
-    pub fn reference(self) -> anaglyph::AnaglyphKind {
-        match self {
-            AnaglyphKind::True => anaglyph::AnaglyphKind::True,
-            AnaglyphKind::Gray => anaglyph::AnaglyphKind::Gray,
-            AnaglyphKind::Color => anaglyph::AnaglyphKind::Color,
-            AnaglyphKind::HalfColor => anaglyph::AnaglyphKind::HalfColor,
-        }
-    }
 }
 
 /// Flattens as `left` then `right`, each row by row (`m[row][column]`, rows are the output

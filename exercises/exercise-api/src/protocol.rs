@@ -1,7 +1,10 @@
 //! The wire protocol between the grader and an exercise crate's binary.
 //!
 //! The grader runs `<exercise binary> <task>` and writes a JSON array of inputs on stdin. The
-//! binary answers one JSON line per input, in order, flushed as it goes:
+//! binary answers on its own channel, never on stdout (a student's `println!` while debugging
+//! must not be read as an answer): the file descriptor named by the environment variable
+//! [`ANSWER_FD_ENV`], which the grader opens as a pipe (without it, as when you run the binary
+//! yourself, the answers go to stdout). One JSON line per input, in order, flushed as it goes:
 //! `{"ok": [numbers]}` with the answer flattened to numbers (see [`Answer`]; non-finite numbers
 //! are the strings `"NaN"`, `"inf"`, `"-inf"` because JSON has no such numbers), or
 //! `{"panic": "message"}`. A panic costs only that input; the grader kills a binary that runs
@@ -145,7 +148,7 @@ fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
 }
 
 /// Encodes one reply line.
-pub(crate) fn encode_reply(reply: &Result<Vec<f64>, String>) -> String {
+pub fn encode_reply(reply: &Result<Vec<f64>, String>) -> String {
     let v = match reply {
         Ok(nums) => {
             let arr = nums
@@ -165,7 +168,7 @@ pub(crate) fn encode_reply(reply: &Result<Vec<f64>, String>) -> String {
 }
 
 /// Decodes one reply line; `Err` carries the panic message (or why the line is unreadable).
-pub(crate) fn decode_reply(line: &str) -> Result<Vec<f64>, String> {
+pub fn decode_reply(line: &str) -> Result<Vec<f64>, String> {
     let v: Value = serde_json::from_str(line).map_err(|e| format!("unreadable reply: {e}"))?;
     if let Some(msg) = v.get("panic") {
         return Err(msg.as_str().unwrap_or("panicked").to_string());
@@ -185,9 +188,30 @@ pub(crate) fn decode_reply(line: &str) -> Result<Vec<f64>, String> {
         .collect()
 }
 
-/// The `main` of an exercise binary: `BINARY TASK < inputs.json`, or `BINARY --list`.
-/// Panics inside the student's code are caught per input and reported, never printed.
-pub fn serve(tasks: Vec<Task>) -> ExitCode {
+/// Names the file descriptor the answers go to (set by the grader).
+pub const ANSWER_FD_ENV: &str = "STEREOLAB_ANSWER_FD";
+
+/// Where the answers go: the grader's channel when it named one, else stdout.
+fn answer_channel() -> Box<dyn Write> {
+    #[cfg(unix)]
+    if let Some(fd) = std::env::var(ANSWER_FD_ENV)
+        .ok()
+        .and_then(|v| v.parse::<i32>().ok())
+        .filter(|fd| *fd > 2)
+    {
+        use std::os::fd::FromRawFd;
+        // SAFETY: the grader opened this descriptor for us and nothing else in this process
+        // uses it; if it is not open, the first write fails and `serve` exits with code 3.
+        return Box::new(unsafe { std::fs::File::from_raw_fd(fd) });
+    }
+    Box::new(std::io::stdout())
+}
+
+/// The `main` of an exercise binary: `BINARY TASK < inputs.json`, `BINARY --list` or
+/// `BINARY --source-hash` (the hash of the sources the grader built it from, so it can prove
+/// it runs the submission's code and not a stale build). Panics inside the student's code are
+/// caught per input and reported, never printed.
+pub fn serve(source_hash: &str, tasks: Vec<Task>) -> ExitCode {
     let args: Vec<String> = std::env::args().collect();
     let Some(name) = args.get(1) else {
         eprintln!("usage: {} TASK < inputs.json  (or --list)", args[0]);
@@ -198,6 +222,13 @@ pub fn serve(tasks: Vec<Task>) -> ExitCode {
             println!("{}", t.name);
         }
         return ExitCode::SUCCESS;
+    }
+    if name == "--source-hash" {
+        let mut out = answer_channel();
+        return match writeln!(out, "{source_hash}").and_then(|()| out.flush()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(_) => ExitCode::from(3),
+        };
     }
     let Some(task) = tasks.iter().find(|t| t.name == name) else {
         eprintln!("unknown task {name}");
@@ -217,8 +248,7 @@ pub fn serve(tasks: Vec<Task>) -> ExitCode {
     };
     // The grader reports panics itself; the default hook would only clutter stderr.
     std::panic::set_hook(Box::new(|_| {}));
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
+    let mut out = answer_channel();
     for input in &inputs {
         let line = encode_reply(&(task.run)(input));
         if writeln!(out, "{line}").and_then(|()| out.flush()).is_err() {
