@@ -38,6 +38,25 @@ pub struct TaskResult {
     pub details: Vec<String>,
     /// `(id, text)` of the likely mistake, for a task that lost points.
     pub hint: Option<(String, String)>,
+    /// The task's hidden cases (generated from the instructor's seed, never shipped), scored
+    /// apart so that results.json can publish them only after grades are published. `None`:
+    /// the task has none.
+    pub hidden: Option<HiddenResult>,
+}
+
+/// How a task's hidden cases scored (their points are part of the task's points).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HiddenResult {
+    /// Points earned on the hidden cases.
+    pub score: f64,
+    /// Points the hidden cases carry.
+    pub points: f64,
+    /// Hidden cases passed.
+    pub passed: usize,
+    /// Hidden cases.
+    pub total: usize,
+    /// What went wrong, as in [`TaskResult::details`].
+    pub details: Vec<String>,
 }
 
 impl TaskResult {
@@ -57,6 +76,7 @@ impl TaskResult {
                 "build".into(),
                 "fix the compile errors printed above first".into(),
             )),
+            hidden: None,
         }
     }
 }
@@ -245,6 +265,7 @@ pub(crate) fn evaluate(
         image_passed,
         details,
         hint,
+        hidden: None,
     }
 }
 
