@@ -286,11 +286,15 @@ fn files_under(dir: &Path) -> Vec<PathBuf> {
 fn exported_handout_has_no_solutions_builds_and_grades() {
     let _turn = take_turn();
     let handout = out_dir("handout");
+    let documents = out_dir("handout_documents");
+    std::fs::write(documents.join("course-copy.txt"), "the course's copy\n").unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
         .args(["exercises", "export"])
         .arg(&handout)
         .arg("--root")
         .arg(root())
+        .arg("--documents")
+        .arg(&documents)
         .output()
         .expect("run export");
     assert!(
@@ -316,6 +320,46 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
         }
     }
     assert!(handout.join("stereolab/assets/scenes/wuson.toml").is_file());
+    // Everything the stubs and the handout's README cite is in the handout.
+    for f in [
+        "slides/01-stereo-rig.md",
+        "stereolab/README.md",
+        "stereolab/docs/sources.md",
+        "stereolab/docs/anaglyph-matrices.md",
+        "stereolab/exercises/exercise-api/src/lib.rs",
+        "documents/course-copy.txt",
+    ] {
+        assert!(handout.join(f).is_file(), "{f} missing from the handout");
+    }
+    let readme = std::fs::read_to_string(handout.join("README.md")).unwrap();
+    for says in [
+        "Only `src/stubs.rs` is\n  graded",
+        "minutes",
+        "How points are given",
+        "println!",
+    ] {
+        assert!(
+            readme.contains(says),
+            "the handout README does not say {says:?}"
+        );
+    }
+    for ex in ["ex1_stereo", "ex2_chromadepth", "ex3_sirds"] {
+        let stubs = std::fs::read_to_string(handout.join(ex).join("src/stubs.rs")).unwrap();
+        for cited in stubs
+            .split('`')
+            .filter(|w| w.ends_with(".md") && w.contains('/'))
+        {
+            assert!(
+                handout.join(cited).is_file(),
+                "{ex} cites {cited}, not in the handout"
+            );
+        }
+        let manifest = std::fs::read_to_string(handout.join(ex).join("Cargo.toml")).unwrap();
+        assert!(
+            !manifest.contains("stereolab ="),
+            "{ex} depends on stereolab:\n{manifest}"
+        );
+    }
 
     // The handout's crates build (the grader builds them) and the untouched stubs grade to zero.
     let (_, v) = grade("all", &[], &handout, None, "handout");

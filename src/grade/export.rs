@@ -69,7 +69,7 @@ fn library_manifest(text: &str, path: &Path) -> Result<String> {
 ///
 /// # Errors
 /// Unreadable sources or an unwritable `dir`.
-pub fn export(root: &Path, dir: &Path) -> Result<()> {
+pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     let manifest_path = root.join("Cargo.toml");
     let manifest = std::fs::read_to_string(&manifest_path).map_err(io(&manifest_path))?;
     let lib = dir.join("stereolab");
@@ -82,6 +82,8 @@ pub fn export(root: &Path, dir: &Path) -> Result<()> {
     copy_tree(&root.join("src"), &lib.join("src"), &|_| false)?;
     // The crate documentation includes docs/formulas.md, and the code cites the rest.
     copy_tree(&root.join("docs"), &lib.join("docs"), &|_| false)?;
+    // The slides the stubs cite, at the handout's top level.
+    copy_tree(&root.join("slides"), &dir.join("slides"), &|_| false)?;
     for asset in ["scenes", "models"] {
         copy_tree(
             &root.join("assets").join(asset),
@@ -93,6 +95,7 @@ pub fn export(root: &Path, dir: &Path) -> Result<()> {
     // in (every build of a submission resolves from the same versions).
     for (from, to) in [
         (root.join("LICENSE"), lib.join("LICENSE")),
+        (root.join("README.md"), lib.join("README.md")),
         (root.join("Cargo.lock"), dir.join("Cargo.lock")),
         (root.join("Cargo.lock"), lib.join("Cargo.lock")),
     ] {
@@ -146,25 +149,85 @@ pub fn export(root: &Path, dir: &Path) -> Result<()> {
     );
     std::fs::write(dir.join("Cargo.toml"), workspace).map_err(io(dir))?;
     std::fs::write(dir.join("README.md"), HANDOUT_README).map_err(io(dir))?;
+    // The course's own copies of the source documents (not redistributable, so not in the
+    // repository): copied in when the instructor names the folder that holds them.
+    if let Some(docs) = documents {
+        if !docs.is_dir() {
+            return Err(Error::invalid(
+                "--documents",
+                docs.display(),
+                "not a folder: name the folder holding the course's copies of the documents \
+                 listed in docs/sources.md",
+            ));
+        }
+        copy_tree(docs, &dir.join("documents"), &|_| false)?;
+    }
     Ok(())
 }
 
-const HANDOUT_README: &str = "# Stereo rendering exercises
+const HANDOUT_README: &str = r#"# Stereo rendering exercises
 
-Three exercises, one crate each: `ex1_stereo` (the exercise slides: stereo frusta, anaglyphs, remapping,
-parallax), `ex2_chromadepth` (the ChromaDepth article), `ex3_sirds` (the SIRDS paper (Petz et al.)). Complete the `todo!`s in each
-crate's `src/stubs.rs`; every stub's doc comment states the task, the formula's source and the
-conventions (right-handed, NDC z in [-1, 1], eye index 0 = left).
+Three exercises, one crate each:
+
+| crate | topic | source (see `stereolab/docs/sources.md`) | points |
+| --- | --- | --- | --- |
+| `ex1_stereo` | stereo frusta, anaglyphs, remapping, visibility, parallax | the exercise slides, *Exercise 1: Stereoscopy* | see `grade` |
+| `ex2_chromadepth` | the ChromaDepth ramp and texgen | Bailey, Clark: *Using ChromaDepth to obtain Inexpensive Single-image Stereovision for Scientific Visualization* | 5 |
+| `ex3_sirds` | single-image random-dot stereograms | Petz, Goldlücke, Magnor: *Hardware-accelerated Autostereogram Rendering for Interactive 3D Visualization* | 5 |
+
+Complete the `todo!`s in each crate's `src/stubs.rs`. Every stub's doc comment states the task,
+its points, the formula's source and the conventions (right-handed, NDC z in [-1, 1], eye
+index 0 = left).
+
+What is here:
+- `ex1_stereo/`, `ex2_chromadepth/`, `ex3_sirds/`: your crates. **Only `src/stubs.rs` is
+  graded**: the grader builds a clean copy of each crate with your `src/stubs.rs` in it, so
+  changes to other files (and added dependencies) do not reach the grade. Your crate may use
+  `glam` and `exercise_api` (the types the stubs take and return), nothing else.
+- `slides/`: the course slides on the stereo rig.
+- `stereolab/`: the renderer and the grader. `stereolab/docs/sources.md` names the course's
+  source documents (title, authors, where to get them); `stereolab/docs/formulas.md` collects the
+  formulas; `stereolab/docs/anaglyph-matrices.md` holds the published anaglyph matrices the
+  bonus task needs. `documents/`, when your instructor added it, holds the documents
+  themselves.
+
+## Commands
 
 ```sh
-cargo test -p ex1_stereo                                  # the worked examples
-cargo run -p stereolab -- grade ex1                       # points, hints (or: all)
-cargo run -p stereolab -- grade all --json results.json   # Gradescope's format
+cargo test -p ex1_stereo                                  # the worked examples of the sources
+cargo run -p stereolab -- grade ex1                       # points, hints (or ex2, ex3, all)
 cargo run -p stereolab -- render --exercise ex1 stereolab/assets/scenes/wuson.toml --out out
 ```
 
-Passing: at least 50% of all points and at least 2 points in each exercise.
-";
+**The first `cargo run -p stereolab` compiles stereolab and its dependencies: several minutes
+on a two-core laptop** (about 4 to 5 minutes measured; later runs start at once). Each `grade`
+then builds your crates in `target/stereolab-grade/` in seconds.
+
+## How points are given
+
+- Each task is checked on many inputs (the numbers, with a tolerance printed beside every
+  failure) and, where it draws something, by an image check: your function plugged into the
+  real renderer, compared with the reference picture. The image check carries 30% of the task's
+  points, the numeric checks 70%, in proportion to the inputs you get right.
+- A mistake the grader recognizes (swapped eyes, a transposed matrix, degrees for radians, …)
+  is named in a hint. When every failing answer matches such a mistake, the task scores 0: the
+  formula is wrong, not an input.
+- The instructor may grade extra hidden inputs beside the ones you see.
+- A task whose function panics, loops (killed after 10 s), crashes or runs out of memory
+  (1 GiB) loses that task only.
+- Bonus tasks add points beyond the total.
+- Passing: at least 50% of all points and at least 2 points in each exercise.
+
+## Printing while you debug
+
+`println!` and `eprintln!` are fine: the grader shows the first lines of what each task printed
+and never reads it as an answer. Printing a lot slows a task down; remove it when you are done.
+
+## Pictures
+
+`grade` writes `expected | diff | actual` strips of failing image checks to `grade-out/`
+(cleared at each run). Open them next to the ASCII maps it prints.
+"#;
 
 #[cfg(test)]
 mod tests {

@@ -70,7 +70,7 @@ pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
 /// Bonus task `dubois_matrices` (1 bonus point): Dubois' least-squares red-cyan matrices.
 ///
 /// Source: Eric Dubois (2001), the CRT-derived numbers as in three.js' `AnaglyphEffect.js`
-/// (listed in `data/anaglyph-matrices.md` of the course material): six significant digits.
+/// (listed in `stereolab/docs/anaglyph-matrices.md` of the handout): six significant digits.
 /// Same layout as [`anaglyph_matrices`].
 pub fn dubois_matrices() -> AnaglyphMatrices {
     // TODO: copy the numbers carefully (public copies contain typos).

@@ -16,6 +16,11 @@ pub enum ExercisesCommand {
         /// The stereolab repository (default: . when it has exercises/, else the build's source).
         #[arg(long)]
         root: Option<PathBuf>,
+        /// A folder holding the course's copies of the source documents (see docs/sources.md),
+        /// copied into the handout's documents/ (they are not redistributable, so the
+        /// repository does not ship them).
+        #[arg(long)]
+        documents: Option<PathBuf>,
     },
 }
 
@@ -24,7 +29,11 @@ pub enum ExercisesCommand {
 /// # Errors
 /// The handout cannot be read or written.
 pub fn run(command: ExercisesCommand) -> Result<()> {
-    let ExercisesCommand::Export { dir, root } = command;
+    let ExercisesCommand::Export {
+        dir,
+        root,
+        documents,
+    } = command;
     let root = root.unwrap_or_else(|| {
         if Path::new("exercises/ex1_stereo").is_dir() {
             PathBuf::from(".")
@@ -32,7 +41,7 @@ pub fn run(command: ExercisesCommand) -> Result<()> {
             PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         }
     });
-    grade::export::export(&root, &dir)?;
+    grade::export::export(&root, &dir, documents.as_deref())?;
     outln!("wrote the student handout to {}", dir.display());
     Ok(())
 }
