@@ -272,3 +272,81 @@ mod tests {
         assert!(err.to_string().contains("a folder"), "{err}");
     }
 }
+
+/// Where a scene may read the files it names (models, terrain, pattern images): relative paths
+/// start at `base` (the scene's folder), and unless outside paths are allowed, the file a path
+/// names, with every symbolic link followed, must lie inside `base`'s folder tree. A scene handed
+/// in by someone else (a student's, to a grader) thereby reads nothing else on the machine.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InputRoot {
+    base: PathBuf,
+    allow_outside: bool,
+}
+
+impl InputRoot {
+    /// Paths confined to `base`'s folder tree.
+    pub fn confined(base: &Path) -> InputRoot {
+        InputRoot {
+            base: base.to_path_buf(),
+            allow_outside: false,
+        }
+    }
+
+    /// Paths relative to `base`, anywhere on the machine (`--allow-outside-paths`).
+    pub fn anywhere(base: &Path) -> InputRoot {
+        InputRoot {
+            base: base.to_path_buf(),
+            allow_outside: true,
+        }
+    }
+
+    /// The file `path` (from the scene's field `field`) names.
+    ///
+    /// # Errors
+    /// `Invalid` naming the field when the file lies outside the scene's folder tree (its
+    /// contents are never read, so no message can quote them); `Io` when it cannot be found.
+    pub fn resolve(&self, field: &str, path: &str) -> Result<PathBuf> {
+        let base = if self.base.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            &self.base
+        };
+        let joined = base.join(path);
+        if self.allow_outside {
+            return Ok(joined);
+        }
+        let root = base.canonicalize().map_err(|e| Error::io(base, e))?;
+        let full = joined.canonicalize().map_err(|e| Error::io(&joined, e))?;
+        if full.starts_with(&root) {
+            Ok(full)
+        } else {
+            Err(Error::invalid(
+                field,
+                format!("\"{}\"", path.escape_debug()),
+                format!(
+                    "names a file outside the scene's folder {}: a scene may read only files \
+                     in its own folder tree (pass --allow-outside-paths to allow it)",
+                    root.display()
+                ),
+            ))
+        }
+    }
+}
+
+/// Longest excerpt of an input line an error message quotes.
+pub const EXCERPT_CHARS: usize = 40;
+
+/// A short, printable excerpt of `text` for an error message: at most [`EXCERPT_CHARS`]
+/// characters, control characters and quotes escaped, `…` when cut. Messages never quote more
+/// of a file than this (the file may not be the user's to show).
+pub fn excerpt(text: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in text.chars().enumerate() {
+        if i == EXCERPT_CHARS {
+            out.push('…');
+            break;
+        }
+        out.extend(c.escape_debug());
+    }
+    out
+}

@@ -755,7 +755,7 @@ fn bad_terrain_csv_is_refused_naming_file_line_and_value() {
     assert!(m.contains("mesh[0].path") && m.contains("CSV"), "{m}");
     let m = message(scene(
         "",
-        "[[mesh]]\nkind = \"terrain\"\npath = \"../terrain/nope.csv\"\n",
+        "[[mesh]]\nkind = \"terrain\"\npath = \"terrain/nope.csv\"\n",
         &[],
     ));
     assert!(m.contains("nope.csv"), "{m}");

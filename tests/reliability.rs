@@ -187,6 +187,7 @@ fn fifos_and_devices_as_inputs_are_refused_at_once() {
             wuson.clone(),
             "--set".into(),
             "mesh.0.path=\"/dev/zero\"".into(),
+            "--allow-outside-paths".into(),
             "--out".into(),
             s(&dir),
         ],
@@ -353,4 +354,108 @@ fn oversized_images_are_refused_from_their_header() {
         !out.status.success() && stderr.contains("--frames"),
         "{stderr}"
     );
+}
+
+/// A scene in `dir` whose one mesh is `kind` read from `path` (and an optional extra line).
+fn scene_reading(dir: &Path, kind: &str, path: &str, extra: &str) -> PathBuf {
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "outputs = [\"left\"]\n{extra}\n[image]\nwidth = 32\nheight = 24\n[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n[[mesh]]\nkind = \"{kind}\"\npath = \"{path}\"\n"
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+/// Issue 14 item 4: a scene reads only files in its own folder tree unless
+/// `--allow-outside-paths` is given (absolute paths, `..`, links out of the tree, pattern
+/// images), and what an error quotes of a file is short and escaped.
+#[cfg(unix)]
+#[test]
+fn scenes_read_only_their_own_folder_tree_and_errors_quote_little() {
+    let dir = out_dir("reliability-confined");
+    let secret = out_dir("reliability-confined-outside").join("secret.csv");
+    let secret_line = format!("x;y;height;{}\x1b[31m\n", "SECRET".repeat(20));
+    std::fs::write(&secret, &secret_line).unwrap();
+    std::os::unix::fs::symlink(&secret, dir.join("link.csv")).unwrap();
+    let wuson = std::fs::read_to_string(asset("scenes/models/WusonOBJ.obj")).unwrap();
+    std::fs::create_dir_all(dir.join("models")).unwrap();
+    std::fs::write(dir.join("models/inside.obj"), wuson).unwrap();
+    let cases = [
+        ("terrain", s(&secret), ""),
+        (
+            "terrain",
+            "../reliability-confined-outside/secret.csv".to_string(),
+            "",
+        ),
+        ("terrain", "link.csv".to_string(), ""),
+        (
+            "obj",
+            "models/inside.obj".to_string(),
+            &*format!("[sirds]\npattern_image = \"{}\"", s(&secret)),
+        ),
+    ];
+    for (kind, path, extra) in cases {
+        let scene = s(&scene_reading(&dir, kind, &path, extra));
+        let out = stereolab(&["info", &scene]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{path}: {err}");
+        assert!(
+            err.contains("outside the scene's folder") && err.contains("--allow-outside-paths"),
+            "{path}: {err}"
+        );
+        assert!(!err.contains("SECRET"), "{path} leaked the file: {err}");
+    }
+    // Inside the tree, the same scene loads.
+    let inside = s(&scene_reading(&dir, "obj", "models/inside.obj", ""));
+    assert!(stereolab(&["info", &inside]).status.success());
+    // With the flag the file is read, and the error quotes at most a short escaped excerpt.
+    let scene = s(&scene_reading(&dir, "terrain", &s(&secret), ""));
+    let out = stereolab(&["info", &scene, "--allow-outside-paths"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("SECRET"), "the excerpt: {err}");
+    assert!(err.matches("SECRET").count() <= 7, "quotes too much: {err}");
+    assert!(
+        !err.contains('\x1b'),
+        "control characters must be escaped: {err}"
+    );
+}
+
+/// Issue 14 item 6: a small scene asking for millions of triangles is refused before anything
+/// is built, naming the field, the count, the budget and the flag; the flag moves the budget.
+#[test]
+fn a_scene_over_its_triangle_budget_is_refused_before_it_is_built() {
+    let dir = out_dir("reliability-budget");
+    for (mesh, field) in [
+        ("kind = \"sphere\"\ndetail = 4096", "mesh[0].detail"),
+        ("kind = \"triangles\"\ncount = 10000000", "mesh[0].count"),
+    ] {
+        let scene = dir.join("big.toml");
+        std::fs::write(
+            &scene,
+            format!("outputs = [\"left\"]\n[image]\nwidth = 64\nheight = 48\n[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n[[mesh]]\n{mesh}\n"),
+        )
+        .unwrap();
+        let started = std::time::Instant::now();
+        let out = stereolab(&["info", &s(&scene)]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains(field)
+                && err.contains("budget of 4000000")
+                && err.contains("--max-triangles"),
+            "{err}"
+        );
+        // Refused from the numbers, not after building ~16M triangles (which takes seconds).
+        assert!(
+            started.elapsed().as_secs() < 5,
+            "took {:?}",
+            started.elapsed()
+        );
+    }
+    let out = stereolab(&["info", &s(&dir.join("big.toml")), "--max-triangles", "10"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("budget of 10"));
 }

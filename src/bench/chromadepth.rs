@@ -253,7 +253,7 @@ fn glasses_and_terrain(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let (fb, _) = render_view(scene, &center, Shading::ChromaDepth)?;
     let shift = scene.chromadepth.max_shift_px(fb.width);
     let glasses_ms = median_ms(iters, || glasses_pair(&fb, shift));
-    let csv = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/terrain/island.csv");
+    let csv = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/terrain/island.csv");
     let text = std::fs::read_to_string(&csv).map_err(|e| Error::io(&csv, e))?;
     let points = terrain::parse_csv(&csv, &text)?;
     let mut triangles = 0;

@@ -10,7 +10,7 @@ pub(crate) use file::SceneFile;
 pub use mesh::Mesh;
 pub use obj::load_obj;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::{EulerRot, Mat4, Quat, Vec3};
 
@@ -18,6 +18,7 @@ use crate::effects::anaglyph::AnaglyphOptions;
 use crate::effects::chromadepth::ChromaDepthSettings;
 use crate::effects::parallax::ParallaxRig;
 use crate::error::{Error, Result};
+use crate::files::InputRoot;
 use crate::framebuffer::check_size;
 use crate::math::{Camera, Separation, StereoRig, ZeroParallax};
 use crate::plan::Output;
@@ -72,12 +73,52 @@ pub struct Scene {
 /// separate files with their own limits).
 const MAX_SCENE_BYTES: u64 = 16 * 1024 * 1024;
 
+/// The triangle budget a scene gets unless told otherwise: a few million triangles render in
+/// well under a second and take a few hundred MB.
+pub const DEFAULT_MAX_TRIANGLES: u64 = 4_000_000;
+
+/// How a scene file is loaded: where it may read files, and its triangle budget.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Read files outside the scene's folder tree (`--allow-outside-paths`).
+    pub allow_outside_paths: bool,
+    /// The most triangles all meshes together may have (`--max-triangles`).
+    pub max_triangles: u64,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            allow_outside_paths: false,
+            max_triangles: DEFAULT_MAX_TRIANGLES,
+        }
+    }
+}
+
+impl LoadOptions {
+    fn root(&self, base: &Path) -> InputRoot {
+        if self.allow_outside_paths {
+            InputRoot::anywhere(base)
+        } else {
+            InputRoot::confined(base)
+        }
+    }
+}
+
 impl Scene {
     /// Reads a scene file, applies `--set key=value` overrides, loads its models, validates it.
     ///
     /// # Errors
     /// Any I/O, TOML, OBJ or validation error, naming the file and the field.
     pub fn load(path: &Path, sets: &[String]) -> Result<Scene> {
+        Scene::load_with(path, sets, &LoadOptions::default())
+    }
+
+    /// [`Scene::load`] with explicit [`LoadOptions`] (outside paths, the triangle budget).
+    ///
+    /// # Errors
+    /// As [`Scene::load`].
+    pub fn load_with(path: &Path, sets: &[String], opts: &LoadOptions) -> Result<Scene> {
         let bytes = crate::files::read_input(path, MAX_SCENE_BYTES)?;
         let text = String::from_utf8(bytes).map_err(|e| {
             Error::parse(
@@ -87,7 +128,7 @@ impl Scene {
             )
         })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        Scene::from_toml(&text, path, &base, sets)
+        Scene::from_toml_with(&text, path, &opts.root(&base), sets, opts.max_triangles)
     }
 
     /// Parses scene text; `path` is used in messages, `base_dir` resolves relative model paths.
@@ -95,6 +136,17 @@ impl Scene {
     /// # Errors
     /// As [`Scene::load`].
     pub fn from_toml(text: &str, path: &Path, base_dir: &Path, sets: &[String]) -> Result<Scene> {
+        let opts = LoadOptions::default();
+        Scene::from_toml_with(text, path, &opts.root(base_dir), sets, opts.max_triangles)
+    }
+
+    fn from_toml_with(
+        text: &str,
+        path: &Path,
+        root: &InputRoot,
+        sets: &[String],
+        max_triangles: u64,
+    ) -> Result<Scene> {
         let mut table: toml::Table =
             toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
         for s in sets {
@@ -107,14 +159,14 @@ impl Scene {
                 _ => Error::parse(path, None, e.message().to_string()),
             }
         })?;
-        Scene::from_file(file, base_dir).map_err(|e| e.in_file(path))
+        Scene::from_file(file, root, max_triangles).map_err(|e| e.in_file(path))
     }
 
     /// Validates a parsed scene file and loads its meshes.
     ///
     /// # Errors
     /// The first invalid field.
-    pub(crate) fn from_file(f: SceneFile, base_dir: &Path) -> Result<Scene> {
+    pub(crate) fn from_file(f: SceneFile, root: &InputRoot, max_triangles: u64) -> Result<Scene> {
         check_size(f.image.width, f.image.height)?;
         f.camera.validate()?;
         let separation = match &f.stereo.eye_separation {
@@ -186,8 +238,12 @@ impl Scene {
             .meshes
             .iter()
             .enumerate()
-            .map(|(i, m)| load_object(i, m, base_dir))
+            .map(|(i, m)| load_object(i, m, root, max_triangles))
             .collect::<Result<Vec<_>>>()?;
+        let triangles: u64 = objects.iter().map(|o| o.mesh.triangles.len() as u64).sum();
+        if triangles > max_triangles {
+            return Err(over_budget("mesh", triangles, max_triangles));
+        }
         Ok(Scene {
             width: f.image.width,
             height: f.image.height,
@@ -207,7 +263,7 @@ impl Scene {
                 linear_light: f.finalize.linear_light,
                 swap_eyes: f.finalize.swap_eyes,
             },
-            sirds: crate::effects::sirds::Settings::from_spec(&f.sirds, base_dir)?,
+            sirds: crate::effects::sirds::Settings::from_spec(&f.sirds, root)?,
         })
     }
 
@@ -264,7 +320,24 @@ fn check_finite(field: &str, v: &[f32]) -> Result<()> {
 }
 
 /// Builds one `[[mesh]]` entry.
-fn load_object(i: usize, m: &file::MeshSpec, base_dir: &Path) -> Result<Object> {
+/// The triangle budget's error: what the scene asks for, the limit, and the flag that moves it.
+fn over_budget(field: &str, triangles: u64, max: u64) -> Error {
+    Error::invalid(
+        field,
+        format!("{triangles} triangles"),
+        format!(
+            "over the scene's budget of {max} triangles (lower the detail or count, or raise \
+             the budget with --max-triangles)"
+        ),
+    )
+}
+
+fn load_object(
+    i: usize,
+    m: &file::MeshSpec,
+    root: &InputRoot,
+    max_triangles: u64,
+) -> Result<Object> {
     let field = |f: &str| format!("mesh[{i}].{f}");
     let positive = |name: &str, v: Option<f32>, default: f32| -> Result<f32> {
         let v = v.unwrap_or(default);
@@ -286,13 +359,30 @@ fn load_object(i: usize, m: &file::MeshSpec, base_dir: &Path) -> Result<Object> 
             "must lie in 3..=4096",
         ));
     }
+    // Generated meshes are checked against the budget before they are built.
+    let planned: u64 = match m.kind.as_str() {
+        "sphere" | "torus" => 2 * u64::from(detail) * u64::from(detail / 2),
+        "plane" => 2 * u64::from(detail.min(512)).pow(2),
+        "triangles" => u64::from(m.count.unwrap_or(1000)),
+        _ => 0,
+    };
+    if planned > max_triangles {
+        return Err(over_budget(
+            &field(if m.kind == "triangles" {
+                "count"
+            } else {
+                "detail"
+            }),
+            planned,
+            max_triangles,
+        ));
+    }
     let mesh = match m.kind.as_str() {
         "obj" => {
             let p = m.path.as_ref().ok_or_else(|| {
                 Error::invalid(field("path"), "missing", "an obj mesh needs a path")
             })?;
-            let full: PathBuf = base_dir.join(p);
-            load_obj(&full)?
+            load_obj(&root.resolve(&field("path"), p)?)?
         }
         "sphere" => Mesh::sphere(positive("size", m.size, 1.0)?, detail, detail / 2),
         "cube" => Mesh::cube(positive("size", m.size, 1.0)?),
@@ -306,7 +396,7 @@ fn load_object(i: usize, m: &file::MeshSpec, base_dir: &Path) -> Result<Object> 
             let p = m.path.as_ref().ok_or_else(|| {
                 Error::invalid(field("path"), "missing", "a terrain mesh needs a CSV path")
             })?;
-            terrain::load_terrain_csv(&base_dir.join(p))?.mesh
+            terrain::load_terrain_csv(&root.resolve(&field("path"), p)?)?.mesh
         }
         "plane" => Mesh::plane(positive("size", m.size, 1.0)?, detail.min(512)),
         "triangles" => {

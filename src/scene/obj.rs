@@ -6,6 +6,7 @@ use glam::{Vec2, Vec3};
 
 use super::mesh::Mesh;
 use crate::error::{Error, Result};
+use crate::files::excerpt;
 
 /// Refuse OBJ files above this size before reading them (the largest real model we ship is < 1 MB).
 const MAX_OBJ_BYTES: u64 = 512 * 1024 * 1024;
@@ -103,7 +104,7 @@ fn check_lines(path: &Path, text: &str) -> Result<()> {
                         return Err(Error::parse(
                             path,
                             Some(line),
-                            format!("'{tag}' coordinate '{w}' is not a finite number"),
+                            format!("'{tag}' coordinate '{}' is not a finite number", excerpt(w)),
                         ));
                     }
                     count += 1;
@@ -112,7 +113,10 @@ fn check_lines(path: &Path, text: &str) -> Result<()> {
                     return Err(Error::parse(
                         path,
                         Some(line),
-                        format!("'{tag}' needs {need} coordinates, found {count}: '{raw}'"),
+                        format!(
+                            "'{tag}' needs {need} coordinates, found {count}: '{}'",
+                            excerpt(raw)
+                        ),
                     ));
                 }
                 match tag {
@@ -128,8 +132,9 @@ fn check_lines(path: &Path, text: &str) -> Result<()> {
                         path,
                         Some(line),
                         format!(
-                            "face needs at least 3 corners, found {}: '{raw}'",
-                            corners.len()
+                            "face needs at least 3 corners, found {}: '{}'",
+                            corners.len(),
+                            excerpt(raw)
                         ),
                     ));
                 }
@@ -147,7 +152,7 @@ fn check_lines(path: &Path, text: &str) -> Result<()> {
                             Error::parse(
                                 path,
                                 Some(line),
-                                format!("face {what} index '{part}' is not an integer"),
+                                format!("face {what} index '{}' is not an integer", excerpt(part)),
                             )
                         })?;
                         let resolved = if idx < 0 { count + idx + 1 } else { idx };

@@ -9,6 +9,7 @@ use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 use super::mesh::Mesh;
 use crate::error::{Error, Result};
+use crate::files::excerpt;
 
 /// Refuse CSV files above this size before reading them.
 const MAX_CSV_BYTES: u64 = 256 * 1024 * 1024;
@@ -108,14 +109,22 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<Vec<TerrainPoint>> {
                 Error::parse(
                     path,
                     Some(line),
-                    format!("column {}: \"{text}\" is not a number", COLUMNS[k]),
+                    format!(
+                        "column {}: \"{}\" is not a number",
+                        COLUMNS[k],
+                        excerpt(text)
+                    ),
                 )
             })?;
             if !value.is_finite() {
                 return Err(Error::parse(
                     path,
                     Some(line),
-                    format!("column {} = {text}: must be a finite number", COLUMNS[k]),
+                    format!(
+                        "column {} = {}: must be a finite number",
+                        COLUMNS[k],
+                        excerpt(text)
+                    ),
                 ));
             }
             v[k] = value;
@@ -146,7 +155,7 @@ fn header_columns(path: &Path, line: usize, fields: &[&str]) -> Result<[usize; 3
                 format!(
                     "missing column \"{}\" (the header names: {}; a terrain needs x, y, height)",
                     COLUMNS[k],
-                    fields.join(", ")
+                    excerpt(&fields.join(", "))
                 ),
             )
         })?;

@@ -1,4 +1,4 @@
-//! The terrain data sets shipped under `assets/terrain/`, in the spirit of the ChromaDepth article's gallery:
+//! The terrain data sets shipped under `assets/scenes/terrain/`, in the spirit of the ChromaDepth article's gallery:
 //! an earthquake fault valley and a map-like island. Generated deterministically from fixed
 //! seeds with integer hashing and `+ − × ÷` only (no `sin`/`exp`, whose last bits vary between
 //! math libraries), so the same CSV bytes come out on every machine.
@@ -131,7 +131,7 @@ pub fn to_csv(title: &str, points: &[[f64; 3]]) -> String {
     s
 }
 
-/// The shipped data sets: file name under `assets/terrain/`, its header comment, its points.
+/// The shipped data sets: file name under `assets/scenes/terrain/`, its header comment, its points.
 pub fn shipped() -> [(&'static str, &'static str, Vec<[f64; 3]>); 2] {
     [
         (

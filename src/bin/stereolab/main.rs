@@ -50,7 +50,19 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Let a scene read files outside its own folder tree (models, terrain, pattern images).
+    /// Off by default, so a scene someone hands you reads nothing else on your machine.
+    #[arg(long, global = true)]
+    allow_outside_paths: bool,
+    /// The most triangles a scene's meshes may have together.
+    #[arg(long, global = true, default_value_t = stereolab::scene::DEFAULT_MAX_TRIANGLES,
+          value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
+    max_triangles: u64,
 }
+
+/// The scene-loading options of this run (`--allow-outside-paths`, `--max-triangles`).
+static LOAD_OPTIONS: std::sync::OnceLock<stereolab::scene::LoadOptions> =
+    std::sync::OnceLock::new();
 
 #[derive(Subcommand)]
 enum Command {
@@ -103,7 +115,8 @@ fn scalar_requested() -> bool {
 
 /// Loads a scene with `--set` overrides, `--size`, and `STEREOLAB_SCALAR` applied.
 fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Result<Scene> {
-    let mut s = Scene::load(path, sets)?;
+    let opts = LOAD_OPTIONS.get().copied().unwrap_or_default();
+    let mut s = Scene::load_with(path, sets, &opts)?;
     if scalar_requested() {
         s.set_simd(false);
     }
@@ -144,6 +157,10 @@ fn run(cli: Cli) -> Result<()> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let _ = LOAD_OPTIONS.set(stereolab::scene::LoadOptions {
+        allow_outside_paths: cli.allow_outside_paths,
+        max_triangles: cli.max_triangles,
+    });
     // The whole command runs on a worker of the thread pool, so every parallel pass inside it
     // starts from the pool instead of waking it from outside: a 512×512 SIRDS frame (the SIRDS
     // paper's Table 1 row 1) made of seven parallel passes took 6–8% less time. The main

@@ -59,7 +59,11 @@ fn settings_from_sets(sets: &[String]) -> Result<Settings> {
     }
     let spec: SirdsSpec = toml::from_str(&text)
         .map_err(|e| Error::invalid("--set", sets.join(" "), e.message().to_string()))?;
-    Settings::from_spec(&spec, Path::new("."))
+    // Paths typed on the command line are the user's own: not confined.
+    Settings::from_spec(
+        &spec,
+        &stereolab::files::InputRoot::anywhere(Path::new(".")),
+    )
 }
 
 /// Whether `path` ends in one of `extensions` (ASCII case ignored).

@@ -9,6 +9,7 @@ use super::disparity::{DisparityModel, Geometry};
 use super::pattern::Pattern;
 use super::per_pixel::{MAX_OVERSAMPLE, PerPixelOptions};
 use crate::error::{Error, Result};
+use crate::files::InputRoot;
 
 /// Where the pattern strip sits (the SIRDS paper's Fig. 7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -179,16 +180,17 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Self {
-        Settings::from_spec(&SirdsSpec::default(), Path::new("")).expect("defaults are valid")
+        Settings::from_spec(&SirdsSpec::default(), &InputRoot::anywhere(Path::new("")))
+            .expect("defaults are valid")
     }
 }
 
 impl Settings {
-    /// Validates `spec`; a pattern image path is relative to `base_dir`.
+    /// Validates `spec`; a pattern image path is resolved by `root` (the scene's folder).
     ///
     /// # Errors
     /// The first invalid `sirds.*` field, or an unreadable pattern image.
-    pub fn from_spec(spec: &SirdsSpec, base_dir: &Path) -> Result<Settings> {
+    pub fn from_spec(spec: &SirdsSpec, root: &InputRoot) -> Result<Settings> {
         let g = Geometry::default();
         let geometry = Geometry {
             model: spec.model,
@@ -221,7 +223,7 @@ impl Settings {
         }
         let seed = spec.seed.unwrap_or(1);
         let pattern = match &spec.pattern_image {
-            Some(p) => Pattern::load_image(&base_dir.join(p))?,
+            Some(p) => Pattern::load_image(&root.resolve("sirds.pattern_image", p)?)?,
             None => match spec.dots {
                 DotKind::BlackWhite => Pattern::BlackWhite { seed },
                 DotKind::Gray => Pattern::Gray { seed },
