@@ -540,7 +540,7 @@ fn csv_points(text: &str) -> Result<terrain::Terrain, Error> {
 
 #[test]
 fn every_input_point_is_a_terrain_vertex() {
-    let path = common::asset("terrain/island.csv");
+    let path = common::asset("scenes/terrain/island.csv");
     let text = std::fs::read_to_string(&path).expect("shipped");
     let points = terrain::parse_csv(&path, &text).expect("parses");
     let t = terrain::triangulate(&path, &points).expect("triangulates");
@@ -564,7 +564,7 @@ fn every_input_point_is_a_terrain_vertex() {
 
 #[test]
 fn terrain_triangles_have_empty_circumcircles() {
-    let path = common::asset("terrain/fault_valley.csv");
+    let path = common::asset("scenes/terrain/fault_valley.csv");
     let text = std::fs::read_to_string(&path).expect("shipped");
     let points = terrain::parse_csv(&path, &text).expect("parses");
     let t = terrain::triangulate(&path, &points).expect("triangulates");
@@ -625,7 +625,7 @@ fn terrain_csv_header_may_reorder_columns() {
 #[test]
 fn shipped_terrain_data_matches_its_generator() {
     for (file, title, points) in terrain_data::shipped() {
-        let path = common::asset(&format!("terrain/{file}"));
+        let path = common::asset(&format!("scenes/terrain/{file}"));
         let csv = terrain_data::to_csv(title, &points);
         if std::env::var_os("UPDATE_ASSETS").is_some() {
             std::fs::write(&path, &csv).expect("write asset");

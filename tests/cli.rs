@@ -34,6 +34,12 @@ fn wuson() -> String {
 /// Writes a scene that renders one OBJ file.
 fn obj_scene(dir: &Path, obj: &Path) -> String {
     let scene = dir.join("obj.toml");
+    // A scene reads only files in its own folder tree: the model is copied next to it.
+    let local = dir.join(obj.file_name().expect("a file"));
+    if !obj.starts_with(dir) {
+        std::fs::copy(obj, &local).expect("copy the model");
+    }
+    let obj = local.as_path();
     let text = format!(
         "outputs = [\"left\"]\n[image]\nwidth = 32\nheight = 24\n[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n[[mesh]]\nkind = \"obj\"\npath = \"{}\"\n",
         obj.display()
@@ -104,7 +110,7 @@ fn malformed_obj_files_name_file_line_and_value() {
     let dir = out_dir("cli_obj");
     let err = fails(&[
         "render",
-        &obj_scene(&dir, &asset("models/invalid/malformed.obj")),
+        &obj_scene(&dir, &asset("scenes/models/invalid/malformed.obj")),
         "--out",
         dir.to_str().unwrap(),
     ]);
@@ -114,7 +120,7 @@ fn malformed_obj_files_name_file_line_and_value() {
     );
     let err = fails(&[
         "render",
-        &obj_scene(&dir, &asset("models/invalid/empty.obj")),
+        &obj_scene(&dir, &asset("scenes/models/invalid/empty.obj")),
         "--out",
         dir.to_str().unwrap(),
     ]);
@@ -147,7 +153,7 @@ fn obj_with_missing_material_library_renders_but_an_empty_face_does_not() {
     let dir = out_dir("cli_obj_material");
     let err = fails(&[
         "render",
-        &obj_scene(&dir, &asset("models/invalid/malformed2.obj")),
+        &obj_scene(&dir, &asset("scenes/models/invalid/malformed2.obj")),
         "--out",
         dir.to_str().unwrap(),
     ]);
@@ -156,7 +162,7 @@ fn obj_with_missing_material_library_renders_but_an_empty_face_does_not() {
         "{err}"
     );
     let fixed = dir.join("material.obj");
-    let text = std::fs::read_to_string(asset("models/invalid/malformed2.obj"))
+    let text = std::fs::read_to_string(asset("scenes/models/invalid/malformed2.obj"))
         .unwrap()
         .replace("\nf\n", "\n");
     std::fs::write(&fixed, text).unwrap();
