@@ -156,6 +156,11 @@ pub struct Comparison {
     pub has_depth: bool,
     /// The `expected | diff | actual` strip, when one was written.
     pub strip: Option<PathBuf>,
+    /// Images with 16 bits per channel are compared at 16 bits: this is the largest channel
+    /// difference in 16-bit levels (0..=65535), and the metrics give the mean difference in
+    /// 8-bit steps (fractional), the PSNR against 65535, and the largest difference rounded up
+    /// to 8-bit steps (so that any difference shows). `None`: compared at 8 bits.
+    pub max_levels_16: Option<u16>,
 }
 
 /// The comparisons as an aligned table, one row each.
@@ -182,6 +187,13 @@ pub fn table(rows: &[Comparison]) -> String {
             m.psnr,
             depth
         );
+        if let Some(levels) = r.max_levels_16 {
+            let _ = writeln!(
+                s,
+                "{:<24} compared at 16 bits: max diff {levels} of 65535 levels (above in 8-bit steps, rounded up)",
+                ""
+            );
+        }
     }
     s
 }
@@ -329,12 +341,17 @@ pub fn compare_images(
     background: Option<[u8; 4]>,
     out: Option<&Path>,
 ) -> Result<Comparison> {
-    let load = |p: &Path| -> Result<Framebuffer> {
-        let img = load_image(p)?;
+    let (de, da) = (
+        crate::framebuffer::open_image(expected, "image")?,
+        crate::framebuffer::open_image(actual, "image")?,
+    );
+    let to_fb = |img: &image::DynamicImage| -> Framebuffer {
+        let img = img.to_rgba8();
         let bg = background.unwrap_or_else(|| img.get_pixel(0, 0).0);
-        Ok(framebuffer_from_image(&img, bg))
+        framebuffer_from_image(&img, bg)
     };
-    let (e, a) = (load(expected)?, load(actual)?);
+    let (e, a) = (to_fb(&de), to_fb(&da));
+    let deep = is_16_bit(&de) || is_16_bit(&da);
     let metrics = compare(&e, &a).map_err(|err| match err {
         Error::Invalid { value, .. } => Error::invalid(
             format!("{} vs {}", expected.display(), actual.display()),
@@ -350,12 +367,67 @@ pub fn compare_images(
     let strip = out
         .map(|dir| write_diff_strip(&e, &a, dir, &format!("{name}-diff")))
         .transpose()?;
+    let (metrics, max_levels_16) = if deep {
+        let bg16 = background.map(|b| b.map(|c| u16::from(c) * 257));
+        let (m, max) = compare_16(&de.to_rgba16(), &da.to_rgba16(), bg16);
+        (m, Some(max))
+    } else {
+        (metrics, None)
+    };
     Ok(Comparison {
         name,
         metrics,
         has_depth: false,
         strip,
+        max_levels_16,
     })
+}
+
+/// Whether an image holds 16 bits per channel (16-bit PNG or PGM, as depth maps often are).
+fn is_16_bit(img: &image::DynamicImage) -> bool {
+    use image::ColorType::{L16, La16, Rgb16, Rgba16};
+    matches!(img.color(), L16 | La16 | Rgb16 | Rgba16)
+}
+
+/// The metrics of two same-sized images at 16 bits per channel (see
+/// [`Comparison::max_levels_16`]); a pixel is covered when it differs from the background
+/// (`background`, else each image's top-left pixel). Returns the metrics and the largest
+/// difference in 16-bit levels.
+fn compare_16(
+    expected: &image::ImageBuffer<image::Rgba<u16>, Vec<u16>>,
+    actual: &image::ImageBuffer<image::Rgba<u16>, Vec<u16>>,
+    background: Option<[u16; 4]>,
+) -> (Metrics, u16) {
+    let bg_e = background.unwrap_or_else(|| expected.get_pixel(0, 0).0);
+    let bg_a = background.unwrap_or_else(|| actual.get_pixel(0, 0).0);
+    let (mut max, mut sum, mut sq, mut mismatch) = (0u16, 0u64, 0u128, 0usize);
+    for (pe, pa) in expected.pixels().zip(actual.pixels()) {
+        for c in 0..3 {
+            let d = pe[c].abs_diff(pa[c]);
+            max = max.max(d);
+            sum += u64::from(d);
+            sq += u128::from(d) * u128::from(d);
+        }
+        if (pe.0[..3] != bg_e[..3]) != (pa.0[..3] != bg_a[..3]) {
+            mismatch += 1;
+        }
+    }
+    let pixels = (expected.width() as usize) * (expected.height() as usize);
+    let n = (3 * pixels).max(1) as f64;
+    let psnr = if sq == 0 {
+        f64::INFINITY
+    } else {
+        10.0 * (65535.0f64 * 65535.0 / (sq as f64 / n)).log10()
+    };
+    let metrics = Metrics {
+        pixels,
+        coverage_mismatch: mismatch,
+        max_channel_diff: u8::try_from(max.div_ceil(257)).unwrap_or(u8::MAX),
+        mean_channel_diff: sum as f64 / n / 257.0,
+        psnr,
+        max_depth_diff: 0.0,
+    };
+    (metrics, max)
 }
 
 #[cfg(test)]
@@ -379,6 +451,7 @@ mod tests {
             metrics: m,
             has_depth,
             strip: None,
+            max_levels_16: None,
         }
     }
 

@@ -452,3 +452,33 @@ fn a_scene_over_its_triangle_budget_is_refused_before_it_is_built() {
     let out = stereolab(&["info", &s(&dir.join("big.toml")), "--max-triangles", "10"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("budget of 10"));
 }
+
+/// Issue 14 item 7: 16-bit images (depth maps) are compared at 16 bits; two maps 100 levels
+/// apart used to compare as identical after the reduction to 8 bits.
+#[test]
+fn sixteen_bit_images_are_compared_at_their_own_depth() {
+    let dir = out_dir("reliability-16bit");
+    let map = |name: &str, offset: u16| {
+        let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(32, 16, |x, y| {
+            image::Luma([1000 + 1000 * x as u16 + 10 * y as u16 + offset])
+        });
+        let p = dir.join(name);
+        img.save(&p).expect("write 16-bit png");
+        s(&p)
+    };
+    let (a, b, same) = (map("a.png", 0), map("b.png", 100), map("c.png", 0));
+    let out = stereolab(&["compare", &a, &b]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("compared at 16 bits: max diff 100 of 65535 levels"),
+        "{stdout}"
+    );
+    assert!(
+        !stdout.contains(" inf "),
+        "a difference must show in the PSNR: {stdout}"
+    );
+    let out = stereolab(&["compare", &a, &same]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    assert!(stdout.contains("max diff 0 of 65535 levels"), "{stdout}");
+}

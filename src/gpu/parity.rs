@@ -106,6 +106,7 @@ pub fn compare_finalize(
             metrics,
             has_depth: false,
             strip,
+            max_levels_16: None,
         });
     }
     Ok(rows)
@@ -133,6 +134,7 @@ pub fn compare_frames(
             metrics,
             has_depth: true,
             strip,
+            max_levels_16: None,
         });
     }
     for &o in &expected.plan.outputs {
@@ -157,6 +159,7 @@ pub fn compare_frames(
             metrics,
             has_depth: false,
             strip,
+            max_levels_16: None,
         });
     }
     Ok(rows)

@@ -72,5 +72,6 @@ pub fn compare_strips(
         metrics,
         has_depth: false,
         strip,
+        max_levels_16: None,
     }])
 }

@@ -117,6 +117,7 @@ pub fn compare_exercise(
             metrics,
             has_depth: true,
             strip,
+            max_levels_16: None,
         });
     }
     Ok(result)
