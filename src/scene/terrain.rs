@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
-use spade::{DelaunayTriangulation, Point2, Triangulation};
+use spade::{DelaunayTriangulation, HierarchyHintGenerator, Point2, Triangulation};
 
 use super::mesh::Mesh;
 use crate::error::{Error, Result};
@@ -172,7 +172,12 @@ fn header_columns(path: &Path, line: usize, fields: &[&str]) -> Result<[usize; 3
 /// `Parse` naming `path`: fewer than 3 distinct points, all points on one line (no triangle), or
 /// a coordinate spade cannot represent (naming the line).
 pub fn triangulate(path: &Path, points: &[TerrainPoint]) -> Result<Terrain> {
-    let mut dt: DelaunayTriangulation<Point2<f64>> = DelaunayTriangulation::new();
+    // The hierarchy finds where each point goes in O(log n) whatever the file's order; spade's
+    // default walks from the last point inserted, which is quick for row-by-row files but
+    // took 31 s of CPU for 300 000 points in random order (1.4 s with the hierarchy; 1M points in row order: 1.8 s before, 2.3 s now). Only the
+    // search differs: the triangulation is the same.
+    let mut dt: DelaunayTriangulation<Point2<f64>, (), (), (), HierarchyHintGenerator<f64>> =
+        DelaunayTriangulation::new();
     let mut sums: Vec<(f64, f64, f64, u32)> = Vec::new(); // x, y, height sum, count
     let mut vertex_of_point = Vec::with_capacity(points.len());
     for p in points {
