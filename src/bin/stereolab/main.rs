@@ -113,10 +113,46 @@ fn scalar_requested() -> bool {
     std::env::var_os("STEREOLAB_SCALAR").is_some_and(|v| !v.is_empty() && v != "0")
 }
 
+/// Runs `work`, showing a spinner with `what` on a terminal's stderr once it has taken more
+/// than a second (never for quick work, never into a pipe or a file).
+fn with_spinner<T>(what: &str, work: impl FnOnce() -> T) -> T {
+    use std::sync::{Arc, Condvar, Mutex};
+    let done = Arc::new((Mutex::new(false), Condvar::new()));
+    let watcher = {
+        let (done, what) = (Arc::clone(&done), what.to_string());
+        std::thread::spawn(move || {
+            let (lock, cv) = &*done;
+            let guard = lock.lock().unwrap_or_else(|e| e.into_inner());
+            let (guard, _) = cv
+                .wait_timeout_while(guard, std::time::Duration::from_secs(1), |d| !*d)
+                .unwrap_or_else(|e| e.into_inner());
+            if *guard {
+                return;
+            }
+            drop(guard);
+            let bar = indicatif::ProgressBar::new_spinner().with_message(what);
+            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+            let guard = lock.lock().unwrap_or_else(|e| e.into_inner());
+            let _unused = cv.wait_while(guard, |d| !*d);
+            bar.finish_and_clear();
+        })
+    };
+    let result = work();
+    {
+        let (lock, cv) = &*done;
+        *lock.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        cv.notify_all();
+    }
+    let _ = watcher.join();
+    result
+}
+
 /// Loads a scene with `--set` overrides, `--size`, and `STEREOLAB_SCALAR` applied.
 fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Result<Scene> {
     let opts = LOAD_OPTIONS.get().copied().unwrap_or_default();
-    let mut s = Scene::load_with(path, sets, &opts)?;
+    let mut s = with_spinner(&format!("loading {}", path.display()), || {
+        Scene::load_with(path, sets, &opts)
+    })?;
     if scalar_requested() {
         s.set_simd(false);
     }

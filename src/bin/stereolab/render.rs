@@ -85,8 +85,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     let (frame, paths) = match backend {
         Backend::Cpu => {
-            let frame = render::render(&s, &plan)?;
-            let paths = output::write_all(&frame, &s, &out)?;
+            let frame = super::with_spinner("rendering", || render::render(&s, &plan))?;
+            let paths = super::with_spinner("writing", || output::write_all(&frame, &s, &out))?;
             (frame, paths)
         }
         Backend::Gpu => render_gpu(&s, &plan, &out)?,
