@@ -350,3 +350,12 @@ pub fn excerpt(text: &str) -> String {
     }
     out
 }
+
+/// `text` without a leading byte-order mark (U+FEFF), which Windows editors write at the start
+/// of UTF-8 files and which would otherwise become part of the first word.
+pub fn without_bom(text: String) -> String {
+    match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    }
+}

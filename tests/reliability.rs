@@ -482,3 +482,76 @@ fn sixteen_bit_images_are_compared_at_their_own_depth() {
     assert!(out.status.success(), "{stdout}");
     assert!(stdout.contains("max diff 0 of 65535 levels"), "{stdout}");
 }
+
+/// Issue 14 item 11: messages that misled now name the input, the field or flag, the value and
+/// the remedy.
+#[test]
+fn misleading_messages_now_name_the_real_problem() {
+    let dir = out_dir("reliability-messages");
+    let wuson = s(&asset("scenes/wuson.toml"));
+    let afile = dir.join("afile");
+    std::fs::write(&afile, "").unwrap();
+    let image = s(&asset("readme/side_by_side.png"));
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec![
+                "info".into(),
+                wuson.clone(),
+                "--set".into(),
+                "camera.eye=[0,0,1e30]".into(),
+            ],
+            "camera.eye = [0.0, 0.0, 1e30]: lies 1.000e30 from the origin",
+        ),
+        (
+            vec!["render".into(), wuson.clone(), "--out".into(), s(&afile)],
+            "--out = ",
+        ),
+        (
+            vec![
+                "render".into(),
+                wuson.clone(),
+                "--size".into(),
+                "0x0".into(),
+                "--out".into(),
+                s(&dir),
+            ],
+            "--size = 0x0: width and height must be at least 1 pixel",
+        ),
+        (vec!["compare".into(), image], "takes two images"),
+    ];
+    for (args, says) in cases {
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = stereolab(&argv);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{argv:?}: {err}");
+        assert!(err.contains(says), "{argv:?}: {err}");
+    }
+    // A byte-order mark (as Windows editors write) is no part of the first word.
+    let scene = |kind: &str, file: &str| {
+        let p = dir.join(format!("{kind}.toml"));
+        std::fs::write(
+            &p,
+            format!("outputs = [\"left\"]\n[image]\nwidth = 32\nheight = 24\n[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n[[mesh]]\nkind = \"{kind}\"\npath = \"{file}\"\n"),
+        )
+        .unwrap();
+        s(&p)
+    };
+    std::fs::write(
+        dir.join("bom.obj"),
+        "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("bom.csv"),
+        "\u{feff}x,y,height\n0,0,0\n1,0,0\n0,1,1\n",
+    )
+    .unwrap();
+    for p in [scene("obj", "bom.obj"), scene("terrain", "bom.csv")] {
+        let out = stereolab(&["info", &p]);
+        assert!(
+            out.status.success(),
+            "{p}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}

@@ -67,6 +67,28 @@ impl Camera {
             ));
         }
         let dir = Vec3::from(self.target) - Vec3::from(self.eye);
+        // In f64: the lengths of far-out points overflow f32.
+        let (eye64, target64) = (
+            Vec3::from(self.eye).as_dvec3(),
+            Vec3::from(self.target).as_dvec3(),
+        );
+        let far_out = eye64.length().max(target64.length());
+        if self.target != self.eye
+            && !(f64::from(dir.length()) > f64::from(f32::EPSILON) * far_out.max(1.0)
+                && dir.length().is_finite())
+        {
+            return Err(Error::invalid(
+                "camera.eye",
+                format!("{:?}", self.eye),
+                format!(
+                    "lies {far_out:.3e} from the origin and {:.3e} from camera.target {:?}: \
+                     single precision loses the view direction at that scale; bring the \
+                     camera and the scene nearer the origin",
+                    target64.distance(eye64),
+                    self.target
+                ),
+            ));
+        }
         if dir.length() <= f32::EPSILON * Vec3::from(self.eye).length().max(1.0) {
             return Err(Error::invalid(
                 "camera.target",

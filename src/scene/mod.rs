@@ -127,6 +127,7 @@ impl Scene {
                 format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
             )
         })?;
+        let text = crate::files::without_bom(text);
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Scene::from_toml_with(&text, path, &opts.root(&base), sets, opts.max_triangles)
     }

@@ -26,6 +26,7 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
             format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         )
     })?;
+    let text = crate::files::without_bom(text);
     check_lines(path, &text)?;
 
     let opts = tobj::LoadOptions {

@@ -61,6 +61,7 @@ pub fn load_terrain_csv(path: &Path) -> Result<Terrain> {
             format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         )
     })?;
+    let text = crate::files::without_bom(text);
     triangulate(path, &parse_csv(path, &text)?)
 }
 

@@ -90,6 +90,14 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 out.as_deref(),
             )?]
         }
+        None if is_image_name(&first) => {
+            return Err(Error::invalid(
+                "compare",
+                first.display(),
+                "is an image: compare EXPECTED ACTUAL takes two images (or one scene file, to \
+                 compare its CPU and GPU renders)",
+            ));
+        }
         None => {
             let s = load_scene(&first, &sets, size.as_deref())?;
             compare_scene(&s, out.as_deref())?
@@ -113,6 +121,13 @@ pub fn run(args: CompareArgs) -> Result<()> {
             failed.join("; "),
         ))
     }
+}
+
+/// A file name with an image extension stereolab reads.
+fn is_image_name(path: &std::path::Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        ["png", "ppm", "pgm", "pbm", "pam", "pnm", "gif"].contains(&e.to_ascii_lowercase().as_str())
+    })
 }
 
 fn parse_rgb(s: &str) -> Result<[u8; 4]> {

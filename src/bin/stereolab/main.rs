@@ -101,10 +101,18 @@ fn no_gpu(what: &str) -> Error {
 fn parse_size(s: &str) -> Result<(u32, u32)> {
     let bad = || Error::invalid("--size", s, "expected WxH, e.g. 1024x768");
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    Ok((
+    let (w, h): (u32, u32) = (
         w.trim().parse().map_err(|_| bad())?,
         h.trim().parse().map_err(|_| bad())?,
-    ))
+    );
+    if w == 0 || h == 0 {
+        return Err(Error::invalid(
+            "--size",
+            s,
+            "width and height must be at least 1 pixel",
+        ));
+    }
+    Ok((w, h))
 }
 
 /// `STEREOLAB_SCALAR=1` (any value but empty or `0`): every pass on the scalar loops, what a
@@ -158,7 +166,10 @@ fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Re
     }
     if let Some(size) = size {
         let (w, h) = parse_size(size)?;
-        s.set_size(w, h)?;
+        s.set_size(w, h).map_err(|e| match e {
+            Error::Invalid { value, reason, .. } => Error::invalid("--size", value, reason),
+            other => other,
+        })?;
     }
     Ok(s)
 }

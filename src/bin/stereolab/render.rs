@@ -59,6 +59,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
         solution,
         exercises,
     } = args;
+    if out.is_file() {
+        return Err(Error::invalid(
+            "--out",
+            out.display(),
+            "names a file: --out is the folder the outputs are written into",
+        ));
+    }
     let s = load_scene(&scene, &sets, size.as_deref())?;
     if let Some(name) = exercise {
         let [ex] = grade::Exercise::parse_list(&name)?[..] else {
@@ -85,7 +92,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     let (frame, paths) = match backend {
         Backend::Cpu => {
-            let frame = super::with_spinner("rendering", || render::render(&s, &plan))?;
+            // Errors this late still name the scene they come from.
+            let frame = super::with_spinner("rendering", || render::render(&s, &plan))
+                .map_err(|e| e.in_file(&scene))?;
             let paths = super::with_spinner("writing", || output::write_all(&frame, &s, &out))?;
             (frame, paths)
         }
