@@ -9,6 +9,7 @@ mod coverage;
 mod determinism;
 mod figures;
 mod finalize;
+mod fuzz;
 mod golden;
 #[cfg(feature = "gpu")]
 mod gpu_finalize;

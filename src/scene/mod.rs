@@ -8,7 +8,7 @@ pub mod terrain_data;
 
 pub(crate) use file::SceneFile;
 pub use mesh::Mesh;
-pub use obj::load_obj;
+pub use obj::{load_obj, parse_obj};
 
 use std::path::Path;
 

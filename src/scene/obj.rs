@@ -26,7 +26,14 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
             format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         )
     })?;
-    let text = crate::files::without_bom(text);
+    parse_obj(path, crate::files::without_bom(text))
+}
+
+/// [`load_obj`] on text already read (`path` names it in messages).
+///
+/// # Errors
+/// As [`load_obj`], but for reading the file.
+pub fn parse_obj(path: &Path, text: String) -> Result<Mesh> {
     check_lines(path, &text)?;
 
     let opts = tobj::LoadOptions {
