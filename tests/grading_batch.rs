@@ -71,20 +71,14 @@ fn check_gradescope_schema(v: &Value) -> f64 {
     if !v["score"].is_number() {
         fail("score must be a number", v);
     }
-    if let Some(t) = v.get("execution_time") {
-        if !t.is_u64() {
-            fail("execution_time must be whole seconds", v);
-        }
+    if v.get("execution_time").is_some_and(|t| !t.is_u64()) {
+        fail("execution_time must be whole seconds", v);
     }
-    if let Some(o) = v.get("output") {
-        if !o.is_string() {
-            fail("output must be a string", v);
-        }
+    if v.get("output").is_some_and(|o| !o.is_string()) {
+        fail("output must be a string", v);
     }
-    if let Some(e) = v.get("extra_data") {
-        if !e.is_object() {
-            fail("extra_data must be an object", v);
-        }
+    if v.get("extra_data").is_some_and(|e| !e.is_object()) {
+        fail("extra_data must be an object", v);
     }
     check_string_in(v, "visibility", &VISIBILITY);
     check_string_in(v, "stdout_visibility", &VISIBILITY);
