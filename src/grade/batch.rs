@@ -118,7 +118,8 @@ pub fn grade_batch(
             format!("must be between 1 and {} on this machine", max_jobs()),
         ));
     }
-    if opts.out.starts_with(&opts.submissions) {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    if absolute(&opts.out).starts_with(absolute(&opts.submissions)) {
         return Err(Error::invalid(
             "--out",
             opts.out.display(),

@@ -181,9 +181,11 @@ fn parse_timeout(seconds: f64) -> Result<Duration> {
 }
 
 fn batch(args: BatchArgs) -> Result<()> {
-    let jobs = args
-        .jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, std::num::NonZero::get));
+    let jobs = args.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map_or(1, std::num::NonZero::get)
+            .min(grade::batch::max_jobs())
+    });
     let opts = grade::batch::BatchOptions {
         exercises: grade::Exercise::parse_list(&args.exercises_list)?,
         jobs,
