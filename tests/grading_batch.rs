@@ -14,8 +14,8 @@ use crate::grading::{full_points, grade, repo_exercises, take_turn, target_dir, 
 const VISIBILITY: [&str; 4] = ["hidden", "after_due_date", "after_published", "visible"];
 /// Gradescope's output formats.
 const FORMATS: [&str; 5] = ["text", "html", "simple_format", "md", "ansi"];
-/// The longest per-test output: the grader's cap (4 000 characters) and the line saying so.
-const TEST_OUTPUT_LIMIT: usize = 4200;
+/// The longest per-test output: the grader's cap (4 000 characters), the line saying so, the hint.
+const TEST_OUTPUT_LIMIT: usize = 4500;
 
 fn fail(what: &str, v: &Value) -> ! {
     panic!("results.json: {what}: {v}")

@@ -203,7 +203,8 @@ impl Report {
                 .map_or((0.0, 0.0), |h| (h.score, h.points));
             let score = round2(t.score - hidden_score);
             let points = round2(t.points - hidden_points);
-            let mut output = t.details.join("\n");
+            // The details capped, the hint always after them.
+            let mut output = cap(&without_dirs(t.details.join("\n").trim()), TEST_OUTPUT_MAX);
             if let Some((id, text)) = &t.hint {
                 let _ = write!(output, "\nhint [{id}]: {text}");
             }
@@ -221,7 +222,7 @@ impl Report {
                 "status": if score >= points { "passed" } else { "failed" },
                 "visibility": "visible",
                 "tags": if t.bonus { json!([t.exercise, "bonus"]) } else { json!([t.exercise]) },
-                "output": cap(&without_dirs(output.trim()), TEST_OUTPUT_MAX),
+                "output": output.trim(),
                 "output_format": "text",
             }));
             if let Some(h) = &t.hidden {
@@ -387,6 +388,23 @@ mod tests {
         for t in tests {
             assert!(t["output"].as_str().unwrap().chars().count() < TEST_OUTPUT_MAX + 200);
         }
+        let mut hinted = task("texgen", 2.0, false, 0.0);
+        hinted.hint = Some(("texgen-sign".into(), "the sign".into()));
+        let report = Report {
+            exercises: vec![ExerciseResult {
+                exercise: Exercise::Ex2,
+                build_error: None,
+                tasks: vec![hinted],
+            }],
+        };
+        let out = report.gradescope()["tests"][0]["output"].clone();
+        assert!(
+            out.as_str().unwrap().ends_with(
+                "characters cut; the full report is the submission's \
+             output above the tests (and `report.txt` of a batch run)\nhint [texgen-sign]: the sign"
+            ),
+            "the hint survives the cut: {out}"
+        );
     }
 
     #[test]
