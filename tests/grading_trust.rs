@@ -105,7 +105,7 @@ fn a_solution_that_prints_a_megabyte_in_every_task_still_scores_full_marks() {
     let dir = submission("noisy", &files);
     let (_, v) = grade("all", &[], &dir, None, "noisy");
     for t in tests_of(&v) {
-        assert_eq!(t["score"], t["max_score"], "{}: {}", t["name"], t["output"]);
+        assert_eq!(t["status"], "passed", "{}: {}", t["name"], t["output"]);
     }
     assert_eq!(score(&v), 24.0, "{v}");
     let out = test_named(&v, "ex2 texgen")["output"].as_str().unwrap();

@@ -18,6 +18,7 @@ mod gpu_parity;
 #[cfg(feature = "gpu")]
 mod gpu_sirds;
 mod grading;
+mod grading_batch;
 mod grading_trust;
 mod layout;
 mod reliability;

@@ -6,7 +6,9 @@
 //! in one subprocess; a panic costs that input, an endless loop the task (the child is killed
 //! after the time limit), NaN the inputs it spoils. The grader itself never panics on an answer.
 
+pub mod batch;
 pub(crate) mod build;
+pub mod bundle;
 pub(crate) mod child;
 pub mod ex1;
 pub mod ex2;

@@ -184,30 +184,234 @@ impl Report {
         s
     }
 
-    /// Gradescope's `results.json`: total score, one test per task (name, score, max_score,
-    /// output with the details and the hint).
+    /// Gradescope's `results.json` (the autograder specification's fields): the total `score`
+    /// (bonus included), one test per task with `score`, `max_score`, `status`, `visibility`,
+    /// `output` (details and hint, at most [`TEST_OUTPUT_MAX`] characters, picture folders
+    /// dropped: only file names), and the full text report as the top-level `output` (at most
+    /// [`REPORT_OUTPUT_MAX`]). Gradescope has no attachments: what a student sees is `output`.
+    ///
+    /// A bonus task is extra credit: its test has `max_score` 0, so the tests' `max_score`s sum
+    /// to the points to reach ([`Report::max`], 23 for the course) and `score` may exceed it.
+    /// A task's hidden cases (when the instructor's seed made some) are a test of their own,
+    /// `after_published`. `execution_time` is the caller's to add (it is not deterministic).
     pub fn gradescope(&self) -> Value {
-        let tests: Vec<Value> = self
-            .exercises
-            .iter()
-            .flat_map(|e| &e.tasks)
-            .map(|t| {
-                let mut output = t.details.join("\n");
-                if let Some((id, text)) = &t.hint {
-                    let _ = write!(output, "\nhint [{id}]: {text}");
-                }
-                json!({
-                    "name": format!("{} {}{}", t.exercise, t.name, if t.bonus { " (bonus)" } else { "" }),
-                    "score": t.score,
-                    "max_score": t.points,
-                    "output": output.trim(),
-                })
-            })
-            .collect();
+        let mut tests: Vec<Value> = Vec::new();
+        for t in self.exercises.iter().flat_map(|e| &e.tasks) {
+            let (hidden_score, hidden_points) = t
+                .hidden
+                .as_ref()
+                .map_or((0.0, 0.0), |h| (h.score, h.points));
+            let score = round2(t.score - hidden_score);
+            let points = round2(t.points - hidden_points);
+            // The details capped, the hint always after them.
+            let mut output = cap(&without_dirs(t.details.join("\n").trim()), TEST_OUTPUT_MAX);
+            if let Some((id, text)) = &t.hint {
+                let _ = write!(output, "\nhint [{id}]: {text}");
+            }
+            let name = format!(
+                "{} {}{}",
+                t.exercise,
+                t.name,
+                if t.bonus { " (bonus)" } else { "" }
+            );
+            tests.push(json!({
+                "name": name,
+                "number": format!("{}.{}", t.exercise.trim_start_matches("ex"), tests.len() + 1),
+                "score": score,
+                "max_score": if t.bonus { 0.0 } else { points },
+                "status": if score >= points { "passed" } else { "failed" },
+                "visibility": "visible",
+                "tags": if t.bonus { json!([t.exercise, "bonus"]) } else { json!([t.exercise]) },
+                "output": output.trim(),
+                "output_format": "text",
+            }));
+            if let Some(h) = &t.hidden {
+                tests.push(json!({
+                    "name": format!("{name} (hidden cases)"),
+                    "number": format!("{}.{}", t.exercise.trim_start_matches("ex"), tests.len() + 1),
+                    "score": h.score,
+                    "max_score": if t.bonus { 0.0 } else { h.points },
+                    "status": if h.score >= h.points { "passed" } else { "failed" },
+                    "visibility": "after_published",
+                    "tags": [t.exercise, "hidden"],
+                    "output": cap(
+                        &without_dirs(&format!(
+                            "{} of {} hidden cases passed\n{}",
+                            h.passed,
+                            h.total,
+                            h.details.join("\n")
+                        )),
+                        TEST_OUTPUT_MAX,
+                    ),
+                    "output_format": "text",
+                }));
+            }
+        }
         json!({
             "score": self.score(),
-            "output": self.verdict(),
+            "output": cap(&without_dirs(&self.text()), REPORT_OUTPUT_MAX),
+            "output_format": "text",
+            "visibility": "visible",
+            "stdout_visibility": "hidden",
+            "extra_data": {
+                "passed": self.passed(),
+                "max_score": self.max(),
+                "verdict": self.verdict(),
+            },
             "tests": tests,
         })
+    }
+}
+
+/// Characters of one test's `output` in results.json; the rest is in the full report.
+pub const TEST_OUTPUT_MAX: usize = 4000;
+/// Characters of the full report in results.json's top-level `output`.
+pub const REPORT_OUTPUT_MAX: usize = 60_000;
+
+/// `text`, cut to `max` characters with a line saying how much was left out and where it is.
+fn cap(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        None => text.to_string(),
+        Some((i, _)) => {
+            let rest = text[i..].chars().count();
+            format!(
+                "{}\n… {rest} more characters cut; the full report is the submission's output \
+                 above the tests (and `report.txt` of a batch run)",
+                &text[..i]
+            )
+        }
+    }
+}
+
+/// The grader's machine's folders dropped from the words that name a file (`/tmp/x/ex1_a.png`
+/// becomes `ex1_a.png`): results.json goes to students, the paths mean nothing to them.
+fn without_dirs(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for (k, line) in text.split('\n').enumerate() {
+        if k > 0 {
+            out.push('\n');
+        }
+        let mut first = true;
+        for word in line.split(' ') {
+            if !first {
+                out.push(' ');
+            }
+            first = false;
+            let is_file = word.contains('/')
+                && [".png", ".txt", ".json"]
+                    .iter()
+                    .any(|ext| word.trim_end_matches([',', ';', ')']).ends_with(ext));
+            match word.rsplit_once('/') {
+                Some((_, name)) if is_file => out.push_str(name),
+                _ => out.push_str(word),
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cap_keeps_short_text_and_says_what_it_cut() {
+        assert_eq!(cap("abc", 3), "abc");
+        let c = cap(&"é".repeat(10), 4);
+        assert!(c.starts_with("éééé\n… 6 more characters cut"), "{c}");
+    }
+
+    fn task(name: &'static str, points: f64, bonus: bool, score: f64) -> TaskResult {
+        TaskResult {
+            exercise: "ex2",
+            name,
+            points,
+            bonus,
+            score,
+            passed: 0,
+            total: 1,
+            image_passed: None,
+            details: vec!["x".repeat(10_000)],
+            hint: None,
+            hidden: None,
+        }
+    }
+
+    #[test]
+    fn gradescope_tests_hidden_cases_after_publishing_and_the_bonus_as_extra_credit() {
+        let mut hidden = task("texgen", 2.0, false, 1.5);
+        hidden.hidden = Some(super::super::score::HiddenResult {
+            score: 0.5,
+            points: 1.0,
+            passed: 1,
+            total: 2,
+            details: vec!["case 2: expected 1, actual 2".into()],
+        });
+        let report = Report {
+            exercises: vec![ExerciseResult {
+                exercise: Exercise::Ex2,
+                build_error: None,
+                tasks: vec![
+                    task("hsv_ramp", 2.0, false, 2.0),
+                    hidden,
+                    task("extra", 1.0, true, 1.0),
+                ],
+            }],
+        };
+        let v = report.gradescope();
+        let tests = v["tests"].as_array().unwrap();
+        let names: Vec<&str> = tests.iter().map(|t| t["name"].as_str().unwrap()).collect();
+        assert_eq!(
+            names,
+            [
+                "ex2 hsv_ramp",
+                "ex2 texgen",
+                "ex2 texgen (hidden cases)",
+                "ex2 extra (bonus)"
+            ]
+        );
+        let field = |k: &str| -> Vec<Value> { tests.iter().map(|t| t[k].clone()).collect() };
+        assert_eq!(
+            field("max_score"),
+            [json!(2.0), json!(1.0), json!(1.0), json!(0.0)]
+        );
+        assert_eq!(
+            field("score"),
+            [json!(2.0), json!(1.0), json!(0.5), json!(1.0)]
+        );
+        assert_eq!(
+            field("visibility"),
+            ["visible", "visible", "after_published", "visible"]
+        );
+        assert_eq!(field("status"), ["passed", "passed", "failed", "passed"]);
+        assert_eq!(v["score"], json!(4.5));
+        for t in tests {
+            assert!(t["output"].as_str().unwrap().chars().count() < TEST_OUTPUT_MAX + 200);
+        }
+        let mut hinted = task("texgen", 2.0, false, 0.0);
+        hinted.hint = Some(("texgen-sign".into(), "the sign".into()));
+        let report = Report {
+            exercises: vec![ExerciseResult {
+                exercise: Exercise::Ex2,
+                build_error: None,
+                tasks: vec![hinted],
+            }],
+        };
+        let out = report.gradescope()["tests"][0]["output"].clone();
+        assert!(
+            out.as_str().unwrap().ends_with(
+                "characters cut; the full report is the submission's \
+             output above the tests (and `report.txt` of a batch run)\nhint [texgen-sign]: the sign"
+            ),
+            "the hint survives the cut: {out}"
+        );
+    }
+
+    #[test]
+    fn without_dirs_keeps_file_names_only() {
+        assert_eq!(
+            without_dirs("image a: x; expected | diff | actual: /home/me/out/ex1_a.png\n  b/c d"),
+            "image a: x; expected | diff | actual: ex1_a.png\n  b/c d"
+        );
     }
 }
