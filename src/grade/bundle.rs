@@ -208,8 +208,6 @@ fn files(root: &Path, seed: Option<u64>) -> Result<Files> {
         "src",
         "docs",
         "assets/scenes",
-        "assets/models",
-        "assets/terrain",
         "exercises/exercise-api",
     ] {
         add_tree(root, dir, &mut files)?;
