@@ -176,6 +176,16 @@ impl Report {
             for d in &t.details {
                 let _ = writeln!(s, "  {d}");
             }
+            if let Some(h) = &t.hidden {
+                let _ = writeln!(
+                    s,
+                    "  hidden cases: {}/{} passed, {:.2} of {:.2} points",
+                    h.passed, h.total, h.score, h.points
+                );
+                for d in &h.details {
+                    let _ = writeln!(s, "    {d}");
+                }
+            }
             if let Some((id, text)) = &t.hint {
                 let _ = writeln!(s, "  hint [{id}]: {text}");
             }
@@ -196,12 +206,26 @@ impl Report {
                 if let Some((id, text)) = &t.hint {
                     let _ = write!(output, "\nhint [{id}]: {text}");
                 }
-                json!({
+                let mut test = json!({
                     "name": format!("{} {}{}", t.exercise, t.name, if t.bonus { " (bonus)" } else { "" }),
                     "score": t.score,
                     "max_score": t.points,
                     "output": output.trim(),
-                })
+                });
+                if let Some(h) = &t.hidden {
+                    // Gradescope shows extra_data to instructors only; the students see the
+                    // hidden cases' count and points, not their inputs.
+                    test["output"] = json!(format!(
+                        "{}\nhidden cases: {}/{} passed, {:.2} of {:.2} points",
+                        output.trim(),
+                        h.passed,
+                        h.total,
+                        h.score,
+                        h.points
+                    ));
+                    test["extra_data"] = json!({ "hidden_details": h.details });
+                }
+                test
             })
             .collect();
         json!({
