@@ -32,6 +32,18 @@ pub(crate) fn grade(
     mutant: Option<&str>,
     name: &str,
 ) -> (Output, Value) {
+    grade_seeded(what, extra, exercises, mutant, None, name)
+}
+
+/// [`grade`] with the instructor's seed for hidden cases (`STEREOLAB_GRADER_SEED`) when given.
+pub(crate) fn grade_seeded(
+    what: &str,
+    extra: &[&str],
+    exercises: &Path,
+    mutant: Option<&str>,
+    seed: Option<&str>,
+    name: &str,
+) -> (Output, Value) {
     let dir = out_dir(&format!("grading_{name}"));
     let json = dir.join("results.json");
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_stereolab"));
@@ -43,9 +55,13 @@ pub(crate) fn grade(
         .arg(exercises)
         .args(extra)
         .env("CARGO_TARGET_DIR", target_dir())
-        .env_remove("STEREOLAB_MUTANT");
+        .env_remove("STEREOLAB_MUTANT")
+        .env_remove("STEREOLAB_GRADER_SEED");
     if let Some(m) = mutant {
         cmd.env("STEREOLAB_MUTANT", m);
+    }
+    if let Some(s) = seed {
+        cmd.env("STEREOLAB_GRADER_SEED", s);
     }
     let out = cmd.output().expect("run stereolab grade");
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -181,6 +197,16 @@ fn check_planted(what: &str, planted: &[Planted], name: &str) {
                 "{}: {task} should get hint [{hint}]:\n{output}",
                 p.mutant
             );
+            // A known mistake explains every failing answer: systematic, no partial credit.
+            // (Crashes, NaN and the dependency hint are not such a diagnosis.)
+            if !["nan", "timeout", "depends-on"].contains(hint) {
+                assert_eq!(
+                    t["score"].as_f64(),
+                    Some(0.0),
+                    "{}: {task} has a systematic mistake: {output}",
+                    p.mutant
+                );
+            }
         }
     }
     let targeted: Vec<&str> = planted
@@ -212,7 +238,7 @@ fn swapped_eyes_transposed_anaglyph_opengl_depth_nan_reversed_ramp_full_disparit
                 mutant: "swapped-eyes",
                 loses: &[
                     ("ex1 stereo_frustum", "swapped-eyes"),
-                    ("ex1 stereo_matrices", "swapped-eyes"),
+                    ("ex1 stereo_matrices", "depends-on"),
                 ],
             },
             Planted {
@@ -249,7 +275,7 @@ fn toe_in_endless_loop_texgen_sign_and_missing_hidden_surfaces_lose_points_with_
                 mutant: "toe-in",
                 loses: &[
                     ("ex1 stereo_frustum", "toe-in"),
-                    ("ex1 stereo_matrices", "toe-in"),
+                    ("ex1 stereo_matrices", "depends-on"),
                 ],
             },
             Planted {
@@ -277,10 +303,150 @@ fn d_instead_of_half_d_in_the_rig_loses_points_with_its_hint() {
             mutant: "full-separation",
             loses: &[
                 ("ex1 stereo_frustum", "d-instead-of-half-d"),
-                ("ex1 stereo_matrices", "d-instead-of-half-d"),
+                ("ex1 stereo_matrices", "depends-on"),
             ],
         }],
         "mutants_c",
+    );
+}
+
+#[test]
+fn mv_t_order_one_sided_depth_hue_to_360_and_degrees_lose_all_points_with_their_hints() {
+    check_planted(
+        "all",
+        &[
+            Planted {
+                mutant: "mv-t-order",
+                loses: &[("ex1 stereo_matrices", "mv-t-order")],
+            },
+            Planted {
+                mutant: "one-sided-depth",
+                loses: &[("ex1 remap", "one-sided-depth")],
+            },
+            Planted {
+                mutant: "full-circle-ramp",
+                loses: &[("ex2 hsv_ramp", "ramp-full-circle")],
+            },
+            Planted {
+                mutant: "degrees-phi",
+                loses: &[("ex3 disparity_constant_direction", "degrees")],
+            },
+        ],
+        "mutants_d",
+    );
+}
+
+#[test]
+fn fov_in_degrees_and_never_none_lose_points_and_the_caller_names_the_callee() {
+    check_planted(
+        "ex1",
+        &[
+            Planted {
+                mutant: "fov-degrees",
+                loses: &[
+                    ("ex1 stereo_frustum", "degrees-not-radians"),
+                    ("ex1 stereo_matrices", "depends-on"),
+                ],
+            },
+            Planted {
+                mutant: "never-none",
+                loses: &[("ex1 remap", "never-none")],
+            },
+        ],
+        "mutants_e",
+    );
+}
+
+#[test]
+fn transposed_frustum_fails_stereo_matrices_through_its_dependency_and_no_w_divide_costs_remap() {
+    check_planted(
+        "ex1",
+        &[
+            Planted {
+                mutant: "transposed-frustum",
+                loses: &[
+                    ("ex1 frustum", "transposed"),
+                    ("ex1 stereo_matrices", "depends-on"),
+                ],
+            },
+            Planted {
+                mutant: "no-w-divide",
+                loses: &[("ex1 remap", "no-w-divide")],
+            },
+        ],
+        "mutants_f",
+    );
+    let (_, v) = grade(
+        "ex1",
+        &["--solution"],
+        &repo_exercises(),
+        Some("transposed-frustum"),
+        "mutants_f_text",
+    );
+    let output = test_named(&v, "ex1 stereo_matrices")["output"]
+        .as_str()
+        .unwrap_or_default();
+    assert!(
+        output.contains("fails because `frustum`, which it calls, fails: fix `frustum` first"),
+        "{output}"
+    );
+}
+
+/// `hidden cases: P/T passed` of a task's output.
+fn hidden_counts(t: &Value) -> Option<(usize, usize)> {
+    let out = t["output"].as_str()?;
+    let rest = out.split("hidden cases: ").nth(1)?;
+    let (p, rest) = rest.split_once('/')?;
+    let t = rest.split_whitespace().next()?;
+    Some((p.parse().ok()?, t.parse().ok()?))
+}
+
+#[test]
+fn hidden_cases_come_from_the_seed_the_solution_passes_them_and_a_mutant_fails_them() {
+    let _turn = take_turn();
+    let (_, v) = grade_seeded(
+        "all",
+        &["--solution"],
+        &repo_exercises(),
+        None,
+        Some("20260412"),
+        "hidden_solution",
+    );
+    let mut with_hidden = 0;
+    for t in tests_of(&v) {
+        assert_eq!(t["score"], t["max_score"], "{}: {}", t["name"], t["output"]);
+        if let Some((p, n)) = hidden_counts(t) {
+            assert!(n > 0 && p == n, "{}: {}", t["name"], t["output"]);
+            with_hidden += 1;
+        }
+    }
+    assert!(with_hidden >= 6, "hidden cases on too few tasks: {v}");
+    let (_, v) = grade_seeded(
+        "ex1",
+        &["--solution"],
+        &repo_exercises(),
+        Some("mv-t-order"),
+        Some("20260412"),
+        "hidden_mutant",
+    );
+    let t = test_named(&v, "ex1 stereo_matrices");
+    let (p, n) = hidden_counts(t).expect("stereo_matrices has hidden cases");
+    assert!(
+        p < n,
+        "MV·T must fail hidden cases (random cameras): {}",
+        t["output"]
+    );
+    // Without the seed there are none: what students run locally.
+    let (_, v) = grade(
+        "ex3",
+        &["--solution"],
+        &repo_exercises(),
+        None,
+        "hidden_none",
+    );
+    assert!(
+        tests_of(&v).iter().all(|t| hidden_counts(t).is_none()),
+        "{v}"
     );
 }
 

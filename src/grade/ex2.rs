@@ -90,6 +90,8 @@ fn ramp_task() -> TaskSpec {
         name: "hsv_ramp",
         points: 2.0,
         bonus: false,
+        depends_on: &[],
+        hidden: Vec::new(),
         tolerance: Tolerance {
             abs: 1e-5,
             rel: 0.0,
@@ -206,6 +208,8 @@ fn texgen_task(fx: &Fixture) -> TaskSpec {
         name: "texgen",
         points: 2.0,
         bonus: false,
+        depends_on: &[],
+        hidden: Vec::new(),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 1e-5,
@@ -267,6 +271,8 @@ fn depth_range_task() -> TaskSpec {
         name: "depth_range",
         points: 1.0,
         bonus: false,
+        depends_on: &[],
+        hidden: Vec::new(),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 1e-6,

@@ -9,7 +9,7 @@ use serde_json::json;
 
 use super::ex1::flat;
 use super::fixture::{Fixture, unproject};
-use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
+use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use crate::effects::sirds::disparity::{separation_eye_distance, separation_view_angle};
 use crate::effects::sirds::per_pixel::RowLinker;
 use crate::effects::sirds::{Disparity, DisparityModel};
@@ -241,6 +241,8 @@ fn link_task(fx: &Fixture) -> TaskSpec {
         name: "link_row",
         points: 3.0,
         bonus: false,
+        depends_on: &["disparity_constant_eyes"],
+        hidden: Vec::new(),
         tolerance: Tolerance::EXACT,
         cases: inputs
             .iter()
@@ -303,6 +305,15 @@ fn direction_task() -> TaskSpec {
         name: "disparity_constant_direction",
         points: 1.0,
         bonus: false,
+        depends_on: &[],
+        hidden: hidden_cases("disparity_constant_direction", 5, |rng, _| {
+            let (z, p) = (rng.range(0.0, 50.0), rng.range(0.1, 1.5));
+            Case {
+                label: format!("hidden: z = {z}, phi = {p} rad"),
+                input: json!([z, p]),
+                expected: vec![separation_view_angle(z, p.tan()) as f64],
+            }
+        }),
         tolerance: Tolerance {
             abs: 1e-5,
             rel: 1e-5,
@@ -324,7 +335,7 @@ fn direction_task() -> TaskSpec {
             },
             Mistake {
                 id: "degrees",
-                hint: "φ is given in radians already",
+                hint: "φ is given in radians already: to_radians() reads 0.785 rad as 0.785°",
                 answers: each(&|z, p| 2.0 * z / p.to_radians().tan()),
             },
             Mistake {
@@ -356,6 +367,16 @@ fn eyes_task() -> TaskSpec {
         name: "disparity_constant_eyes",
         points: 1.0,
         bonus: false,
+        depends_on: &[],
+        hidden: hidden_cases("disparity_constant_eyes", 5, |rng, _| {
+            let z = rng.range(0.0, 1000.0);
+            let g = g(rng.range(40.0, 130.0), rng.range(100.0, 600.0));
+            Case {
+                label: format!("hidden: z = {z}, {g:?}"),
+                input: json!([z, g]),
+                expected: vec![disparity(z, &g) as f64],
+            }
+        }),
         tolerance: Tolerance {
             abs: 1e-5,
             rel: 1e-5,

@@ -211,6 +211,7 @@ fn inputs_of(spec: &TaskSpec) -> Vec<Value> {
     if let Some(img) = &spec.image {
         v.extend(img.inputs.iter().cloned());
     }
+    v.extend(spec.hidden.iter().map(|c| c.input.clone()));
     v
 }
 
@@ -236,17 +237,21 @@ pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
                     .map(|s| TaskResult::not_built(ex.id(), s))
                     .collect(),
             },
-            Ok(binary) => ExerciseResult {
-                exercise: ex,
-                build_error: None,
-                tasks: specs
+            Ok(binary) => {
+                let mut tasks: Vec<TaskResult> = specs
                     .iter()
                     .map(|s| {
                         let run = child::run(&binary, s.name, &inputs_of(s), opts.limits);
                         score::evaluate(ex.id(), s, &run, &opts.out)
                     })
-                    .collect(),
-            },
+                    .collect();
+                score::blame_dependencies(&specs, &mut tasks);
+                ExerciseResult {
+                    exercise: ex,
+                    build_error: None,
+                    tasks,
+                }
+            }
         };
         exercises.push(result);
     }

@@ -117,6 +117,11 @@ impl Report {
 
     /// The points table, the failing tasks with their details and hints, and the verdict.
     pub fn text(&self) -> String {
+        self.text_with(true)
+    }
+
+    /// [`Report::text`], with or without the hidden cases' details (inputs and answers).
+    fn text_with(&self, hidden_details: bool) -> String {
         let mut s = String::new();
         let _ = writeln!(
             s,
@@ -175,6 +180,18 @@ impl Report {
             );
             for d in &t.details {
                 let _ = writeln!(s, "  {d}");
+            }
+            if let Some(h) = &t.hidden {
+                let _ = writeln!(
+                    s,
+                    "  hidden cases: {}/{} passed, {:.2} of {:.2} points",
+                    h.passed, h.total, h.score, h.points
+                );
+                if hidden_details {
+                    for d in &h.details {
+                        let _ = writeln!(s, "    {d}");
+                    }
+                }
             }
             if let Some((id, text)) = &t.hint {
                 let _ = writeln!(s, "  hint [{id}]: {text}");
@@ -249,7 +266,8 @@ impl Report {
         }
         json!({
             "score": self.score(),
-            "output": cap(&without_dirs(&self.text()), REPORT_OUTPUT_MAX),
+            // The hidden cases' inputs stay out of what students see at once.
+            "output": cap(&without_dirs(&self.text_with(false)), REPORT_OUTPUT_MAX),
             "output_format": "text",
             "visibility": "visible",
             "stdout_visibility": "hidden",

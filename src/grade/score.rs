@@ -6,7 +6,8 @@ use std::path::Path;
 
 use super::child::Run;
 use super::spec::{
-    IMAGE_MAX_COVERAGE_PERCENT, IMAGE_MAX_MEAN_DIFF, IMAGE_SHARE, Picture, TaskSpec, Tolerance,
+    Case, HIDDEN_SHARE, IMAGE_MAX_COVERAGE_PERCENT, IMAGE_MAX_MEAN_DIFF, IMAGE_SHARE, Picture,
+    TaskSpec, Tolerance,
 };
 use crate::compare::{ascii_map, compare, coverage, write_diff_strip};
 
@@ -90,12 +91,40 @@ fn shorten(msg: &str) -> String {
     }
 }
 
-fn fmt_nums(v: &[f64]) -> String {
+/// Whether `v` is printed as integers: exact answers (indices, booleans) that are whole.
+fn integral(v: &[f64], tol: &Tolerance) -> bool {
+    tol.abs == 0.0 && tol.rel == 0.0 && v.iter().all(|x| x.is_finite() && x.fract() == 0.0)
+}
+
+fn fmt_nums(v: &[f64], tol: &Tolerance) -> String {
     if v.is_empty() {
         return "None".into();
     }
-    let items: Vec<String> = v.iter().map(|x| format!("{x:.6}")).collect();
+    let items: Vec<String> = if integral(v, tol) {
+        v.iter().map(|x| format!("{x:.0}")).collect()
+    } else {
+        v.iter().map(|x| format!("{x:.6}")).collect()
+    };
     format!("[{}]", items.join(", "))
+}
+
+/// `v` (16 column-major numbers per matrix: 16 or 32 numbers) as 4×4 rows, the way the
+/// exercise slides write matrices: element `k` of a matrix is row `k % 4`, column `k / 4`.
+fn fmt_matrices(v: &[f64]) -> String {
+    let names = ["view", "projection"];
+    let mut s = String::new();
+    for (m, chunk) in v.chunks(16).enumerate() {
+        if v.len() > 16 {
+            let _ = write!(s, "\n    {}:", names[m]);
+        }
+        for row in 0..4 {
+            let cells: Vec<String> = (0..4)
+                .map(|col| format!("{:>12.6}", chunk[4 * col + row]))
+                .collect();
+            let _ = write!(s, "\n      | {} |", cells.join(" "));
+        }
+    }
+    s
 }
 
 /// Why a numeric answer fails, or `None` when it passes.
@@ -103,6 +132,7 @@ fn check(expected: &[f64], actual: &[f64], tol: &Tolerance) -> Option<String> {
     if tol.accepts(expected, actual) {
         return None;
     }
+    let matrices = expected.len() == actual.len() && matches!(expected.len(), 16 | 32);
     let diff = if expected.len() != actual.len() {
         format!("{} numbers instead of {}", actual.len(), expected.len())
     } else {
@@ -118,15 +148,95 @@ fn check(expected: &[f64], actual: &[f64], tol: &Tolerance) -> Option<String> {
                     best
                 }
             });
-        format!("{d:.3e} at element {k}")
+        if matrices {
+            let which = if expected.len() == 32 {
+                if k < 16 { "view " } else { "projection " }
+            } else {
+                ""
+            };
+            let j = k % 16;
+            format!(
+                "{d:.3e} at {which}row {}, column {} (element {k}, column-major)",
+                j % 4,
+                j / 4
+            )
+        } else {
+            format!("{d:.3e} at element {k}")
+        }
     };
+    if matrices {
+        return Some(format!(
+            "tolerance {} ({}), difference {diff}\n    expected (rows as written on the slides):{}\n    actual:{}",
+            tol.describe(),
+            tol.why,
+            fmt_matrices(expected),
+            fmt_matrices(actual)
+        ));
+    }
     Some(format!(
         "expected {}, actual {}, tolerance {} ({}), difference {diff}",
-        fmt_nums(expected),
-        fmt_nums(actual),
+        fmt_nums(expected, tol),
+        fmt_nums(actual, tol),
         tol.describe(),
         tol.why
     ))
+}
+
+/// The numeric checks of one list of cases against the replies to them.
+#[derive(Default)]
+struct CaseTally {
+    passed: usize,
+    panics: usize,
+    todo: usize,
+    non_finite: usize,
+    /// Index and answer of each answered case that failed.
+    failing: Vec<(usize, Vec<f64>)>,
+    /// The first failures, described, and a count of the rest.
+    details: Vec<String>,
+}
+
+fn tally(cases: &[Case], replies: &[Result<Vec<f64>, String>], tol: &Tolerance) -> CaseTally {
+    let mut t = CaseTally::default();
+    for (i, case) in cases.iter().enumerate() {
+        let msg = match replies.get(i) {
+            None => Some("no answer (the binary stopped or timed out before this input)".into()),
+            Some(Err(panic)) => {
+                t.panics += 1;
+                if panic.starts_with("not yet implemented") {
+                    t.todo += 1;
+                }
+                Some(format!("panicked: {}", shorten(panic)))
+            }
+            Some(Ok(a)) => {
+                let bad =
+                    a.iter().any(|x| !x.is_finite()) && case.expected.iter().all(|x| x.is_finite());
+                if bad {
+                    t.non_finite += 1;
+                }
+                let m = check(&case.expected, a, tol);
+                if m.is_some() {
+                    t.failing.push((i, a.clone()));
+                }
+                m
+            }
+        };
+        match msg {
+            None => t.passed += 1,
+            Some(m) => {
+                if t.details.len() < SHOWN_FAILURES {
+                    t.details.push(format!("{}: {m}", case.label));
+                }
+            }
+        }
+    }
+    let failed = cases.len() - t.passed;
+    if failed > SHOWN_FAILURES {
+        t.details.push(format!(
+            "… and {} more failing inputs",
+            failed - SHOWN_FAILURES
+        ));
+    }
+    t
 }
 
 /// Scores `spec` from `run`; failing pictures are written to `out_dir` as
@@ -138,48 +248,20 @@ pub(crate) fn evaluate(
     out_dir: &Path,
 ) -> TaskResult {
     let n = spec.cases.len();
-    let mut details = Vec::new();
-    let mut failing: Vec<(usize, Vec<f64>)> = Vec::new();
-    let (mut passed, mut panics, mut todo, mut non_finite) = (0, 0, 0, 0);
-    for (i, case) in spec.cases.iter().enumerate() {
-        let msg = match run.replies.get(i) {
-            None => Some("no answer (the binary stopped or timed out before this input)".into()),
-            Some(Err(panic)) => {
-                panics += 1;
-                if panic.starts_with("not yet implemented") {
-                    todo += 1;
-                }
-                Some(format!("panicked: {}", shorten(panic)))
-            }
-            Some(Ok(a)) => {
-                let bad = a.iter().any(|x| !x.is_finite())
-                    && spec.cases[i].expected.iter().all(|x| x.is_finite());
-                if bad {
-                    non_finite += 1;
-                }
-                let m = check(&case.expected, a, &spec.tolerance);
-                if m.is_some() {
-                    failing.push((i, a.clone()));
-                }
-                m
-            }
-        };
-        match msg {
-            None => passed += 1,
-            Some(m) => {
-                if details.len() < SHOWN_FAILURES {
-                    details.push(format!("{}: {m}", case.label));
-                }
-            }
-        }
-    }
-    let failed = n - passed;
-    if failed > SHOWN_FAILURES {
-        details.push(format!(
-            "… and {} more failing inputs",
-            failed - SHOWN_FAILURES
-        ));
-    }
+    let image_n = spec.image.as_ref().map_or(0, |img| img.inputs.len());
+    let replies = |from: usize| {
+        run.replies
+            .get(from.min(run.replies.len())..)
+            .unwrap_or(&[])
+    };
+    let CaseTally {
+        passed,
+        panics,
+        todo,
+        non_finite,
+        failing,
+        mut details,
+    } = tally(&spec.cases, replies(0), &spec.tolerance);
     if let Some(e) = &run.ending {
         details.push(format!("your program {}", e.message));
     }
@@ -221,8 +303,40 @@ pub(crate) fn evaluate(
         Some(ok) => (1.0 - IMAGE_SHARE) * frac + IMAGE_SHARE * f64::from(u8::from(ok)),
         None => frac,
     };
-    let score = (spec.points * raw * 100.0).round() / 100.0;
+    // Hidden cases (after the image inputs): HIDDEN_SHARE of the points when there are any.
+    let hidden = (!spec.hidden.is_empty()).then(|| {
+        let t = tally(&spec.hidden, replies(n + image_n), &spec.tolerance);
+        let points = spec.points * HIDDEN_SHARE;
+        let frac = t.passed as f64 / spec.hidden.len() as f64;
+        HiddenResult {
+            score: round2(points * frac),
+            points,
+            passed: t.passed,
+            total: spec.hidden.len(),
+            details: t.details,
+        }
+    });
+    let public_points = match &hidden {
+        Some(h) => spec.points - h.points,
+        None => spec.points,
+    };
+    let mut score = round2(public_points * raw + hidden.as_ref().map_or(0.0, |h| h.score));
     let lost = score < spec.points;
+    let known = if lost && run.ending.is_none() && non_finite == 0 {
+        diagnose(spec, &failing)
+    } else {
+        None
+    };
+    if let Some((id, _)) = &known {
+        // A systematic mistake: one known wrong formula explains every failing answer, so the
+        // answers that pass do so by coincidence (an eye or a setup where the mistake happens
+        // not to show). No partial credit for it.
+        score = 0.0;
+        details.push(format!(
+            "every failing answer is what the known mistake [{id}] gives: a systematic \
+             mistake scores 0 points (partial credit is for scattered failures)"
+        ));
+    }
     let hint = if !lost {
         None
     } else if let Some(e) = &run.ending {
@@ -243,13 +357,17 @@ pub(crate) fn evaluate(
             "your code panics on some inputs (see above): an index out of range?".into(),
         ))
     } else {
-        diagnose(spec, &failing).or_else(|| {
+        known.or_else(|| {
             Some((
                 "mismatch".into(),
-                if failing.is_empty() {
+                if !failing.is_empty() {
+                    "no known mistake matches: compare expected and actual above".into()
+                } else if image_passed == Some(false) {
                     "the numbers match but the image does not: compare the diff image".into()
                 } else {
-                    "no known mistake matches: compare expected and actual above".into()
+                    "the public cases pass but hidden cases fail: test inputs beyond the \
+                     worked examples (other setups, rotated cameras, edge cases)"
+                        .into()
                 },
             ))
         })
@@ -265,7 +383,46 @@ pub(crate) fn evaluate(
         image_passed,
         details,
         hint,
-        hidden: None,
+        hidden,
+    }
+}
+
+fn round2(x: f64) -> f64 {
+    (x * 100.0).round() / 100.0
+}
+
+/// After all tasks of an exercise are scored: a task that lost points while a task it calls
+/// (`depends_on`) lost points too gets the hint to fix that one first; its own diagnosis is kept
+/// in the hint's text.
+pub(crate) fn blame_dependencies(specs: &[TaskSpec], results: &mut [TaskResult]) {
+    let failed: Vec<&'static str> = results
+        .iter()
+        .filter(|r| r.score < r.points)
+        .map(|r| r.name)
+        .collect();
+    for (spec, r) in specs.iter().zip(results.iter_mut()) {
+        // Only wrong answers are blamed on the callee: a task not yet written, not built, that
+        // crashed, hung or returned NaN keeps its own hint (that is the first thing to fix).
+        let wrong_answers = r.hint.as_ref().is_some_and(|(id, _)| {
+            id == "mismatch" || spec.mistakes.iter().any(|m| m.id == id.as_str())
+        });
+        if r.score >= r.points || !wrong_answers {
+            continue;
+        }
+        let Some(dep) = spec.depends_on.iter().find(|d| failed.contains(d)) else {
+            continue;
+        };
+        let own = r
+            .hint
+            .as_ref()
+            .map(|(id, text)| format!(" (on its own it looks like [{id}]: {text})"))
+            .unwrap_or_default();
+        r.hint = Some((
+            "depends-on".into(),
+            format!(
+                "this task fails because `{dep}`, which it calls, fails: fix `{dep}` first{own}"
+            ),
+        ));
     }
 }
 
@@ -365,4 +522,30 @@ fn check_pictures(
         details.push(line);
     }
     all
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matrices_print_as_rows_with_the_worst_row_and_column_and_indices_as_integers() {
+        let expected: Vec<f64> = (0..16).map(f64::from).collect();
+        let mut actual = expected.clone();
+        actual[14] += 1.0; // column 3, row 2 (column-major)
+        let tol = Tolerance {
+            abs: 1e-6,
+            rel: 0.0,
+            why: "test",
+        };
+        let msg = check(&expected, &actual, &tol).expect("fails");
+        assert!(msg.contains("row 2, column 3"), "{msg}");
+        // Row 0 reads across the columns: elements 0, 4, 8, 12.
+        assert!(
+            msg.contains("|     0.000000     4.000000     8.000000    12.000000 |"),
+            "{msg}"
+        );
+        let msg = check(&[3.0, 1.0], &[3.0, 2.0], &Tolerance::EXACT).expect("fails");
+        assert!(msg.starts_with("expected [3, 1], actual [3, 2]"), "{msg}");
+    }
 }

@@ -2,7 +2,8 @@
 //!
 //! `STEREOLAB_MUTANT=name[,name]` plants a known mistake for the grader's mutation tests
 //! (tests/grading.rs): `swapped-eyes`, `toe-in`, `full-separation`, `transposed-anaglyph`,
-//! `opengl-depth`, `hang-parallax`, `nan-parallax`.
+//! `opengl-depth`, `hang-parallax`, `nan-parallax`, `transposed-frustum`, `fov-degrees`,
+//! `mv-t-order`, `one-sided-depth`, `no-w-divide`, `never-none`.
 
 use exercise_api::{AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, StereoSetup};
 use exercise_api::{Lighting, look_at};
@@ -14,7 +15,7 @@ fn planted(mistake: &str) -> bool {
 
 /// `P_frustum(l, r, b, t, n, f)` (the exercise slides).
 pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
-    Mat4::from_cols(
+    let m = Mat4::from_cols(
         Vec4::new(2.0 * n / (r - l), 0.0, 0.0, 0.0),
         Vec4::new(0.0, 2.0 * n / (t - b), 0.0, 0.0),
         Vec4::new(
@@ -24,7 +25,12 @@ pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
             -1.0,
         ),
         Vec4::new(0.0, 0.0, 2.0 * n * f / (n - f), 0.0),
-    )
+    );
+    if planted("transposed-frustum") {
+        m.transpose()
+    } else {
+        m
+    }
 }
 
 /// −1 for the left eye (index 0), +1 for the right eye.
@@ -48,7 +54,12 @@ fn half_separation(s: &StereoSetup) -> f32 {
 
 /// `[l, r, b, t, n, f]` of `P_frustum±` (the exercise slides).
 pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
-    let t = setup.near * (setup.fov_y_degrees.to_radians() * 0.5).tan();
+    let fov = if planted("fov-degrees") {
+        setup.fov_y_degrees
+    } else {
+        setup.fov_y_degrees.to_radians()
+    };
+    let t = setup.near * (fov * 0.5).tan();
     let w = t * setup.aspect;
     let shift = if planted("toe-in") {
         0.0
@@ -68,6 +79,7 @@ pub fn stereo_matrices(
     let [l, r, b, t, n, f] = stereo_frustum(setup, eye);
     let p = frustum(l, r, b, t, n, f);
     let half = half_separation(setup);
+    let translation = Mat4::from_translation(Vec3::new(-side(eye) * half, 0.0, 0.0));
     let eye_view = if planted("toe-in") {
         // The SGI course notes' rotated eyes: each looks at the fusion point on the center line.
         let inv = modelview.inverse();
@@ -75,9 +87,13 @@ pub fn stereo_matrices(
         let fusion = inv.transform_point3(Vec3::new(0.0, 0.0, -setup.zero_parallax));
         look_at(at, fusion, inv.transform_vector3(Vec3::Y))
     } else {
-        Mat4::from_translation(Vec3::new(-side(eye) * half, 0.0, 0.0)) * modelview
+        translation * modelview
     };
     match lighting {
+        Lighting::PerEye if planted("mv-t-order") => EyeView {
+            view: modelview * translation,
+            projection: p,
+        },
         Lighting::PerEye => EyeView {
             view: eye_view,
             projection: p,
@@ -142,11 +158,15 @@ pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) ->
     };
     let ndc_left = (2.0 * uv_left - Vec2::ONE).extend(z_ndc).extend(1.0);
     let clip = mvp_right * mvp_left.inverse() * ndc_left;
-    if clip.w <= 0.0 {
+    if clip.w <= 0.0 && !planted("never-none") {
         return None;
     }
-    let ndc = clip.truncate() / clip.w;
-    let depth = if planted("opengl-depth") {
+    let ndc = if planted("no-w-divide") {
+        clip.truncate()
+    } else {
+        clip.truncate() / clip.w
+    };
+    let depth = if planted("opengl-depth") || planted("one-sided-depth") {
         ndc.z
     } else {
         0.5 * (ndc.z + 1.0)

@@ -1,7 +1,7 @@
 //! The instructor's solution (feature `solution`). Never part of the student handout.
 //!
 //! `STEREOLAB_MUTANT=name[,name]` plants a known mistake for the grader's mutation tests:
-//! `reversed-ramp`, `texgen-sign`.
+//! `reversed-ramp`, `full-circle-ramp` (hue to 360°), `texgen-sign`.
 
 use glam::Vec3;
 
@@ -13,14 +13,20 @@ fn planted(mistake: &str) -> bool {
 pub fn hsv_ramp(t: f32) -> [f32; 3] {
     let t = t.clamp(0.0, 1.0);
     let t = if planted("reversed-ramp") { 1.0 - t } else { t };
-    let h = 240.0 * t / 60.0;
+    let end = if planted("full-circle-ramp") {
+        360.0
+    } else {
+        240.0
+    };
+    let h = end * t / 60.0;
     let x = 1.0 - (h % 2.0 - 1.0).abs();
     match h as u32 {
         0 => [1.0, x, 0.0],
         1 => [x, 1.0, 0.0],
         2 => [0.0, 1.0, x],
         3 => [0.0, x, 1.0],
-        _ => [x, 0.0, 1.0],
+        4 => [x, 0.0, 1.0],
+        _ => [1.0, 0.0, x],
     }
 }
 

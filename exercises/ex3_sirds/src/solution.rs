@@ -1,7 +1,8 @@
 //! The instructor's solution (feature `solution`). Never part of the student handout.
 //!
 //! `STEREOLAB_MUTANT=name[,name]` plants a known mistake for the grader's mutation tests:
-//! `full-disparity` (pairs at x ∓ s instead of x ∓ s/2), `no-hidden-surfaces`.
+//! `full-disparity` (pairs at x ∓ s instead of x ∓ s/2), `no-hidden-surfaces`, `degrees-phi` (φ
+//! converted from degrees although it is in radians).
 
 use exercise_api::{SirdsGeometry, SirdsSetup};
 
@@ -11,6 +12,11 @@ fn planted(mistake: &str) -> bool {
 
 /// Eq. (1) of the SIRDS paper (Petz et al.).
 pub fn disparity_constant_direction(z: f32, phi: f32) -> f32 {
+    let phi = if planted("degrees-phi") {
+        phi.to_radians()
+    } else {
+        phi
+    };
     2.0 * z / phi.tan()
 }
 

@@ -106,6 +106,8 @@ pub(super) fn anaglyph_task(fx: &Fixture) -> TaskSpec {
         name: "anaglyph_matrices",
         points: 2.0,
         bonus: false,
+        depends_on: &[],
+        hidden: Vec::new(),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 0.0,
@@ -141,6 +143,8 @@ pub(super) fn dubois_task() -> TaskSpec {
         name: "dubois_matrices",
         points: 1.0,
         bonus: true,
+        depends_on: &[],
+        hidden: Vec::new(),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 0.0,

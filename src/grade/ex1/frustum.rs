@@ -3,9 +3,9 @@
 use glam::Mat4;
 use serde_json::json;
 
-use super::{MATRIX_TOLERANCE, eyes, flat, setups};
+use super::{HIDDEN_SETUPS, MATRIX_TOLERANCE, eyes, flat, random_setup, setups};
 use crate::grade::fixture::Fixture;
-use crate::grade::spec::{Case, Mistake, TaskSpec, Tolerance};
+use crate::grade::spec::{Case, Mistake, TaskSpec, Tolerance, hidden_cases};
 use crate::math::{CameraMode, Lighting, frustum};
 
 pub(super) fn frustum_task(fx: &Fixture) -> TaskSpec {
@@ -30,6 +30,19 @@ pub(super) fn frustum_task(fx: &Fixture) -> TaskSpec {
         name: "frustum",
         points: 2.0,
         bonus: false,
+        depends_on: &[],
+        hidden: hidden_cases("frustum", 6, |rng, _| {
+            let (l, r) = (rng.range(-3.0, -0.01), rng.range(0.01, 3.0));
+            let (b, t) = (rng.range(-3.0, -0.01), rng.range(0.01, 3.0));
+            let n = rng.range(0.01, 5.0);
+            let f = n * rng.range(2.0, 1000.0);
+            let a = [l, r, b, t, n, f];
+            Case {
+                label: format!("hidden P_frustum{a:?}"),
+                input: json!(a),
+                expected: flat(&frustum(l, r, b, t, n, f)),
+            }
+        }),
         tolerance: Tolerance {
             rel: 1e-5,
             abs: 1e-6,
@@ -94,11 +107,41 @@ pub(super) fn stereo_frustum_task(fx: &Fixture) -> TaskSpec {
             wrong[3].push(flat(&no_scale));
         }
     }
+    // φ in degrees fed to tan as if radians: t = n·tan(fov_y/2) with fov_y in degrees.
+    let fov_degrees = setups(fx)
+        .iter()
+        .flat_map(|(s, _)| {
+            let t = s.near * (0.5 * s.fov_y_degrees).tan();
+            let w = t * s.aspect;
+            (0..2).map(move |eye| {
+                let shift =
+                    if eye == 0 { 0.5 } else { -0.5 } * s.eye_separation * s.near / s.zero_parallax;
+                flat(&[-w + shift, w + shift, -t, t, s.near, s.far])
+            })
+        })
+        .collect();
     let [swapped, toe, double, no_scale] = wrong;
     TaskSpec {
         name: "stereo_frustum",
         points: 2.0,
         bonus: false,
+        depends_on: &[],
+        hidden: hidden_cases("stereo_frustum", 2 * HIDDEN_SETUPS, |rng, i| {
+            let (s, cam) = random_setup(rng);
+            let eye = i % 2;
+            let ok = eyes(
+                &s,
+                &cam,
+                s.eye_separation,
+                CameraMode::OffAxis,
+                Lighting::PerEye,
+            );
+            Case {
+                label: format!("hidden: eye {eye} of {s:?}"),
+                input: json!([s, eye]),
+                expected: flat(&ok[eye].frustum),
+            }
+        }),
         tolerance: MATRIX_TOLERANCE,
         cases,
         mistakes: vec![
@@ -126,6 +169,12 @@ pub(super) fn stereo_frustum_task(fx: &Fixture) -> TaskSpec {
                 hint: "the shift is measured on the near plane: (d/2)·n/z0 (intercept theorem), \
                        not d/2",
                 answers: no_scale,
+            },
+            Mistake {
+                id: "degrees-not-radians",
+                hint: "the field of view is in DEGREES (fov_y_degrees) and tan takes radians: \
+                       t = n·tan(fov_y.to_radians() / 2)",
+                answers: fov_degrees,
             },
         ],
         image: None,

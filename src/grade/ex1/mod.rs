@@ -13,7 +13,7 @@ mod rig;
 mod visible;
 
 use super::fixture::{Fixture, reference_rig};
-use super::spec::{TaskSpec, Tolerance};
+use super::spec::{SplitMix64, TaskSpec, Tolerance};
 use crate::exercise::{Answer, StereoSetup};
 use crate::framebuffer::Framebuffer;
 use crate::math::{Camera, CameraMode, EyeMatrices, Lighting};
@@ -85,6 +85,40 @@ fn setups(fx: &Fixture) -> Vec<(StereoSetup, Camera)> {
         (seed003, camera(&seed003, [0.0, 0.0, 9.0], [0.0, 0.0, 0.0])),
         (wide, camera(&wide, [3.0, 2.0, -1.0], [0.0, 0.5, 0.0])),
     ]
+}
+
+/// Hidden cases per ex1 task that draws random setups.
+const HIDDEN_SETUPS: usize = 4;
+
+/// A random but valid setup and camera for hidden cases: any field of view, aspect, near/far,
+/// separation and zero-parallax distance a course scene could use, and a camera looking at a
+/// point near the origin from any azimuth and from up to 60° above or below (so that the eye's
+/// x axis is rotated about Y and X, and `up` is never parallel to the view direction).
+fn random_setup(rng: &mut SplitMix64) -> (StereoSetup, Camera) {
+    let near = rng.range(0.1, 2.0);
+    let far = near * rng.range(10.0, 200.0);
+    let s = StereoSetup {
+        fov_y_degrees: rng.range(30.0, 100.0),
+        aspect: rng.range(0.75, 2.0),
+        near,
+        far,
+        eye_separation: rng.range(0.03, 1.0),
+        zero_parallax: rng.range(1.5 * near, 0.5 * far),
+    };
+    let target = [
+        rng.range(-1.0, 1.0),
+        rng.range(-1.0, 1.0),
+        rng.range(-1.0, 1.0),
+    ];
+    let azimuth = rng.range(0.0, std::f32::consts::TAU);
+    let elevation = rng.range(-60.0, 60.0).to_radians();
+    let dist = rng.range(3.0, 10.0);
+    let eye = [
+        target[0] + dist * elevation.cos() * azimuth.sin(),
+        target[1] + dist * elevation.sin(),
+        target[2] + dist * elevation.cos() * azimuth.cos(),
+    ];
+    (s, camera(&s, eye, target))
 }
 
 /// The reference eyes for a setup with a changed separation, mode and lighting.

@@ -5,7 +5,7 @@ use serde_json::json;
 
 use super::{flat, left_samples};
 use crate::grade::fixture::Fixture;
-use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
+use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use crate::shade::to_rgba8;
 
 pub(super) fn parallax_task() -> TaskSpec {
@@ -24,6 +24,19 @@ pub(super) fn parallax_task() -> TaskSpec {
         name: "parallax",
         points: 1.0,
         bonus: false,
+        depends_on: &[],
+        hidden: hidden_cases("parallax", 6, |rng, _| {
+            let i = [
+                rng.range(0.1, 100.0),
+                rng.range(0.5, 20.0),
+                rng.range(0.03, 2.0),
+            ];
+            Case {
+                label: format!("hidden: z = {}, z0 = {}, d = {}", i[0], i[1], i[2]),
+                input: json!(i),
+                expected: vec![p(i) as f64],
+            }
+        }),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 1e-5,
@@ -127,6 +140,8 @@ pub(super) fn parallax_color_task(fx: &Fixture) -> TaskSpec {
         name: "parallax_color",
         points: 1.0,
         bonus: false,
+        depends_on: &[],
+        hidden: Vec::new(),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 0.0,

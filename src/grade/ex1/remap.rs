@@ -12,6 +12,12 @@ use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance
 #[derive(Clone, Copy, Default)]
 struct RemapVariant {
     depth_as_ndc: bool,
+    /// Only the incoming depth left as it is (`z_ndc = depth`), the outgoing one converted.
+    depth_in_raw: bool,
+    /// Only the outgoing depth left in NDC, the incoming one converted.
+    depth_out_raw: bool,
+    /// No `None` when `w ≤ 0`.
+    never_none: bool,
     order_swapped: bool,
     no_divide: bool,
     ndc_out: bool,
@@ -26,13 +32,13 @@ fn remap_reference(l: &Mat4, r: &Mat4, uv: [f32; 2], depth: f32, v: RemapVariant
     } else {
         r * l.inverse()
     };
-    let z = if v.depth_as_ndc {
+    let z = if v.depth_as_ndc || v.depth_in_raw {
         depth as f64
     } else {
         2.0 * depth as f64 - 1.0
     };
     let clip = m * DVec4::new(2.0 * uv[0] as f64 - 1.0, 2.0 * uv[1] as f64 - 1.0, z, 1.0);
-    if clip.w <= 0.0 {
+    if clip.w <= 0.0 && !v.never_none {
         return Vec::new();
     }
     let ndc = if v.no_divide {
@@ -43,7 +49,7 @@ fn remap_reference(l: &Mat4, r: &Mat4, uv: [f32; 2], depth: f32, v: RemapVariant
     if v.ndc_out {
         return ndc.to_array().to_vec();
     }
-    let depth = if v.depth_as_ndc {
+    let depth = if v.depth_as_ndc || v.depth_out_raw {
         ndc.z
     } else {
         0.5 * (ndc.z + 1.0)
@@ -78,10 +84,56 @@ pub(super) fn remap_task(fx: &Fixture) -> TaskSpec {
         .filter(|(i, _)| i % 41 == 0)
         .map(|(_, (x, y, _, d))| (format!("left pixel ({x}, {y})"), l, r, (x, y), d))
         .collect();
-    // A right eye looking the other way: the point is behind it (w ≤ 0) → None.
-    let behind = r * Mat4::from_rotation_y(std::f32::consts::PI);
+    // A right eye turned 8.6° about its own Y axis (converged eyes): MVP_r · MVP_l⁻¹ then has a
+    // non-trivial bottom row, so clip_r.w ≠ 1 and a forgotten divide shows. With the parallel
+    // eyes of the rig w is exactly 1 and the divide cannot be checked.
+    let turned = fx.eyes[1].projection * Mat4::from_rotation_y(0.15) * fx.eyes[1].view;
+    inputs.extend(
+        left_samples(fx)
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| i % 41 == 20)
+            .map(|(_, (x, y, _, d))| {
+                (
+                    format!("left pixel ({x}, {y}), right eye turned 8.6° about Y (w ≠ 1)"),
+                    l,
+                    turned,
+                    (x, y),
+                    d,
+                )
+            }),
+    );
+    // A right eye turned round (180° about its own Y axis): every point the left eye sees is
+    // behind it, clip_r.w < 0 → None.
+    let around =
+        fx.eyes[1].projection * Mat4::from_rotation_y(std::f32::consts::PI) * fx.eyes[1].view;
+    inputs.extend(
+        left_samples(fx)
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| i % 97 == 5)
+            .take(4)
+            .map(|(_, (x, y, _, d))| {
+                (
+                    format!("left pixel ({x}, {y}), right eye turned round (behind it: None)"),
+                    l,
+                    around,
+                    (x, y),
+                    d,
+                )
+            }),
+    );
+    // The model turned 180° about its own Y axis for the right eye only (a point still in
+    // front of the right eye, elsewhere in the image).
+    let model_turned = r * Mat4::from_rotation_y(std::f32::consts::PI);
     let center = (size.0 / 2, size.1 / 2);
-    inputs.push(("behind the right eye".into(), l, behind, center, 0.9));
+    inputs.push((
+        "center pixel, the model turned 180° about Y for the right eye".into(),
+        l,
+        model_turned,
+        center,
+        0.9,
+    ));
     let json_of = |l: &Mat4, r: &Mat4, uv: [f32; 2], d: f32| {
         json!([l.to_cols_array(), r.to_cols_array(), uv, d])
     };
@@ -143,6 +195,8 @@ pub(super) fn remap_task(fx: &Fixture) -> TaskSpec {
         name: "remap",
         points: 2.0,
         bonus: false,
+        depends_on: &[],
+        hidden: Vec::new(),
         tolerance: Tolerance {
             abs: 2e-4,
             rel: 0.0,
@@ -158,6 +212,33 @@ pub(super) fn remap_task(fx: &Fixture) -> TaskSpec {
                        [−1, 1]: z_ndc = 2·depth − 1 going in, depth = (z_ndc + 1)/2 coming out",
                 answers: each(RemapVariant {
                     depth_as_ndc: true,
+                    ..Default::default()
+                }),
+            },
+            Mistake {
+                id: "one-sided-depth",
+                hint: "depth converted one way only: depth_left in [0, 1] becomes \
+                       z_ndc = 2·depth − 1, AND the result goes back: depth = (z_ndc + 1)/2",
+                answers: each(RemapVariant {
+                    depth_out_raw: true,
+                    ..Default::default()
+                }),
+            },
+            Mistake {
+                id: "one-sided-depth",
+                hint: "depth converted one way only: the result is converted back with \
+                       (z_ndc + 1)/2, so depth_left must go in as z_ndc = 2·depth − 1",
+                answers: each(RemapVariant {
+                    depth_in_raw: true,
+                    ..Default::default()
+                }),
+            },
+            Mistake {
+                id: "never-none",
+                hint: "return None when clip_r.w ≤ 0: the point is behind the right eye and \
+                       dividing by w flips it into the image",
+                answers: each(RemapVariant {
+                    never_none: true,
                     ..Default::default()
                 }),
             },

@@ -1,15 +1,15 @@
 //! Exercise 1's stereo rig task: each eye's view and projection (`stereo_matrices`), with
 //! per-eye and cyclopic lighting, and its rendered pictures.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
-use super::{MATRIX_TOLERANCE, blank, eyes, flat, setups};
+use super::{HIDDEN_SETUPS, MATRIX_TOLERANCE, blank, camera, eyes, flat, random_setup, setups};
 use crate::exercise::StereoSetup;
 use crate::framebuffer::Framebuffer;
 use crate::grade::fixture::Fixture;
-use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec};
-use crate::math::{CameraMode, EyeMatrices, Lighting};
+use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, hidden_cases};
+use crate::math::{Camera, CameraMode, EyeMatrices, Lighting};
 use crate::plan::Shading;
 use crate::render::render_view;
 
@@ -49,10 +49,44 @@ fn other(l: Lighting) -> Lighting {
     }
 }
 
+/// The setups of the frustum tasks plus cameras whose eye x axis is not world x: the fixture's
+/// camera orbited 50° about Y around its target, and a camera looking down from above and to
+/// the side (rotated about Y and X). A camera that only tilts about X keeps eye x = world x,
+/// where `MV · T±` equals `T± · MV` and the order cannot be checked.
+fn rig_setups(fx: &Fixture) -> Vec<(StereoSetup, Camera)> {
+    let mut v = setups(fx);
+    let (s, cam) = v[0].clone();
+    let target = Vec3::from(cam.target);
+    let orbit = target + Quat::from_rotation_y(50f32.to_radians()) * (Vec3::from(cam.eye) - target);
+    v.push((
+        s,
+        Camera {
+            eye: orbit.to_array(),
+            ..cam
+        },
+    ));
+    let (s, _) = v[1].clone();
+    v.push((s, camera(&s, [6.0, 4.0, 5.0], [0.0, -1.0, 0.0])));
+    v
+}
+
+/// The reference's answer for a random setup and camera (hidden cases).
+fn hidden_case(s: &StereoSetup, cam: &Camera, eye: usize, lighting: Lighting) -> Case {
+    let ok = eyes(s, cam, s.eye_separation, CameraMode::OffAxis, lighting);
+    Case {
+        label: format!(
+            "hidden: eye {eye}, {lighting:?} lighting, camera at {:?} looking at {:?}, {s:?}",
+            cam.eye, cam.target
+        ),
+        input: eye_view_input(s, &cam.view(), eye, lighting),
+        expected: eye_answer(&ok[eye]),
+    }
+}
+
 pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
     let mut cases = Vec::new();
-    let mut wrong: [Vec<Vec<f64>>; 5] = Default::default();
-    for (s, cam) in setups(fx) {
+    let mut wrong: [Vec<Vec<f64>>; 6] = Default::default();
+    for (s, cam) in rig_setups(fx) {
         let d = s.eye_separation;
         let mv = cam.view();
         for lighting in [Lighting::PerEye, Lighting::Cyclopic] {
@@ -84,10 +118,20 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
                 let mut v = flat(&flipped.0);
                 v.extend(flat(&flipped.1));
                 wrong[4].push(v);
+                // MV · T± instead of T± · MV (per-eye; cyclopic has no MV in the projection).
+                let t_ok = Mat4::from_translation(Vec3::new(-side * 0.5 * d, 0.0, 0.0));
+                wrong[5].push(match lighting {
+                    Lighting::PerEye => {
+                        let mut v = flat(&(mv * t_ok));
+                        v.extend(flat(&ok[eye].projection));
+                        v
+                    }
+                    Lighting::Cyclopic => eye_answer(&ok[eye]),
+                });
             }
         }
     }
-    let [swapped, toe, double, light, sign] = wrong;
+    let [swapped, toe, double, light, sign, mv_t] = wrong;
     let inputs: Vec<Value> = fixture_eye_inputs(fx)
         .into_iter()
         .map(|(eye, l)| eye_view_input(&fx.setup, &fx.modelview, eye, l))
@@ -132,6 +176,16 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
         name: "stereo_matrices",
         points: 2.0,
         bonus: false,
+        depends_on: &["frustum", "stereo_frustum"],
+        hidden: hidden_cases("stereo_matrices", 2 * HIDDEN_SETUPS, |rng, i| {
+            let (s, cam) = random_setup(rng);
+            let lighting = if i % 4 < 2 {
+                Lighting::PerEye
+            } else {
+                Lighting::Cyclopic
+            };
+            hidden_case(&s, &cam, i % 2, lighting)
+        }),
         tolerance: MATRIX_TOLERANCE,
         cases,
         mistakes: vec![
@@ -163,6 +217,13 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
                 hint: "T± moves the eye the wrong way: T moves the WORLD, so the left eye at \
                        x = −d/2 needs translate(+d/2, 0, 0)",
                 answers: sign,
+            },
+            Mistake {
+                id: "mv-t-order",
+                hint: "MV · T± is the wrong order: T± moves the eye along the EYE's x axis, so \
+                       it acts after the modelview: view = T± · MV. (MV · T± moves along the \
+                       world's x axis, which only agrees when the camera is not turned about Y.)",
+                answers: mv_t,
             },
         ],
         image: Some(ImageCheck {

@@ -140,6 +140,8 @@ pub(super) fn visible_task(fx: &Fixture) -> TaskSpec {
         name: "visible",
         points: 1.0,
         bonus: false,
+        depends_on: &[],
+        hidden: Vec::new(),
         tolerance: Tolerance::EXACT,
         cases,
         mistakes: vec![
