@@ -213,3 +213,29 @@ fn crashes_aborts_exits_and_memory_hogs_get_their_own_hint() {
         );
     }
 }
+
+/// The build folder students get by default is relative (`target/stereolab-grade`), while each
+/// task runs in a scratch folder of its own: the grader must still find the binaries.
+#[test]
+fn a_relative_build_folder_grades_like_an_absolute_one() {
+    let _turn = take_turn();
+    let json = out_dir("grading_relative").join("results.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .current_dir(crate::grading::target_dir())
+        .env("CARGO_TARGET_DIR", ".")
+        .env_remove("STEREOLAB_MUTANT")
+        .args(["grade", "ex2", "--solution", "--exercises"])
+        .arg(repo_exercises())
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .expect("run stereolab grade");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(score(&v), 5.0, "{}", String::from_utf8_lossy(&out.stdout));
+}

@@ -135,6 +135,8 @@ static CARGO: Mutex<()> = Mutex::new(());
 /// A binary already built from the same hash is reused. `Ok(path)` is the executable; `Err` the
 /// compiler's messages or why the build could not run.
 pub(crate) fn build(ex: Exercise, sources: &Sources, work: &Path) -> Result<PathBuf, String> {
+    // Absolute: the binary runs in a scratch folder of its own, where a relative path is wrong.
+    let work = &std::path::absolute(work).map_err(|e| format!("{}: {e}", work.display()))?;
     let name = ex.crate_name();
     let short = &sources.hash[..16];
     let bin = work.join("bin").join(format!("{name}-{short}"));

@@ -108,27 +108,34 @@ fn fmt_nums(v: &[f64], tol: &Tolerance) -> String {
     format!("[{}]", items.join(", "))
 }
 
-/// `v` (16 column-major numbers per matrix: 16 or 32 numbers) as 4×4 rows, the way the
-/// exercise slides write matrices: element `k` of a matrix is row `k % 4`, column `k / 4`.
-fn fmt_matrices(v: &[f64]) -> String {
+/// `expected` and `actual` (16 column-major numbers per matrix: 16 or 32 numbers) side by side
+/// as 4×4 rows, the way the exercise slides write matrices: element `k` of a matrix is row
+/// `k % 4`, column `k / 4`.
+fn fmt_matrices(expected: &[f64], actual: &[f64]) -> String {
     let names = ["view", "projection"];
     let mut s = String::new();
-    for (m, chunk) in v.chunks(16).enumerate() {
-        if v.len() > 16 {
-            let _ = write!(s, "\n    {}:", names[m]);
-        }
+    let row_of = |m: &[f64], row: usize| -> String {
+        (0..4)
+            .map(|col| format!("{:>10.5}", m[4 * col + row]))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    for (m, (e, a)) in expected.chunks(16).zip(actual.chunks(16)).enumerate() {
+        let name = if expected.len() > 16 {
+            names[m]
+        } else {
+            "matrix"
+        };
+        let _ = write!(s, "\n    {name:<10} {:^45}   {:^45}", "expected", "actual");
         for row in 0..4 {
-            let cells: Vec<String> = (0..4)
-                .map(|col| format!("{:>12.6}", chunk[4 * col + row]))
-                .collect();
-            let _ = write!(s, "\n      | {} |", cells.join(" "));
+            let _ = write!(s, "\n      | {} |   | {} |", row_of(e, row), row_of(a, row));
         }
     }
     s
 }
 
 /// Why a numeric answer fails, or `None` when it passes.
-fn check(expected: &[f64], actual: &[f64], tol: &Tolerance) -> Option<String> {
+fn check(expected: &[f64], actual: &[f64], tol: &Tolerance, full: bool) -> Option<String> {
     if tol.accepts(expected, actual) {
         return None;
     }
@@ -165,13 +172,17 @@ fn check(expected: &[f64], actual: &[f64], tol: &Tolerance) -> Option<String> {
         }
     };
     if matrices {
-        return Some(format!(
-            "tolerance {} ({}), difference {diff}\n    expected (rows as written on the slides):{}\n    actual:{}",
-            tol.describe(),
-            tol.why,
-            fmt_matrices(expected),
-            fmt_matrices(actual)
-        ));
+        // The matrices in full for the first failing input; the others say where they differ.
+        return Some(if full {
+            format!(
+                "tolerance {} ({}), difference {diff}; rows as written on the slides:{}",
+                tol.describe(),
+                tol.why,
+                fmt_matrices(expected, actual)
+            )
+        } else {
+            format!("difference {diff}")
+        });
     }
     Some(format!(
         "expected {}, actual {}, tolerance {} ({}), difference {diff}",
@@ -213,7 +224,7 @@ fn tally(cases: &[Case], replies: &[Result<Vec<f64>, String>], tol: &Tolerance) 
                 if bad {
                     t.non_finite += 1;
                 }
-                let m = check(&case.expected, a, tol);
+                let m = check(&case.expected, a, tol, t.failing.is_empty());
                 if m.is_some() {
                     t.failing.push((i, a.clone()));
                 }
@@ -468,6 +479,7 @@ fn check_pictures(
     details: &mut Vec<String>,
 ) -> bool {
     let mut all = true;
+    let mut mapped = false;
     for p in pictures {
         let m = match compare(&p.expected, &p.actual) {
             Ok(m) => m,
@@ -503,7 +515,9 @@ fn check_pictures(
                 let _ = write!(line, "; diff image not written: {e}");
             }
         }
-        if p.expected.width <= ASCII_MAX_WIDTH && m.coverage_mismatch > 0 {
+        // One map per task (the first failing picture): the others are in their strips.
+        if p.expected.width <= ASCII_MAX_WIDTH && m.coverage_mismatch > 0 && !mapped {
+            mapped = true;
             let _ = write!(
                 line,
                 "\n  coverage (# both, ! extra, ? missed):\n{}",
@@ -538,14 +552,16 @@ mod tests {
             rel: 0.0,
             why: "test",
         };
-        let msg = check(&expected, &actual, &tol).expect("fails");
+        let msg = check(&expected, &actual, &tol, true).expect("fails");
         assert!(msg.contains("row 2, column 3"), "{msg}");
         // Row 0 reads across the columns: elements 0, 4, 8, 12.
         assert!(
-            msg.contains("|     0.000000     4.000000     8.000000    12.000000 |"),
+            msg.contains(
+                "|    0.00000    4.00000    8.00000   12.00000 |   |    0.00000    4.00000    8.00000   12.00000 |"
+            ),
             "{msg}"
         );
-        let msg = check(&[3.0, 1.0], &[3.0, 2.0], &Tolerance::EXACT).expect("fails");
+        let msg = check(&[3.0, 1.0], &[3.0, 2.0], &Tolerance::EXACT, true).expect("fails");
         assert!(msg.starts_with("expected [3, 1], actual [3, 2]"), "{msg}");
     }
 }
