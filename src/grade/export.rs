@@ -197,8 +197,8 @@ cargo run -p stereolab -- grade ex1                       # points, hints (or ex
 cargo run -p stereolab -- render --exercise ex1 stereolab/assets/scenes/wuson.toml --out out
 ```
 
-**The first `cargo run -p stereolab` compiles stereolab and its dependencies: several minutes
-on a two-core laptop** (about 4 to 5 minutes measured; later runs start at once). Each `grade`
+**The first `cargo run -p stereolab` compiles stereolab and its dependencies: about 4 minutes
+on a two-core laptop** (7.6 minutes of CPU time measured; later runs start at once). Each `grade`
 then builds your crates in `target/stereolab-grade/` in seconds.
 
 ## How points are given
