@@ -120,7 +120,28 @@ pub fn diff_image(expected: &Framebuffer, actual: &Framebuffer) -> RgbaImage {
     })
 }
 
-/// Writes `expected | diff | actual` side by side as `DIR/NAME.png`; returns the path.
+/// Height of the caption band above each panel of a diff strip, in pixels.
+const CAPTION_HEIGHT: u32 = 22;
+/// Pixels between two panels of a diff strip.
+const PANEL_GAP: u32 = 4;
+/// Small pictures are enlarged (nearest neighbour, whole pixels) to at least this width per
+/// panel, so that a 64×48 grading picture can be seen.
+const MIN_PANEL_WIDTH: u32 = 240;
+
+/// The enlargement of a `width`-pixel-wide picture in a diff strip (1 to 8).
+pub fn strip_scale(width: u32) -> u32 {
+    MIN_PANEL_WIDTH.div_ceil(width.max(1)).clamp(1, 8)
+}
+
+/// The size of the diff strip of `width`×`height` pictures: three enlarged panels side by side
+/// with gaps, under a caption band.
+pub fn strip_size(width: u32, height: u32) -> (u32, u32) {
+    let k = strip_scale(width);
+    (3 * width * k + 2 * PANEL_GAP, height * k + CAPTION_HEIGHT)
+}
+
+/// Writes `expected | diff | actual` side by side as `DIR/NAME.png`, each panel captioned and
+/// small pictures enlarged ([`strip_size`]); returns the path.
 ///
 /// # Errors
 /// Different sizes or an unwritable folder.
@@ -132,13 +153,25 @@ pub fn write_diff_strip(
 ) -> Result<PathBuf> {
     compare(expected, actual)?;
     let (w, h) = (expected.width, expected.height);
+    let k = strip_scale(w);
+    let (sw, sh) = strip_size(w, h);
     let diff = diff_image(expected, actual);
-    let (e, a) = (expected.to_rgba_image(), actual.to_rgba_image());
-    let strip = RgbaImage::from_fn(3 * w, h, |x, y| match x / w {
-        0 => *e.get_pixel(x, y),
-        1 => *diff.get_pixel(x - w, y),
-        _ => *a.get_pixel(x - 2 * w, y),
-    });
+    let panels = [
+        (expected.to_rgba_image(), "expected"),
+        (diff, "difference ×8, yellow: coverage"),
+        (actual.to_rgba_image(), "actual"),
+    ];
+    let mut strip = RgbaImage::from_pixel(sw, sh, Rgba([48, 48, 48, 255]));
+    for (i, (img, label)) in panels.iter().enumerate() {
+        let x0 = i as u32 * (w * k + PANEL_GAP);
+        let band = crate::text::caption(w * k, CAPTION_HEIGHT, label, 14.0, [32, 32, 32]);
+        image::imageops::replace(&mut strip, &band, i64::from(x0), 0);
+        for y in 0..h * k {
+            for x in 0..w * k {
+                strip.put_pixel(x0 + x, CAPTION_HEIGHT + y, *img.get_pixel(x / k, y / k));
+            }
+        }
+    }
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let path = dir.join(format!("{name}.png"));
     crate::files::write_png(&path, &strip)?;

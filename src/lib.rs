@@ -50,6 +50,7 @@ pub mod raster;
 pub mod render;
 pub mod scene;
 pub mod shade;
+pub mod text;
 
 pub use error::{Error, Result};
 pub use framebuffer::{EyePair, Framebuffer};

@@ -29,7 +29,7 @@ use crate::common::root;
 const LAYERS: &[&[&str]] = &[
     &["error"],
     &["files"],
-    &["math", "framebuffer", "shade"],
+    &["math", "framebuffer", "shade", "text"],
     &["raster"],
     &["effects"],
     &["plan"],

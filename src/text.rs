@@ -1,0 +1,118 @@
+//! Text in pictures: labels drawn with the font stereolab ships (`assets/fonts/DejaVuSans.ttf`,
+//! DejaVu Sans, under the Bitstream Vera licence in `assets/fonts/LICENSE-DejaVu.txt`).
+//!
+//! Each glyph's outline is rasterized by `ab_glyph` into coverage values in [0, 1], and each
+//! covered pixel is blended towards the text color by its coverage. Deterministic: the same
+//! text gives the same bytes on every machine (the font is compiled in, no system fonts).
+
+use ab_glyph::{Font, FontRef, PxScale, ScaleFont};
+use image::{Rgba, RgbaImage};
+
+/// The shipped font, compiled in.
+const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+
+fn font() -> FontRef<'static> {
+    // The bytes are a constant checked by the tests: parsing cannot fail at run time.
+    FontRef::try_from_slice(FONT).expect("the shipped font parses")
+}
+
+/// The width in pixels of `text` at `size` pixels (the font's em height).
+pub fn width(text: &str, size: f32) -> f32 {
+    let font = font();
+    let scaled = font.as_scaled(PxScale::from(size));
+    let mut w = 0.0;
+    let mut prev = None;
+    for c in text.chars() {
+        let id = scaled.glyph_id(c);
+        if let Some(p) = prev {
+            w += scaled.kern(p, id);
+        }
+        w += scaled.h_advance(id);
+        prev = Some(id);
+    }
+    w
+}
+
+/// Draws `text` with its top-left corner at `(x, y)`, `size` pixels high, in `color`, onto
+/// `img` (pixels outside the image are skipped).
+pub fn draw(img: &mut RgbaImage, x: f32, y: f32, size: f32, text: &str, color: [u8; 3]) {
+    let font = font();
+    let scaled = font.as_scaled(PxScale::from(size));
+    let baseline = y + scaled.ascent();
+    let mut caret = x;
+    let mut prev = None;
+    for c in text.chars() {
+        let id = scaled.glyph_id(c);
+        if let Some(p) = prev {
+            caret += scaled.kern(p, id);
+        }
+        let glyph =
+            id.with_scale_and_position(PxScale::from(size), ab_glyph::point(caret, baseline));
+        caret += scaled.h_advance(id);
+        prev = Some(id);
+        let Some(outlined) = font.outline_glyph(glyph) else {
+            continue; // a space
+        };
+        let bounds = outlined.px_bounds();
+        outlined.draw(|gx, gy, coverage| {
+            let px = bounds.min.x as i64 + i64::from(gx);
+            let py = bounds.min.y as i64 + i64::from(gy);
+            let (Ok(px), Ok(py)) = (u32::try_from(px), u32::try_from(py)) else {
+                return;
+            };
+            if px >= img.width() || py >= img.height() {
+                return;
+            }
+            let a = coverage.clamp(0.0, 1.0);
+            let p = img.get_pixel_mut(px, py);
+            for k in 0..3 {
+                let v = f32::from(p[k]) * (1.0 - a) + f32::from(color[k]) * a;
+                p[k] = v.round() as u8;
+            }
+            p[3] = 255;
+        });
+    }
+}
+
+/// A band `height` pixels high and `width` wide, filled with `background`, with `text` centered
+/// in it at `size` pixels: a caption above a picture.
+pub fn caption(width: u32, height: u32, text: &str, size: f32, background: [u8; 3]) -> RgbaImage {
+    let [r, g, b] = background;
+    let mut band = RgbaImage::from_pixel(width, height, Rgba([r, g, b, 255]));
+    let w = self::width(text, size);
+    let x = ((width as f32 - w) / 2.0).max(2.0);
+    let y = (height as f32 - size) / 2.0;
+    let luma = 0.299 * f32::from(r) + 0.587 * f32::from(g) + 0.114 * f32::from(b);
+    let ink = if luma > 128.0 {
+        [0, 0, 0]
+    } else {
+        [255, 255, 255]
+    };
+    draw(&mut band, x, y, size, text, ink);
+    band
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_draws_ink_inside_its_width_and_nothing_else() {
+        let mut img = RgbaImage::from_pixel(200, 40, Rgba([255, 255, 255, 255]));
+        let w = width("expected", 20.0);
+        assert!(w > 40.0 && w < 150.0, "{w}");
+        draw(&mut img, 10.0, 10.0, 20.0, "expected", [0, 0, 0]);
+        let inked: Vec<(u32, u32)> = img
+            .enumerate_pixels()
+            .filter(|(_, _, p)| p[0] < 128)
+            .map(|(x, y, _)| (x, y))
+            .collect();
+        assert!(inked.len() > 50, "{}", inked.len());
+        for (x, y) in inked {
+            assert!(
+                (9..=11 + w as u32).contains(&x) && (10..=32).contains(&y),
+                "({x}, {y})"
+            );
+        }
+    }
+}
