@@ -456,7 +456,37 @@ fn hidden_cases_come_from_the_seed_the_solution_passes_them_and_a_mutant_fails_t
     );
 }
 
-fn files_under(dir: &Path) -> Vec<PathBuf> {
+/// Every file a shipped copy of stereolab's sources (`lib`: the handout's or the bundle's
+/// `stereolab/`) compiles in with `include_str!` / `include_bytes!` exists in that copy: a
+/// copy missing one does not build, and building it here would take minutes.
+pub(crate) fn assert_includes_resolve(lib: &Path) {
+    let mut checked = 0;
+    for file in files_under(&lib.join("src")) {
+        if file.extension().is_none_or(|e| e != "rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&file).unwrap();
+        for macro_name in ["include_str!(\"", "include_bytes!(\""] {
+            for rest in text.split(macro_name).skip(1) {
+                let rel = rest.split('"').next().unwrap();
+                let target = file.parent().unwrap().join(rel);
+                assert!(
+                    target.is_file(),
+                    "{} includes {rel}, missing from the shipped copy",
+                    file.display()
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(
+        checked > 5,
+        "only {checked} includes found under {}",
+        lib.display()
+    );
+}
+
+pub(crate) fn files_under(dir: &Path) -> Vec<PathBuf> {
     let mut v = Vec::new();
     for e in std::fs::read_dir(dir).expect("read folder").flatten() {
         let p = e.path();
@@ -507,6 +537,7 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
         }
     }
     assert!(handout.join("stereolab/assets/scenes/wuson.toml").is_file());
+    assert_includes_resolve(&handout.join("stereolab"));
     // Everything the stubs and the handout's README cite is in the handout.
     for f in [
         "slides/01-stereo-rig.md",

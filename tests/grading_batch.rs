@@ -423,6 +423,8 @@ fn the_gradescope_bundle_runs_in_an_autograder_layout() {
     );
     let run = std::fs::read_to_string(root.join("source/run_autograder")).unwrap();
     assert!(run.contains("export STEREOLAB_GRADER_SEED=7"), "{run}");
+    // Everything the bundled sources compile in is bundled.
+    crate::grading::assert_includes_resolve(&root.join("source/stereolab"));
     // The bundled sources are a workspace of their own that cargo can read.
     let meta = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
         .args([

@@ -204,7 +204,13 @@ fn files(root: &Path, seed: Option<u64>) -> Result<Files> {
     for file in ["Cargo.lock", "LICENSE"] {
         add_file(root, file, &mut files)?;
     }
-    for dir in ["src", "docs", "assets/scenes", "exercises/exercise-api"] {
+    for dir in [
+        "src",
+        "docs",
+        "assets/scenes",
+        "assets/fonts",
+        "exercises/exercise-api",
+    ] {
         add_tree(root, dir, &mut files)?;
     }
     // The templates the grader compiles in, and the stubs for setup's warm-up (no solutions).

@@ -84,11 +84,10 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     copy_tree(&root.join("docs"), &lib.join("docs"), &|_| false)?;
     // The slides the stubs cite, at the handout's top level.
     copy_tree(&root.join("slides"), &dir.join("slides"), &|_| false)?;
-    copy_tree(
-        &root.join("assets/scenes"),
-        &lib.join("assets/scenes"),
-        &|_| false,
-    )?;
+    // The scenes with their models and terrain, and the font the library compiles in.
+    for assets in ["assets/scenes", "assets/fonts"] {
+        copy_tree(&root.join(assets), &lib.join(assets), &|_| false)?;
+    }
     // The lock file twice: the handout's workspace resolves from it, and the grader compiles it
     // in (every build of a submission resolves from the same versions).
     for (from, to) in [
