@@ -227,3 +227,81 @@ fn main() -> ExitCode {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The command line's parser, fuzzed (issue 14): any argument list gives a parsed command
+    //! or clap's error, never a panic (`PROPTEST_CASES` sets the count, docs/reliability.md).
+
+    use clap::{CommandFactory, Parser};
+    use proptest::prelude::*;
+
+    use super::Cli;
+
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    fn word() -> impl Strategy<Value = String> {
+        prop_oneof![
+            prop::sample::select(vec![
+                "render",
+                "compare",
+                "grade",
+                "exercises",
+                "export",
+                "info",
+                "figures",
+                "bench",
+                "sirds",
+                "batch",
+                "bundle",
+                "all",
+                "ex1",
+                "--out",
+                "-o",
+                "--size",
+                "--set",
+                "--frames",
+                "--depth",
+                "--decode",
+                "--json",
+                "--timeout",
+                "--memory-mb",
+                "--jobs",
+                "--seed",
+                "--max-triangles",
+                "--allow-outside-paths",
+                "--exercise",
+                "--solution",
+                "--threshold",
+                "--backend",
+                "gpu",
+                "cpu",
+                "--help",
+                "-h",
+                "--version",
+                "0",
+                "-1",
+                "1e30",
+                "nan",
+                "64x48",
+                "0x0",
+                "x",
+                "=",
+                "--",
+            ])
+            .prop_map(str::to_string),
+            "\\PC{0,12}",
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn any_arguments_parse_or_fail_cleanly(args in prop::collection::vec(word(), 0..8)) {
+            let argv = std::iter::once("stereolab".to_string()).chain(args);
+            let _ = Cli::try_parse_from(argv);
+        }
+    }
+}
