@@ -397,7 +397,7 @@ fn load_object(
             let p = m.path.as_ref().ok_or_else(|| {
                 Error::invalid(field("path"), "missing", "a terrain mesh needs a CSV path")
             })?;
-            terrain::load_terrain_csv(&root.resolve(&field("path"), p)?)?.mesh
+            terrain::load_terrain_csv_within(&root.resolve(&field("path"), p)?, max_triangles)?.mesh
         }
         "plane" => Mesh::plane(positive("size", m.size, 1.0)?, detail.min(512)),
         "triangles" => {

@@ -53,6 +53,15 @@ pub fn map_to_world(x: f64, y: f64, height: f64) -> Vec3 {
 /// Unreadable or oversized file, and everything [`parse_csv`] and [`triangulate`] refuse, each
 /// naming the file (and line).
 pub fn load_terrain_csv(path: &Path) -> Result<Terrain> {
+    load_terrain_csv_within(path, u64::MAX)
+}
+
+/// [`load_terrain_csv`] refusing, before the triangulation, a file whose points would make more
+/// than `max_triangles` triangles (a Delaunay triangulation of n points has fewer than 2n).
+///
+/// # Errors
+/// As [`load_terrain_csv`], and `Invalid` naming the point count and the budget.
+pub fn load_terrain_csv_within(path: &Path, max_triangles: u64) -> Result<Terrain> {
     let bytes = crate::files::read_input(path, MAX_CSV_BYTES)?;
     let text = String::from_utf8(bytes).map_err(|e| {
         Error::parse(
@@ -62,7 +71,21 @@ pub fn load_terrain_csv(path: &Path) -> Result<Terrain> {
         )
     })?;
     let text = crate::files::without_bom(text);
-    triangulate(path, &parse_csv(path, &text)?)
+    let points = parse_csv(path, &text)?;
+    drop(text);
+    let most = 2 * points.len() as u64;
+    if most > max_triangles {
+        return Err(Error::invalid(
+            "mesh path",
+            path.display(),
+            format!(
+                "{} points make up to {most} triangles, over the scene's budget of \
+                 {max_triangles} (thin the data, or raise the budget with --max-triangles)",
+                points.len()
+            ),
+        ));
+    }
+    triangulate(path, &points)
 }
 
 /// Parses CSV text: one point per line, comma-separated; blank lines and lines starting with `#`

@@ -104,8 +104,10 @@ fn report(args: &SirdsArgs) -> Result<String> {
         let (w, h) = img.dimensions();
         let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
         let d = settings.geometry.to_pixels()?;
-        let decoded = decode(&pixels, w, h, &DecodeOptions::for_disparity(&d))
-            .map_err(|e| e.in_file(path))?;
+        let decoded = super::with_spinner(&format!("decoding {}", path.display()), || {
+            decode(&pixels, w, h, &DecodeOptions::for_disparity(&d))
+        })
+        .map_err(|e| e.in_file(path))?;
         let z: Vec<f32> = depth_from_separation(&decoded, &d)
             .into_iter()
             .map(|z| {
@@ -168,13 +170,15 @@ fn report(args: &SirdsArgs) -> Result<String> {
             out.extension().and_then(|e| e.to_str()),
             Some("ppm" | "pnm")
         );
-        let (w, h) = if is_ppm && !settings.guide_dots {
-            stream_depth_map(path, &settings, &out)?
-        } else {
-            let sirds = from_depth_map(DepthMap::load(path)?, &settings)?;
-            save(&sirds.pixels, sirds.width, sirds.height, &out)?;
-            (sirds.width, sirds.height)
-        };
+        let (w, h) = super::with_spinner("making the autostereogram", || {
+            if is_ppm && !settings.guide_dots {
+                stream_depth_map(path, &settings, &out)
+            } else {
+                let sirds = from_depth_map(DepthMap::load(path)?, &settings)?;
+                save(&sirds.pixels, sirds.width, sirds.height, &out)?;
+                Ok((sirds.width, sirds.height))
+            }
+        })?;
         return Ok(format!(
             "per-pixel SIRDS of {} ({w}x{h}), separations {:.1}..{:.1} px\n  wrote {}\n",
             path.display(),
