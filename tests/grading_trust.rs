@@ -137,9 +137,12 @@ fn a_process_left_behind_by_a_task_cannot_change_the_results() {
     let results = dir.join("results.json");
     // Two ways to outlive the task: a plain child in its process group, and one in a new
     // session of its own (`setsid`), both rewriting results.json a second later.
+    // Each leaves a marker first, to prove it ran (a forger that never started proves nothing).
     let forge = |how: &str| {
         format!(
-            "std::process::Command::new(\"sh\").args([\"-c\", \"{how} sh -c 'sleep 1; echo forged > {}'\"]).spawn().ok();",
+            "std::process::Command::new(\"sh\").args([\"-c\", \"{how} sh -c 'touch {}/started-{}; sleep 1; echo forged > {}'\"]).spawn().ok();",
+            dir.display(),
+            if how.is_empty() { "plain" } else { how },
             results.display()
         )
     };
@@ -156,6 +159,12 @@ fn a_process_left_behind_by_a_task_cannot_change_the_results() {
     assert_eq!(score(&v), 5.0, "{v}");
     let written = std::fs::read_to_string(&results).unwrap();
     std::thread::sleep(Duration::from_millis(2500));
+    for how in ["plain", "setsid"] {
+        assert!(
+            dir.join(format!("started-{how}")).is_file(),
+            "the {how} forger never ran: the test would prove nothing"
+        );
+    }
     assert_eq!(
         std::fs::read_to_string(&results).unwrap(),
         written,
