@@ -538,6 +538,26 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
     }
     assert!(handout.join("stereolab/assets/scenes/wuson.toml").is_file());
     assert_includes_resolve(&handout.join("stereolab"));
+    // What a student's crate can reach: exercise-api, glam and serde, never stereolab.
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    for ex in ["ex1_stereo", "ex2_chromadepth", "ex3_sirds"] {
+        let tree = Command::new(&cargo)
+            .current_dir(&handout)
+            .args(["tree", "--offline", "-e", "normal", "-p", ex])
+            .output()
+            .expect("run cargo tree");
+        let text = String::from_utf8_lossy(&tree.stdout);
+        assert!(
+            tree.status.success(),
+            "{}",
+            String::from_utf8_lossy(&tree.stderr)
+        );
+        assert!(text.contains("exercise-api"), "{text}");
+        assert!(
+            !text.contains("stereolab v"),
+            "{ex} reaches stereolab:\n{text}"
+        );
+    }
     // Everything the stubs and the handout's README cite is in the handout.
     for f in [
         "slides/01-stereo-rig.md",
