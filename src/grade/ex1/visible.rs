@@ -5,7 +5,7 @@ use serde_json::json;
 use super::remap::{stereolab_remap, texel_of};
 use super::{flat, left_samples};
 use crate::grade::fixture::Fixture;
-use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
+use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 
 /// The visibility inputs `(uv_right, remapped, stored, tolerance)` of a left pixel, using the
 /// reference remap and a nearest lookup in the right depth buffer.
@@ -141,7 +141,34 @@ pub(super) fn visible_task(fx: &Fixture) -> TaskSpec {
         points: 1.0,
         bonus: false,
         depends_on: &[],
-        hidden: Vec::new(),
+        hidden: hidden_cases("visible", 10, |rng, i| {
+            // Inside the image or clearly outside it (never on its border), depths that agree,
+            // differ a little inside the tolerance or clearly beyond it (never on its edge).
+            let mut coordinate = |outside: bool| {
+                if outside {
+                    let c = rng.range(0.02, 0.3);
+                    if rng.next_u64() % 2 == 0 { -c } else { 1.0 + c }
+                } else {
+                    rng.range(0.01, 0.99)
+                }
+            };
+            let outside = i % 5 == 4;
+            let uv = (i % 10 != 9).then(|| [coordinate(outside), coordinate(false)]);
+            let remapped = rng.range(0.2, 0.98);
+            let tol = rng.range(1e-4, 5e-3);
+            let factor = match i % 3 {
+                0 => rng.range(-0.5, 0.5),
+                1 => rng.range(2.0, 20.0),
+                _ => -rng.range(2.0, 20.0),
+            };
+            let stored = (remapped + factor * tol).min(1.0);
+            let input: VisibleInput = (uv, remapped, stored, tol);
+            Case {
+                label: format!("hidden: {input:?}"),
+                input: json!(input),
+                expected: flat(&visible_reference(&input, None)),
+            }
+        }),
         tolerance: Tolerance::EXACT,
         cases,
         mistakes: vec![
