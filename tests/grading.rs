@@ -742,8 +742,9 @@ fn render_exercise_writes_the_solution_next_to_the_reference_on_any_scene() {
         "{stdout}{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    // Four eye renders, four anaglyphs, remap, visibility, parallax colors.
-    assert_eq!(stdout.lines().count(), 11, "{stdout}");
+    // Four eye renders, four anaglyphs, two finalize pictures, remap both ways, visibility,
+    // parallax colors.
+    assert_eq!(stdout.lines().count(), 14, "{stdout}");
     for line in stdout.lines() {
         assert!(
             line.contains("mismatch   0.00%, mean channel difference   0.00"),
