@@ -7,7 +7,9 @@
 //! `sheet-d-not-dw`, `remap-back-same-order`, `finalize-transposed`, `finalize-no-clamp`,
 //! `finalize-swapped-eyes`.
 
-use exercise_api::{AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, ScreenSetup, StereoSetup};
+use exercise_api::{
+    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, ScreenSetup, StereoSetup,
+};
 use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
@@ -168,7 +170,9 @@ pub fn finalize_pixel(left: [f32; 3], right: [f32; 3], m: &AnaglyphMatrices) -> 
         (m.left, m.right)
     };
     std::array::from_fn(|i| {
-        let v = (0..3).map(|j| ml[i][j] * left[j] + mr[i][j] * right[j]).sum::<f32>();
+        let v = (0..3)
+            .map(|j| ml[i][j] * left[j] + mr[i][j] * right[j])
+            .sum::<f32>();
         if planted("finalize-no-clamp") {
             v
         } else {

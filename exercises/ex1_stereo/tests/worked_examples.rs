@@ -80,7 +80,10 @@ fn seed003_in_the_sheets_terms_projects_to_5_875_left_and_6_125_right() {
     let mv = look_at(Vec3::new(0.0, 0.0, 9.0), Vec3::ZERO, Vec3::Y);
     for (eye, x) in [(0, 5.875), (1, 6.125)] {
         let [l, r, b, t, n, f] = ex1_stereo::sheet_frustum(&screen, eye);
-        assert!((t - 1.0).abs() < 1e-6 && (b + 1.0).abs() < 1e-6, "t = ½·h·n/z0 = 1: {t}");
+        assert!(
+            (t - 1.0).abs() < 1e-6 && (b + 1.0).abs() < 1e-6,
+            "t = ½·h·n/z0 = 1: {t}"
+        );
         // T± translates the eye point by ∓½·d·w = ∓0.5: the world moves the other way.
         let half = 0.5 * screen.eye_separation_fraction * screen.width;
         let shift = if eye == 0 { half } else { -half };
@@ -119,10 +122,16 @@ fn finalize_true_anaglyph_of_white_is_magenta_and_sums_are_clamped() {
     let m = ex1_stereo::anaglyph_matrices(AnaglyphKind::True);
     // The luminance weights sum to 1: white in both eyes gives full red and full blue.
     let out = ex1_stereo::finalize_pixel([1.0; 3], [1.0; 3], &m);
-    assert!((out[0] - 1.0).abs() < 1e-6 && out[1] == 0.0 && (out[2] - 1.0).abs() < 1e-6, "{out:?}");
+    assert!(
+        (out[0] - 1.0).abs() < 1e-6 && out[1] == 0.0 && (out[2] - 1.0).abs() < 1e-6,
+        "{out:?}"
+    );
     let twice = exercise_api::AnaglyphMatrices {
         left: m.left.map(|row| row.map(|x| 2.0 * x)),
         right: m.right.map(|row| row.map(|x| -x)),
     };
-    assert_eq!(ex1_stereo::finalize_pixel([1.0; 3], [1.0; 3], &twice), [1.0, 0.0, 0.0]);
+    assert_eq!(
+        ex1_stereo::finalize_pixel([1.0; 3], [1.0; 3], &twice),
+        [1.0, 0.0, 0.0]
+    );
 }

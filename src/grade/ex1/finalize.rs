@@ -9,7 +9,9 @@ use super::anaglyph::reference_anaglyph;
 use super::flat;
 use crate::effects::anaglyph::AnaglyphKind::DuboisRedCyan;
 use crate::effects::anaglyph::anaglyph_pixel;
-use crate::exercise::{AnaglyphKind, AnaglyphMatrices, ColorMatrix, exercise_matrices, reference_matrices};
+use crate::exercise::{
+    AnaglyphKind, AnaglyphMatrices, ColorMatrix, exercise_matrices, reference_matrices,
+};
 use crate::framebuffer::Framebuffer;
 use crate::grade::fixture::Fixture;
 use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
@@ -27,12 +29,25 @@ struct FinalizeVariant {
 }
 
 /// The finalize pixel in f64, with the known slips as switches.
-fn finalize_reference(left: [f32; 3], right: [f32; 3], m: &AnaglyphMatrices, v: FinalizeVariant) -> [f64; 3] {
-    let (left, right) = if v.swapped { (right, left) } else { (left, right) };
-    let at = |c: &ColorMatrix, i: usize, j: usize| f64::from(if v.transposed { c[j][i] } else { c[i][j] });
+fn finalize_reference(
+    left: [f32; 3],
+    right: [f32; 3],
+    m: &AnaglyphMatrices,
+    v: FinalizeVariant,
+) -> [f64; 3] {
+    let (left, right) = if v.swapped {
+        (right, left)
+    } else {
+        (left, right)
+    };
+    let at = |c: &ColorMatrix, i: usize, j: usize| {
+        f64::from(if v.transposed { c[j][i] } else { c[i][j] })
+    };
     std::array::from_fn(|i| {
         let s: f64 = (0..3)
-            .map(|j| at(&m.left, i, j) * f64::from(left[j]) + at(&m.right, i, j) * f64::from(right[j]))
+            .map(|j| {
+                at(&m.left, i, j) * f64::from(left[j]) + at(&m.right, i, j) * f64::from(right[j])
+            })
             .sum();
         if v.no_clamp { s } else { s.clamp(0.0, 1.0) }
     })
@@ -68,14 +83,54 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
     let orange = [0.9, 0.5, 0.3];
     let teal = [0.2, 0.7, 0.6];
     let inputs: Vec<(String, [f32; 3], [f32; 3], AnaglyphMatrices)> = vec![
-        ("true anaglyph, orange | teal".into(), orange, teal, reference_anaglyph(AnaglyphKind::True)),
-        ("gray anaglyph, teal | orange".into(), teal, orange, reference_anaglyph(AnaglyphKind::Gray)),
-        ("color anaglyph, orange | teal".into(), orange, teal, reference_anaglyph(AnaglyphKind::Color)),
-        ("half-color anaglyph, white | white".into(), white, white, reference_anaglyph(AnaglyphKind::HalfColor)),
-        ("half-color anaglyph, orange | black".into(), orange, [0.0; 3], reference_anaglyph(AnaglyphKind::HalfColor)),
-        ("Dubois, pure red | pure green (negative sums: clamp to 0)".into(), [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], dubois()),
-        ("Dubois, white | blue (above 1 and below 0)".into(), white, [0.0, 0.0, 1.0], dubois()),
-        ("twice the color anaglyph, orange | teal (above 1: clamp to 1)".into(), orange, teal, doubled_color()),
+        (
+            "true anaglyph, orange | teal".into(),
+            orange,
+            teal,
+            reference_anaglyph(AnaglyphKind::True),
+        ),
+        (
+            "gray anaglyph, teal | orange".into(),
+            teal,
+            orange,
+            reference_anaglyph(AnaglyphKind::Gray),
+        ),
+        (
+            "color anaglyph, orange | teal".into(),
+            orange,
+            teal,
+            reference_anaglyph(AnaglyphKind::Color),
+        ),
+        (
+            "half-color anaglyph, white | white".into(),
+            white,
+            white,
+            reference_anaglyph(AnaglyphKind::HalfColor),
+        ),
+        (
+            "half-color anaglyph, orange | black".into(),
+            orange,
+            [0.0; 3],
+            reference_anaglyph(AnaglyphKind::HalfColor),
+        ),
+        (
+            "Dubois, pure red | pure green (negative sums: clamp to 0)".into(),
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            dubois(),
+        ),
+        (
+            "Dubois, white | blue (above 1 and below 0)".into(),
+            white,
+            [0.0, 0.0, 1.0],
+            dubois(),
+        ),
+        (
+            "twice the color anaglyph, orange | teal (above 1: clamp to 1)".into(),
+            orange,
+            teal,
+            doubled_color(),
+        ),
     ];
     let each = |v: FinalizeVariant| {
         inputs
@@ -93,7 +148,10 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
             (fx.views[0].color[i], fx.views[1].color[i])
         })
         .collect();
-    let sets = [("dubois", dubois()), ("half_color", reference_anaglyph(AnaglyphKind::HalfColor))];
+    let sets = [
+        ("dubois", dubois()),
+        ("half_color", reference_anaglyph(AnaglyphKind::HalfColor)),
+    ];
     let canvas = {
         let mut fb = Framebuffer::new(pw, ph, [0, 0, 0, 255]).expect("half the fixture's size");
         fb.depth.fill(0.0);
@@ -101,7 +159,11 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
     };
     let image_inputs = sets
         .iter()
-        .flat_map(|(_, m)| pixels.iter().map(move |(l, r)| finalize_input(rgb(*l), rgb(*r), m)))
+        .flat_map(|(_, m)| {
+            pixels
+                .iter()
+                .map(move |(l, r)| finalize_input(rgb(*l), rgb(*r), m))
+        })
         .collect();
     let expected: Vec<Framebuffer> = sets
         .iter()
@@ -122,7 +184,11 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
             .enumerate()
             .map(|(k, (name, expected))| {
                 let mut actual = canvas.clone();
-                for (px, a) in actual.color.iter_mut().zip(&answers[k * count..(k + 1) * count]) {
+                for (px, a) in actual
+                    .color
+                    .iter_mut()
+                    .zip(&answers[k * count..(k + 1) * count])
+                {
                     *px = match a.as_deref() {
                         Some([r, g, b]) => to_rgba8(Vec3::new(*r as f32, *g as f32, *b as f32)),
                         _ => [0, 0, 0, 255],
@@ -142,7 +208,13 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
         bonus: false,
         depends_on: &[],
         hidden: hidden_cases("finalize_pixel", 8, |rng, _| {
-            let mut color = || [rng.range(0.0, 1.0), rng.range(0.0, 1.0), rng.range(0.0, 1.0)];
+            let mut color = || {
+                [
+                    rng.range(0.0, 1.0),
+                    rng.range(0.0, 1.0),
+                    rng.range(0.0, 1.0),
+                ]
+            };
             let (l, r) = (color(), color());
             let mut matrix = || -> ColorMatrix {
                 std::array::from_fn(|_| std::array::from_fn(|_| rng.range(-0.4, 1.2)))

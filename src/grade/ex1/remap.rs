@@ -5,9 +5,9 @@ use glam::{DMat4, DVec4, Mat4};
 use serde_json::json;
 
 use super::view_samples;
+use super::{HIDDEN_SETUPS, eyes, random_setup};
 use crate::effects::remap::{Precision, Remapped, Remapper};
 use crate::grade::fixture::Fixture;
-use super::{HIDDEN_SETUPS, eyes, random_setup};
 use crate::grade::spec::{
     Case, ImageCheck, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases,
 };
@@ -219,12 +219,23 @@ fn remap_direction_task(fx: &Fixture, from: usize) -> TaskSpec {
     };
     let forward = from == 0;
     TaskSpec {
-        name: if forward { "remap" } else { "remap_right_to_left" },
+        name: if forward {
+            "remap"
+        } else {
+            "remap_right_to_left"
+        },
         points: if forward { 2.0 } else { 1.0 },
         bonus: false,
         // The solution's right-to-left remap is `remap` with the eyes exchanged.
         depends_on: if forward { &[] } else { &["remap"] },
-        hidden: hidden_remaps(if forward { "remap" } else { "remap_right_to_left" }, from),
+        hidden: hidden_remaps(
+            if forward {
+                "remap"
+            } else {
+                "remap_right_to_left"
+            },
+            from,
+        ),
         tolerance: Tolerance {
             abs: 2e-4,
             rel: 0.0,
@@ -354,6 +365,16 @@ fn hidden_remap(rng: &mut SplitMix64, from: usize) -> (Case, Mat4, Mat4, [f32; 2
     (case, src, dst, uv, depth)
 }
 
+/// The texel nearest filtering fetches at texture coordinate (u, v) (v = 0 bottom) in a w × h
+/// image, if inside (stereolab's `Remapped::texel`).
+pub(super) fn texel_of(u: f64, v: f64, w: u32, h: u32) -> Option<(u32, u32)> {
+    Remapped {
+        tex: [u, v],
+        depth: 0.0,
+    }
+    .texel(w, h)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -392,14 +413,4 @@ mod tests {
         // 0.99); the tolerance is 2e-4.
         assert!(worst < 5e-5, "worst f32 error {worst:e}");
     }
-}
-
-/// The texel nearest filtering fetches at texture coordinate (u, v) (v = 0 bottom) in a w × h
-/// image, if inside (stereolab's `Remapped::texel`).
-pub(super) fn texel_of(u: f64, v: f64, w: u32, h: u32) -> Option<(u32, u32)> {
-    Remapped {
-        tex: [u, v],
-        depth: 0.0,
-    }
-    .texel(w, h)
 }

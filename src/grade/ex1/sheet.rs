@@ -33,7 +33,11 @@ struct SheetVariant {
 /// (+ for the left eye, index 0), with the known slips as switches.
 fn sheet_reference(s: &ScreenSetup, eye: usize, v: SheetVariant) -> [f64; 6] {
     let (w, h) = (f64::from(s.width), f64::from(s.height));
-    let (n, f, z0) = (f64::from(s.near), f64::from(s.far), f64::from(s.zero_parallax));
+    let (n, f, z0) = (
+        f64::from(s.near),
+        f64::from(s.far),
+        f64::from(s.zero_parallax),
+    );
     let d = f64::from(s.eye_separation_fraction);
     let scale = if v.unscaled { 1.0 } else { n / z0 };
     let t = 0.5 * h * scale;
@@ -213,8 +217,10 @@ mod tests {
 
     #[test]
     fn every_public_case_tells_each_slip_from_the_right_answer() {
-        let inputs: Vec<(ScreenSetup, usize)> =
-            screens().into_iter().flat_map(|s| [(s, 0), (s, 1)]).collect();
+        let inputs: Vec<(ScreenSetup, usize)> = screens()
+            .into_iter()
+            .flat_map(|s| [(s, 0), (s, 1)])
+            .collect();
         let slips = [
             SheetVariant {
                 swapped: true,

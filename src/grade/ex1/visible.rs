@@ -69,7 +69,11 @@ fn hidden_visible(rng: &mut SplitMix64, i: usize) -> VisibleInput {
     let mut coordinate = |outside: bool| {
         if outside {
             let c = rng.range(0.02, 0.3);
-            if rng.next_u64() % 2 == 0 { -c } else { 1.0 + c }
+            if rng.next_u64().is_multiple_of(2) {
+                -c
+            } else {
+                1.0 + c
+            }
         } else {
             rng.range(0.01, 0.99)
         }
@@ -216,8 +220,9 @@ mod tests {
     fn every_seed_s_hidden_cases_catch_each_known_mistake() {
         for seed in 0..200u64 {
             let mut rng = SplitMix64::for_task(seed, "visible");
-            let inputs: Vec<VisibleInput> =
-                (0..HIDDEN_VISIBLE).map(|i| hidden_visible(&mut rng, i)).collect();
+            let inputs: Vec<VisibleInput> = (0..HIDDEN_VISIBLE)
+                .map(|i| hidden_visible(&mut rng, i))
+                .collect();
             for m in ["ignores-out-of-frame", "no-tolerance", "one-sided"] {
                 assert!(
                     inputs
