@@ -49,8 +49,9 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
 ///   eye (index 1, at x = +½·d·w) by `−½·d·w·n/z0`;
 /// - `n`, `f` unchanged.
 ///
-/// (The matching `T±` translates the eye point by `±½·d·w` in x: as a matrix applied to the
-/// world, `T_left = translate(+½·d·w, 0, 0)`, see [`stereo_matrices`].)
+/// (The slides' matching `T±` is the translation by `½·d·w` in x that moves this eye to the
+/// origin: `T_left = translate(+½·d·w, 0, 0)` for the left eye at x = −½·d·w,
+/// `T_right = translate(−½·d·w, 0, 0)`, as in [`stereo_matrices`].)
 pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
     // TODO: t from h, l and r from w, then shift l and r for this eye; all scaled by n/z0.
     todo!("frustum bounds of eye {eye:?} for {screen:?}")

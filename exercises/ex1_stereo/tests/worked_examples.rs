@@ -84,7 +84,7 @@ fn seed003_in_the_sheets_terms_projects_to_5_875_left_and_6_125_right() {
             (t - 1.0).abs() < 1e-6 && (b + 1.0).abs() < 1e-6,
             "t = ½·h·n/z0 = 1: {t}"
         );
-        // T± translates the eye point by ∓½·d·w = ∓0.5: the world moves the other way.
+        // T± moves the eye at x = ∓½·d·w = ∓0.5 to the origin: translate(±0.5, 0, 0).
         let half = 0.5 * screen.eye_separation_fraction * screen.width;
         let shift = if eye == 0 { half } else { -half };
         let mvp = ex1_stereo::frustum(l, r, b, t, n, f)
