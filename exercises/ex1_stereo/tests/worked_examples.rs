@@ -68,7 +68,7 @@ fn color_anaglyph_keeps_left_red_and_right_green_blue() {
 /// is 9 in front of the screen with a 90° field of view, so the screen spans w = h = 18 there;
 /// the separation 1 is d = 1/18 of the screen width.
 #[test]
-fn seed003_in_the_sheets_terms_projects_to_5_875_left_and_6_125_right() {
+fn stereographics_example_in_the_sheets_terms_projects_to_5_875_and_6_125() {
     let screen = ScreenSetup {
         width: 18.0,
         height: 18.0,

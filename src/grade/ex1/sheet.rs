@@ -62,41 +62,58 @@ fn sheet_reference(s: &ScreenSetup, eye: usize, v: SheetVariant) -> [f64; 6] {
 /// The screens the public cases use: the StereoGraphics guide's worked example in the sheet's
 /// terms (camera 9 in front of the screen, 90° field of view: the screen spans 18 × 18; the
 /// separation 1 is 1/18 of its width), a 16:9 screen a viewer sits 2 from with 6.5 cm eyes,
-/// a small portrait screen, and a wide screen with a far-off near plane.
+/// a small portrait screen, and a wide screen with the near plane halfway to it.
 fn screens() -> Vec<ScreenSetup> {
+    named_screens().into_iter().map(|(_, s)| s).collect()
+}
+
+/// [`screens`] with what each one is, for the case labels.
+fn named_screens() -> Vec<(&'static str, ScreenSetup)> {
     vec![
-        ScreenSetup {
-            width: 18.0,
-            height: 18.0,
-            near: 1.0,
-            far: 100.0,
-            zero_parallax: 9.0,
-            eye_separation_fraction: 1.0 / 18.0,
-        },
-        ScreenSetup {
-            width: 1.6,
-            height: 0.9,
-            near: 0.3,
-            far: 40.0,
-            zero_parallax: 2.0,
-            eye_separation_fraction: 0.065 / 1.6,
-        },
-        ScreenSetup {
-            width: 0.3,
-            height: 0.5,
-            near: 0.1,
-            far: 10.0,
-            zero_parallax: 0.6,
-            eye_separation_fraction: 0.2,
-        },
-        ScreenSetup {
-            width: 4.0,
-            height: 2.0,
-            near: 1.0,
-            far: 50.0,
-            zero_parallax: 2.0,
-            eye_separation_fraction: 0.25,
-        },
+        (
+            "the StereoGraphics guide's example in the sheet's terms",
+            ScreenSetup {
+                width: 18.0,
+                height: 18.0,
+                near: 1.0,
+                far: 100.0,
+                zero_parallax: 9.0,
+                eye_separation_fraction: 1.0 / 18.0,
+            },
+        ),
+        (
+            "a 16:9 screen 2 away, 6.5 cm eyes",
+            ScreenSetup {
+                width: 1.6,
+                height: 0.9,
+                near: 0.3,
+                far: 40.0,
+                zero_parallax: 2.0,
+                eye_separation_fraction: 0.065 / 1.6,
+            },
+        ),
+        (
+            "a small portrait screen",
+            ScreenSetup {
+                width: 0.3,
+                height: 0.5,
+                near: 0.1,
+                far: 10.0,
+                zero_parallax: 0.6,
+                eye_separation_fraction: 0.2,
+            },
+        ),
+        (
+            "a wide screen, near plane halfway to it",
+            ScreenSetup {
+                width: 4.0,
+                height: 2.0,
+                near: 1.0,
+                far: 50.0,
+                zero_parallax: 2.0,
+                eye_separation_fraction: 0.25,
+            },
+        ),
     ]
 }
 
@@ -115,14 +132,14 @@ fn random_screen(rng: &mut SplitMix64) -> ScreenSetup {
 }
 
 pub(super) fn sheet_frustum_task() -> TaskSpec {
-    let inputs: Vec<(ScreenSetup, usize)> = screens()
+    let inputs: Vec<(&str, ScreenSetup, usize)> = named_screens()
         .into_iter()
-        .flat_map(|s| [(s, 0), (s, 1)])
+        .flat_map(|(name, s)| [(name, s, 0), (name, s, 1)])
         .collect();
     let each = |v: SheetVariant| {
         inputs
             .iter()
-            .map(|(s, eye)| flat(&sheet_reference(s, *eye, v)))
+            .map(|(_, s, eye)| flat(&sheet_reference(s, *eye, v)))
             .collect()
     };
     TaskSpec {
@@ -142,8 +159,8 @@ pub(super) fn sheet_frustum_task() -> TaskSpec {
         tolerance: SHEET_TOLERANCE,
         cases: inputs
             .iter()
-            .map(|(s, eye)| Case {
-                label: format!("eye {eye} of {s:?}"),
+            .map(|(name, s, eye)| Case {
+                label: format!("eye {eye}, {name}: {s:?}"),
                 input: json!([s, eye]),
                 expected: flat(&sheet_reference(s, *eye, SheetVariant::default())),
             })
