@@ -63,11 +63,7 @@ fn sheet_reference(s: &ScreenSetup, eye: usize, v: SheetVariant) -> [f64; 6] {
 /// terms (camera 9 in front of the screen, 90° field of view: the screen spans 18 × 18; the
 /// separation 1 is 1/18 of its width), a 16:9 screen a viewer sits 2 from with 6.5 cm eyes,
 /// a small portrait screen, and a wide screen with the near plane halfway to it.
-fn screens() -> Vec<ScreenSetup> {
-    named_screens().into_iter().map(|(_, s)| s).collect()
-}
-
-/// [`screens`] with what each one is, for the case labels.
+/// Each with what it is, for the case labels.
 fn named_screens() -> Vec<(&'static str, ScreenSetup)> {
     vec![
         (
@@ -222,7 +218,7 @@ mod tests {
     fn the_sheets_frustum_of_the_stereographics_example_is_the_field_of_view_one() {
         // Camera 9 from the screen, 90°: t = n·tan(45°) = 1 = ½·18·1/9; the shift (d/2)·n/z0
         // with d = 1 is 1/18 = ½·(1/18)·18·(1/9).
-        let s = &screens()[0];
+        let s = &named_screens()[0].1;
         let left = sheet_reference(s, 0, SheetVariant::default());
         let expected = [-1.0 + 1.0 / 18.0, 1.0 + 1.0 / 18.0, -1.0, 1.0, 1.0, 100.0];
         for (a, e) in left.iter().zip(expected) {
@@ -234,9 +230,9 @@ mod tests {
 
     #[test]
     fn every_public_case_tells_each_slip_from_the_right_answer() {
-        let inputs: Vec<(ScreenSetup, usize)> = screens()
+        let inputs: Vec<(ScreenSetup, usize)> = named_screens()
             .into_iter()
-            .flat_map(|s| [(s, 0), (s, 1)])
+            .flat_map(|(_, s)| [(s, 0), (s, 1)])
             .collect();
         let slips = [
             SheetVariant {
