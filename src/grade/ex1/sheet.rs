@@ -62,8 +62,8 @@ fn sheet_reference(s: &ScreenSetup, eye: usize, v: SheetVariant) -> [f64; 6] {
 /// The screens the public cases use: the StereoGraphics guide's worked example in the sheet's
 /// terms (camera 9 in front of the screen, 90° field of view: the screen spans 18 × 18; the
 /// separation 1 is 1/18 of its width), a 16:9 screen a viewer sits 2 from with 6.5 cm eyes,
-/// a small portrait screen, and a wide screen with the near plane halfway to it.
-/// Each with what it is, for the case labels.
+/// a small portrait screen, and a wide screen with the near plane halfway to it; each named for
+/// the case labels.
 fn named_screens() -> Vec<(&'static str, ScreenSetup)> {
     vec![
         (
