@@ -128,11 +128,11 @@ fn solution_scores_full_marks_on_every_task() {
     for t in tests_of(&v) {
         assert_eq!(t["status"], "passed", "{}: {}", t["name"], t["output"]);
     }
-    // 13 + 5 + 5 points, plus ex1's Dubois bonus point.
-    assert_eq!(v["score"].as_f64(), Some(24.0), "{v}");
+    // 17 + 5 + 5 points, plus ex1's Dubois bonus point.
+    assert_eq!(v["score"].as_f64(), Some(28.0), "{v}");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        stdout.contains("\nPASSED: 24.00 of 23.00 points"),
+        stdout.contains("\nPASSED: 28.00 of 27.00 points"),
         "{stdout}"
     );
 }
@@ -159,7 +159,7 @@ fn untouched_stubs_score_zero_and_the_grader_exits_cleanly_with_the_table() {
         "the points table:\n{stdout}"
     );
     assert!(
-        stdout.contains("NOT PASSED: 0.00 of 23.00 points"),
+        stdout.contains("NOT PASSED: 0.00 of 27.00 points"),
         "{stdout}"
     );
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
@@ -247,7 +247,10 @@ fn swapped_eyes_transposed_anaglyph_opengl_depth_nan_reversed_ramp_full_disparit
             },
             Planted {
                 mutant: "opengl-depth",
-                loses: &[("ex1 remap", "opengl-depth")],
+                loses: &[
+                    ("ex1 remap", "opengl-depth"),
+                    ("ex1 remap_right_to_left", "depends-on"),
+                ],
             },
             Planted {
                 mutant: "nan-parallax",
@@ -321,7 +324,10 @@ fn mv_t_order_one_sided_depth_hue_to_360_and_degrees_lose_all_points_with_their_
             },
             Planted {
                 mutant: "one-sided-depth",
-                loses: &[("ex1 remap", "one-sided-depth")],
+                loses: &[
+                    ("ex1 remap", "one-sided-depth"),
+                    ("ex1 remap_right_to_left", "depends-on"),
+                ],
             },
             Planted {
                 mutant: "full-circle-ramp",
@@ -350,7 +356,10 @@ fn fov_in_degrees_and_never_none_lose_points_and_the_caller_names_the_callee() {
             },
             Planted {
                 mutant: "never-none",
-                loses: &[("ex1 remap", "never-none")],
+                loses: &[
+                    ("ex1 remap", "never-none"),
+                    ("ex1 remap_right_to_left", "depends-on"),
+                ],
             },
         ],
         "mutants_e",
@@ -371,7 +380,10 @@ fn transposed_frustum_fails_stereo_matrices_through_its_dependency_and_no_w_divi
             },
             Planted {
                 mutant: "no-w-divide",
-                loses: &[("ex1 remap", "no-w-divide")],
+                loses: &[
+                    ("ex1 remap", "no-w-divide"),
+                    ("ex1 remap_right_to_left", "depends-on"),
+                ],
             },
         ],
         "mutants_f",
@@ -389,6 +401,50 @@ fn transposed_frustum_fails_stereo_matrices_through_its_dependency_and_no_w_divi
     assert!(
         output.contains("fails because `frustum`, which it calls, fails: fix `frustum` first"),
         "{output}"
+    );
+}
+
+#[test]
+fn the_sheets_frustum_remapping_back_and_the_finalize_pixel_lose_points_with_their_hints() {
+    check_planted(
+        "ex1",
+        &[
+            Planted {
+                mutant: "sheet-unscaled-shift",
+                loses: &[("ex1 sheet_frustum", "missing-near-scale")],
+            },
+            Planted {
+                mutant: "remap-back-same-order",
+                loses: &[("ex1 remap_right_to_left", "matrix-order")],
+            },
+            Planted {
+                mutant: "finalize-transposed",
+                loses: &[("ex1 finalize_pixel", "transposed")],
+            },
+        ],
+        "mutants_g",
+    );
+    check_planted(
+        "ex1",
+        &[
+            Planted {
+                mutant: "sheet-d-not-dw",
+                loses: &[("ex1 sheet_frustum", "d-not-d-times-w")],
+            },
+            Planted {
+                mutant: "finalize-no-clamp",
+                loses: &[("ex1 finalize_pixel", "no-clamp")],
+            },
+        ],
+        "mutants_h",
+    );
+    check_planted(
+        "ex1",
+        &[Planted {
+            mutant: "finalize-swapped-eyes",
+            loses: &[("ex1 finalize_pixel", "swapped-eyes")],
+        }],
+        "mutants_i",
     );
 }
 
@@ -418,15 +474,28 @@ fn hidden_cases_come_from_the_seed_the_solution_passes_them_and_a_mutant_fails_t
         Some("20260412"),
         "hidden_solution",
     );
-    let mut with_hidden = 0;
+    let mut with_hidden = Vec::new();
     for t in tests_of(&v) {
         assert_eq!(t["status"], "passed", "{}: {}", t["name"], t["output"]);
         if let Some((p, n)) = hidden_counts(t) {
             assert!(n > 0 && p == n, "{}: {}", t["name"], t["output"]);
-            with_hidden += 1;
+            with_hidden.push(t["name"].as_str().unwrap_or_default().to_string());
         }
     }
-    assert!(with_hidden >= 6, "hidden cases on too few tasks: {v}");
+    // Every task has hidden cases except the two whose whole input space is public: the four
+    // anaglyph kinds and Dubois' single set of matrices.
+    let without: Vec<&str> = tests_of(&v)
+        .iter()
+        .filter_map(|t| t["name"].as_str())
+        .filter(|n| !n.ends_with(" (hidden cases)"))
+        .map(|n| n.trim_end_matches(" (bonus)"))
+        .filter(|n| !with_hidden.contains(&format!("{n} (hidden cases)")))
+        .collect();
+    assert_eq!(
+        without,
+        ["ex1 anaglyph_matrices", "ex1 dubois_matrices"],
+        "tasks without hidden cases: {with_hidden:?}"
+    );
     let (_, v) = grade_seeded(
         "ex1",
         &["--solution"],
@@ -724,8 +793,9 @@ fn render_exercise_writes_the_solution_next_to_the_reference_on_any_scene() {
         "{stdout}{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    // Four eye renders, four anaglyphs, remap, visibility, parallax colors.
-    assert_eq!(stdout.lines().count(), 11, "{stdout}");
+    // Four eye renders, four anaglyphs, two finalize pictures, remap both ways, visibility,
+    // parallax colors.
+    assert_eq!(stdout.lines().count(), 14, "{stdout}");
     for line in stdout.lines() {
         assert!(
             line.contains("mismatch   0.00%, mean channel difference   0.00"),

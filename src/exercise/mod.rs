@@ -6,8 +6,8 @@
 //! answers live here, in the grader.
 
 pub use exercise_api::{
-    AnaglyphKind, AnaglyphMatrices, Answer, ColorMatrix, EyeView, SirdsGeometry, SirdsSetup,
-    StereoSetup, decode_reply, protocol,
+    AnaglyphKind, AnaglyphMatrices, Answer, ColorMatrix, EyeView, ScreenSetup, SirdsGeometry,
+    SirdsSetup, StereoSetup, decode_reply, protocol,
 };
 
 use crate::effects::anaglyph;

@@ -9,7 +9,7 @@ use serde_json::json;
 
 use super::ex1::flat;
 use super::fixture::Fixture;
-use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
+use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use crate::effects::chromadepth::ChromaDepthSettings;
 use crate::effects::chromadepth::ramp::{Ramp, RampKind, exact, hsv_to_rgb};
 use crate::effects::chromadepth::texgen::{Texgen, auto_range};
@@ -91,7 +91,19 @@ fn ramp_task() -> TaskSpec {
         points: 2.0,
         bonus: false,
         depends_on: &[],
-        hidden: Vec::new(),
+        hidden: hidden_cases("hsv_ramp", 8, |rng, i| {
+            // Mostly inside the ramp, one below and one above it.
+            let t = match i {
+                0 => rng.range(-0.5, -0.01),
+                1 => rng.range(1.01, 1.5),
+                _ => rng.range(0.0, 1.0),
+            };
+            Case {
+                label: format!("hidden: t = {t}"),
+                input: json!(t),
+                expected: flat(&reference_ramp(t)),
+            }
+        }),
         tolerance: Tolerance {
             abs: 1e-5,
             rel: 0.0,
@@ -209,7 +221,15 @@ fn texgen_task(fx: &Fixture) -> TaskSpec {
         points: 2.0,
         bonus: false,
         depends_on: &[],
-        hidden: Vec::new(),
+        hidden: hidden_cases("texgen", 6, |rng, _| {
+            let d1 = rng.range(0.1, 50.0);
+            let d2 = d1 + rng.range(0.1, 100.0);
+            Case {
+                label: format!("hidden: D1 = {d1}, D2 = {d2}"),
+                input: json!([d1, d2]),
+                expected: flat(&reference_texgen(d1, d2)),
+            }
+        }),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 1e-5,
@@ -272,7 +292,19 @@ fn depth_range_task() -> TaskSpec {
         points: 1.0,
         bonus: false,
         depends_on: &[],
-        hidden: Vec::new(),
+        hidden: hidden_cases("depth_range", 6, |rng, _| {
+            let c = [
+                rng.range(-5.0, 5.0),
+                rng.range(-5.0, 5.0),
+                -rng.range(1.0, 100.0),
+            ];
+            let r = rng.range(0.1, 0.9) * -c[2];
+            Case {
+                label: format!("hidden: center {c:?}, radius {r}"),
+                input: json!([c, r]),
+                expected: flat(&range(c, r)),
+            }
+        }),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 1e-6,

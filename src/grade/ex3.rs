@@ -242,7 +242,30 @@ fn link_task(fx: &Fixture) -> TaskSpec {
         points: 3.0,
         bonus: false,
         depends_on: &["disparity_constant_eyes"],
-        hidden: Vec::new(),
+        hidden: hidden_cases("link_row", 6, |rng, _| {
+            // A row of 32 … 64 pixels in flat steps of random nearness (steps are where hidden
+            // surfaces and the row alternation show), a random row and viewing set-up.
+            let n = 32 + (rng.next_u64() % 33) as usize;
+            let mut row = Vec::with_capacity(n);
+            while row.len() < n {
+                let len = 3 + (rng.next_u64() % 12) as usize;
+                let v = rng.range(0.0, 1.0);
+                row.extend(std::iter::repeat_n(v, len.min(n - row.len())));
+            }
+            let y = (rng.next_u64() % 48) as u32;
+            let depth_near = rng.range(10.0, 30.0);
+            let s = SirdsSetup {
+                eye_distance: rng.range(48.0, 80.0),
+                focal_length: rng.range(180.0, 300.0),
+                depth_near,
+                depth_far: depth_near + rng.range(20.0, 60.0),
+            };
+            Case {
+                label: format!("hidden: row {y} of {n} pixels, {s:?}"),
+                input: json!([row, y, s]),
+                expected: flat(&module_links(&row, y, &s, true)),
+            }
+        }),
         tolerance: Tolerance::EXACT,
         cases: inputs
             .iter()

@@ -4,7 +4,7 @@
 use std::process::ExitCode;
 
 use exercise_api::Lighting;
-use exercise_api::{AnaglyphKind, StereoSetup, serve, task};
+use exercise_api::{AnaglyphKind, AnaglyphMatrices, ScreenSetup, StereoSetup, serve, task};
 use glam::{Mat4, Vec2};
 
 fn main() -> ExitCode {
@@ -17,6 +17,9 @@ fn main() -> ExitCode {
             task("stereo_frustum", |(s, eye): (StereoSetup, usize)| {
                 ex1_stereo::stereo_frustum(&s, eye)
             }),
+            task("sheet_frustum", |(s, eye): (ScreenSetup, usize)| {
+                ex1_stereo::sheet_frustum(&s, eye)
+            }),
             task(
                 "stereo_matrices",
                 |(s, mv, eye, lighting): (StereoSetup, [f32; 16], usize, Lighting)| {
@@ -26,11 +29,28 @@ fn main() -> ExitCode {
             task("anaglyph_matrices", |kind: AnaglyphKind| {
                 ex1_stereo::anaglyph_matrices(kind)
             }),
+            task(
+                "finalize_pixel",
+                |(left, right, m): ([f32; 3], [f32; 3], AnaglyphMatrices)| {
+                    ex1_stereo::finalize_pixel(left, right, &m)
+                },
+            ),
             task("dubois_matrices", |(): ()| ex1_stereo::dubois_matrices()),
             task(
                 "remap",
                 |(l, r, uv, depth): ([f32; 16], [f32; 16], [f32; 2], f32)| {
                     ex1_stereo::remap(
+                        Mat4::from_cols_array(&l),
+                        Mat4::from_cols_array(&r),
+                        Vec2::from(uv),
+                        depth,
+                    )
+                },
+            ),
+            task(
+                "remap_right_to_left",
+                |(l, r, uv, depth): ([f32; 16], [f32; 16], [f32; 2], f32)| {
+                    ex1_stereo::remap_right_to_left(
                         Mat4::from_cols_array(&l),
                         Mat4::from_cols_array(&r),
                         Vec2::from(uv),

@@ -3,9 +3,13 @@
 //! `STEREOLAB_MUTANT=name[,name]` plants a known mistake for the grader's mutation tests
 //! (tests/grading.rs): `swapped-eyes`, `toe-in`, `full-separation`, `transposed-anaglyph`,
 //! `opengl-depth`, `hang-parallax`, `nan-parallax`, `transposed-frustum`, `fov-degrees`,
-//! `mv-t-order`, `one-sided-depth`, `no-w-divide`, `never-none`.
+//! `mv-t-order`, `one-sided-depth`, `no-w-divide`, `never-none`, `sheet-unscaled-shift`,
+//! `sheet-d-not-dw`, `remap-back-same-order`, `finalize-transposed`, `finalize-no-clamp`,
+//! `finalize-swapped-eyes`.
 
-use exercise_api::{AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, StereoSetup};
+use exercise_api::{
+    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, ScreenSetup, StereoSetup,
+};
 use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
@@ -67,6 +71,26 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
         -side(eye) * half_separation(setup) * setup.near / setup.zero_parallax
     };
     [-w + shift, w + shift, -t, t, setup.near, setup.far]
+}
+
+/// `[l, r, b, t, n, f]` of `P_frustum±` in the exercise slides' screen-relative terms.
+pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
+    let scale = screen.near / screen.zero_parallax;
+    let t = 0.5 * screen.height * scale;
+    let r = 0.5 * screen.width * scale;
+    // The eye's offset from the center: ½·d·w (½·d with the `sheet-d-not-dw` mistake).
+    let offset = if planted("sheet-d-not-dw") {
+        0.5 * screen.eye_separation_fraction
+    } else {
+        0.5 * screen.eye_separation_fraction * screen.width
+    };
+    let shift = if planted("sheet-unscaled-shift") {
+        offset
+    } else {
+        offset * scale
+    };
+    let shift = if eye == 0 { shift } else { -shift };
+    [-r + shift, r + shift, -t, t, screen.near, screen.far]
 }
 
 /// View and projection of one eye (the exercise slides, per-eye or cyclopic lighting).
@@ -133,6 +157,30 @@ pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
     }
 }
 
+/// The finalize shader's pixel: `clamp(ML·left + MR·right, 0, 1)`.
+pub fn finalize_pixel(left: [f32; 3], right: [f32; 3], m: &AnaglyphMatrices) -> [f32; 3] {
+    let (left, right) = if planted("finalize-swapped-eyes") {
+        (right, left)
+    } else {
+        (left, right)
+    };
+    let (ml, mr) = if planted("finalize-transposed") {
+        (transposed(m.left), transposed(m.right))
+    } else {
+        (m.left, m.right)
+    };
+    std::array::from_fn(|i| {
+        let v = (0..3)
+            .map(|j| ml[i][j] * left[j] + mr[i][j] * right[j])
+            .sum::<f32>();
+        if planted("finalize-no-clamp") {
+            v
+        } else {
+            v.clamp(0.0, 1.0)
+        }
+    })
+}
+
 /// Dubois red-cyan (three.js' CRT-derived numbers).
 pub fn dubois_matrices() -> AnaglyphMatrices {
     AnaglyphMatrices {
@@ -172,6 +220,21 @@ pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) ->
         0.5 * (ndc.z + 1.0)
     };
     Some(Vec3::new(0.5 * (ndc.x + 1.0), 0.5 * (ndc.y + 1.0), depth))
+}
+
+/// The other direction: the right eye's point in the left image, `MVP_l · MVP_r⁻¹` ([`remap`]
+/// with the eyes' roles exchanged).
+pub fn remap_right_to_left(
+    mvp_left: Mat4,
+    mvp_right: Mat4,
+    uv_right: Vec2,
+    depth_right: f32,
+) -> Option<Vec3> {
+    if planted("remap-back-same-order") {
+        remap(mvp_left, mvp_right, uv_right, depth_right)
+    } else {
+        remap(mvp_right, mvp_left, uv_right, depth_right)
+    }
 }
 
 /// The exercise slides' visibility check.

@@ -2,7 +2,7 @@
 //! from, and the conventions; `stereolab grade ex1` scores each function on its own.
 
 use exercise_api::Lighting;
-use exercise_api::{AnaglyphKind, AnaglyphMatrices, EyeView, StereoSetup};
+use exercise_api::{AnaglyphKind, AnaglyphMatrices, EyeView, ScreenSetup, StereoSetup};
 use glam::{Mat4, Vec2, Vec3};
 
 /// Task `frustum` (2 points): the projection matrix `P_frustum(l, r, b, t, n, f)`.
@@ -36,6 +36,27 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
     todo!("frustum bounds of eye {eye:?} for {setup:?}")
 }
 
+/// Task `sheet_frustum` (1 point): the arguments `[l, r, b, t, n, f]` of eye `eye`'s
+/// `P_frustum±` in the exercise slides' own, screen-relative terms.
+///
+/// Source: the exercise slides, "Projection Matrix – View Frustum" and "Projection Matrix Stereo
+/// Case". The screen (width w, height h) stands at the zero-parallax distance z0; the eye
+/// separation d is a fraction of the screen width, so the eyes sit at x = ∓½·d·w. By the
+/// intercept theorem the screen seen from the eye shrinks by n/z0 on the near plane:
+/// - `t = ½·h·n/z0`, `b = −t`;
+/// - the mono `r = ½·w·n/z0`, `l = −r`; each eye's `l` and `r` are translated by
+///   `±½·d·w·n/z0`: the left eye (index 0, at x = −½·d·w) moves them by `+½·d·w·n/z0`, the right
+///   eye (index 1, at x = +½·d·w) by `−½·d·w·n/z0`;
+/// - `n`, `f` unchanged.
+///
+/// (The slides' matching `T±` is the translation by `½·d·w` in x that moves this eye to the
+/// origin: `T_left = translate(+½·d·w, 0, 0)` for the left eye at x = −½·d·w,
+/// `T_right = translate(−½·d·w, 0, 0)`, as in [`stereo_matrices`].)
+pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
+    // TODO: t from h, l and r from w, then shift l and r for this eye; all scaled by n/z0.
+    todo!("frustum bounds of eye {eye:?} for {screen:?}")
+}
+
 /// Task `stereo_matrices` (2 points, image check): eye `eye`'s view and projection, given the
 /// camera's (cyclopean) modelview `modelview`.
 ///
@@ -67,6 +88,20 @@ pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
     todo!("ML and MR of the {kind:?} anaglyph")
 }
 
+/// Task `finalize_pixel` (2 points, image check): one pixel of the finalize shader, the pass
+/// that combines the two eyes' color textures into the anaglyph.
+///
+/// Source: the exercise slides, "Multi Pass Rendering" (a final shader program combining the two
+/// views) and "Anaglyph": `out = clamp(ML · left + MR · right, 0, 1)`, each channel clamped to
+/// [0, 1]. `left` and `right` are the two eyes' colors (R, G, B in [0, 1]) at the same pixel;
+/// `m.left[row][column]` is `ML` written as on the slides (rows are the output R, G, B), so
+/// `out[i] = Σ_j ML[i][j]·left[j] + MR[i][j]·right[j]`. Matrices with negative entries (such
+/// as Dubois') or large ones give values outside [0, 1]: those are clamped.
+pub fn finalize_pixel(left: [f32; 3], right: [f32; 3], m: &AnaglyphMatrices) -> [f32; 3] {
+    // TODO: two matrix-vector products, a sum, a clamp per channel.
+    todo!("finalize left {left:?}, right {right:?} with {m:?}")
+}
+
 /// Bonus task `dubois_matrices` (1 bonus point): Dubois' least-squares red-cyan matrices.
 ///
 /// Source: Eric Dubois (2001), the CRT-derived numbers as in three.js' `AnaglyphEffect.js`
@@ -91,6 +126,28 @@ pub fn dubois_matrices() -> AnaglyphMatrices {
 pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) -> Option<Vec3> {
     // TODO: texture coordinates and depth to NDC, through MVP_r · MVP_l⁻¹, w-divide, back.
     todo!("remap uv {uv_left:?} depth {depth_left:?} with MVP_l {mvp_left:?}, MVP_r {mvp_right:?}")
+}
+
+/// Task `remap_right_to_left` (1 point, image check): the other direction of [`remap`]: where
+/// the surface point seen by the RIGHT eye at texture coordinate `uv_right` with stored depth
+/// `depth_right` appears in the LEFT image.
+///
+/// Source: the exercise slides, "Stereo Rendering – Remapping" (both directions: `p_0` into the
+/// right image and `p_1` into the left one): `clip_l = MVP_l · MVP_r⁻¹ · (x_ndc,r, y_ndc,r,
+/// z_ndc,r, 1)`, then the w-clip and the texture coordinates as in [`remap`]. The arguments
+/// come in the same order as [`remap`]'s (`mvp_left` first). Returns `Some((u, v, depth_left))`
+/// with `depth_left` the point's window depth in [0, 1] as the left eye would store it, or
+/// `None` when `clip_l.w ≤ 0` (behind the left eye).
+pub fn remap_right_to_left(
+    mvp_left: Mat4,
+    mvp_right: Mat4,
+    uv_right: Vec2,
+    depth_right: f32,
+) -> Option<Vec3> {
+    // TODO: the same chain as remap, with the eyes' roles exchanged.
+    todo!(
+        "remap uv {uv_right:?} depth {depth_right:?} from the right eye, MVP_l {mvp_left:?}, MVP_r {mvp_right:?}"
+    )
 }
 
 /// Task `visible` (1 point, image check): is the left eye's surface point also visible to the

@@ -1,7 +1,7 @@
 //! Checks you can run yourself (`cargo test -p ex1_stereo`): the worked examples of the source
 //! documents. They fail until your functions are complete; `stereolab grade ex1` scores more.
 
-use exercise_api::{AnaglyphKind, StereoSetup};
+use exercise_api::{AnaglyphKind, ScreenSetup, StereoSetup};
 use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
@@ -62,4 +62,76 @@ fn color_anaglyph_keeps_left_red_and_right_green_blue() {
     assert_eq!(m.left[0], [1.0, 0.0, 0.0]);
     assert_eq!(m.right[1], [0.0, 1.0, 0.0]);
     assert_eq!(m.right[2], [0.0, 0.0, 1.0]);
+}
+
+/// The StereoGraphics guide's example in the exercise slides' screen-relative terms: the camera
+/// is 9 in front of the screen with a 90° field of view, so the screen spans w = h = 18 there;
+/// the separation 1 is d = 1/18 of the screen width.
+#[test]
+fn stereographics_example_in_the_sheets_terms_projects_to_5_875_and_6_125() {
+    let screen = ScreenSetup {
+        width: 18.0,
+        height: 18.0,
+        near: 1.0,
+        far: 100.0,
+        zero_parallax: 9.0,
+        eye_separation_fraction: 1.0 / 18.0,
+    };
+    let mv = look_at(Vec3::new(0.0, 0.0, 9.0), Vec3::ZERO, Vec3::Y);
+    for (eye, x) in [(0, 5.875), (1, 6.125)] {
+        let [l, r, b, t, n, f] = ex1_stereo::sheet_frustum(&screen, eye);
+        assert!(
+            (t - 1.0).abs() < 1e-6 && (b + 1.0).abs() < 1e-6,
+            "t = ½·h·n/z0 = 1: {t}"
+        );
+        // T± moves the eye at x = ∓½·d·w = ∓0.5 to the origin: translate(±0.5, 0, 0).
+        let half = 0.5 * screen.eye_separation_fraction * screen.width;
+        let shift = if eye == 0 { half } else { -half };
+        let mvp = ex1_stereo::frustum(l, r, b, t, n, f)
+            * Mat4::from_translation(Vec3::new(shift, 0.0, 0.0))
+            * mv;
+        let clip = mvp * Vec3::new(8.0, -5.0, -3.0).extend(1.0);
+        let on_screen = clip.xy() / clip.w * 9.0;
+        assert!(
+            (on_screen.x - x).abs() < 1e-4 && (on_screen.y + 3.75).abs() < 1e-4,
+            "eye {eye}: expected ({x}, -3.75), got {on_screen:?}"
+        );
+    }
+}
+
+#[test]
+fn remapping_to_the_right_and_back_returns_to_the_same_left_pixel() {
+    let (setup, mv) = seed003();
+    let mvp = |eye| {
+        let m = ex1_stereo::stereo_matrices(&setup, mv, eye, Lighting::PerEye);
+        m.projection * m.view
+    };
+    let (l, r) = (mvp(0), mvp(1));
+    let uv = glam::Vec2::new(0.3, 0.6);
+    let there = ex1_stereo::remap(l, r, uv, 0.95).expect("in front of the right eye");
+    let back = ex1_stereo::remap_right_to_left(l, r, there.truncate(), there.z)
+        .expect("in front of the left eye");
+    assert!(
+        (back.truncate() - uv).length() < 1e-4 && (back.z - 0.95).abs() < 1e-4,
+        "{uv:?} at depth 0.95 → {there:?} → {back:?}"
+    );
+}
+
+#[test]
+fn finalize_true_anaglyph_of_white_is_magenta_and_sums_are_clamped() {
+    let m = ex1_stereo::anaglyph_matrices(AnaglyphKind::True);
+    // The luminance weights sum to 1: white in both eyes gives full red and full blue.
+    let out = ex1_stereo::finalize_pixel([1.0; 3], [1.0; 3], &m);
+    assert!(
+        (out[0] - 1.0).abs() < 1e-6 && out[1] == 0.0 && (out[2] - 1.0).abs() < 1e-6,
+        "{out:?}"
+    );
+    let twice = exercise_api::AnaglyphMatrices {
+        left: m.left.map(|row| row.map(|x| 2.0 * x)),
+        right: m.right.map(|row| row.map(|x| -x)),
+    };
+    assert_eq!(
+        ex1_stereo::finalize_pixel([1.0; 3], [1.0; 3], &twice),
+        [1.0, 0.0, 0.0]
+    );
 }

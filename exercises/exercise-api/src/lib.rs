@@ -18,6 +18,6 @@ pub mod types;
 pub use glam;
 pub use protocol::{Answer, Reply, Task, decode_reply, encode_reply, serve, task};
 pub use types::{
-    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, Lighting, SirdsGeometry, SirdsSetup,
-    StereoSetup, look_at,
+    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, Lighting, ScreenSetup, SirdsGeometry,
+    SirdsSetup, StereoSetup, look_at,
 };

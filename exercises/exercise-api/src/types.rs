@@ -60,6 +60,25 @@ pub struct StereoSetup {
     pub zero_parallax: f32,
 }
 
+/// The exercise slides' screen-relative stereo parameters ("Projection Matrix Stereo Case"): the
+/// screen, of width w and height h, stands at the zero-parallax distance z0 in front of the eyes,
+/// and the eye separation d is a fraction of the screen width, so the eyes sit at x = ∓½·d·w.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScreenSetup {
+    /// Screen width w (in the scene's units, at the distance `zero_parallax`).
+    pub width: f32,
+    /// Screen height h (in the scene's units, at the distance `zero_parallax`).
+    pub height: f32,
+    /// Near plane distance n (> 0).
+    pub near: f32,
+    /// Far plane distance f (> n).
+    pub far: f32,
+    /// Zero-parallax (screen) distance z0 (> 0).
+    pub zero_parallax: f32,
+    /// Eye separation d as a fraction of the screen width: the eyes are d·w apart.
+    pub eye_separation_fraction: f32,
+}
+
 /// The two matrices one eye renders with: `projection · view` is its MVP.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EyeView {

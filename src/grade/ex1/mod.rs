@@ -1,15 +1,19 @@
 //! Exercise 1 (the exercise slides): the tasks, their reference answers, known mistakes and image checks.
 //!
-//! One file per task group: `frustum` (mono and stereo frusta), `rig` (the stereo rig's view
-//! and projection matrices), `anaglyph` (anaglyph and Dubois matrices), `remap` (left-to-right
-//! remapping), `visible` (occlusion) and `parallax` (parallax and its color map). This file
-//! holds the task list and the helpers they share.
+//! One file per task group: `frustum` (mono and stereo frusta), `sheet` (the stereo frusta in
+//! the exercise slides' screen-relative terms), `rig` (the stereo rig's view and projection
+//! matrices), `anaglyph` (anaglyph and Dubois matrices), `finalize` (the finalize shader's
+//! anaglyph pixel), `remap` (remapping in both directions), `visible` (occlusion) and
+//! `parallax` (parallax and its color map). This file holds the task list and the helpers they
+//! share.
 
 mod anaglyph;
+mod finalize;
 mod frustum;
 mod parallax;
 mod remap;
 mod rig;
+mod sheet;
 mod visible;
 
 use super::fixture::{Fixture, reference_rig};
@@ -32,10 +36,13 @@ pub(crate) fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
     vec![
         frustum::frustum_task(fx),
         frustum::stereo_frustum_task(fx),
+        sheet::sheet_frustum_task(),
         rig::stereo_matrices_task(fx),
         anaglyph::anaglyph_task(fx),
+        finalize::finalize_task(fx),
         anaglyph::dubois_task(),
         remap::remap_task(fx),
+        remap::remap_right_to_left_task(fx),
         visible::visible_task(fx),
         parallax::parallax_task(),
         parallax::parallax_color_task(fx),
@@ -146,8 +153,13 @@ pub(crate) fn blank(like: &Framebuffer, background: [u8; 4]) -> Framebuffer {
 
 /// Covered pixels of the left view, with their texture coordinate and stored depth.
 fn left_samples(fx: &Fixture) -> Vec<(u32, u32, [f32; 2], f32)> {
+    view_samples(fx, 0)
+}
+
+/// Covered pixels of eye `eye`'s view, with their texture coordinate and stored depth.
+fn view_samples(fx: &Fixture, eye: usize) -> Vec<(u32, u32, [f32; 2], f32)> {
     let (w, h) = fx.size();
-    let left = &fx.views[0];
+    let left = &fx.views[eye];
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .filter_map(|(x, y)| {

@@ -141,7 +141,15 @@ pub(super) fn parallax_color_task(fx: &Fixture) -> TaskSpec {
         points: 1.0,
         bonus: false,
         depends_on: &[],
-        hidden: Vec::new(),
+        hidden: hidden_cases("parallax_color", 6, |rng, _| {
+            let max = rng.range(0.05, 2.0);
+            let p = rng.range(-1.5 * max, 1.5 * max);
+            Case {
+                label: format!("hidden: p = {p}, max = {max}"),
+                input: json!([p, max]),
+                expected: flat(&color_reference(p, max, false)),
+            }
+        }),
         tolerance: Tolerance {
             abs: 1e-6,
             rel: 0.0,

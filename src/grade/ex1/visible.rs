@@ -5,7 +5,9 @@ use serde_json::json;
 use super::remap::{stereolab_remap, texel_of};
 use super::{flat, left_samples};
 use crate::grade::fixture::Fixture;
-use crate::grade::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
+use crate::grade::spec::{
+    Case, ImageCheck, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases,
+};
 
 /// The visibility inputs `(uv_right, remapped, stored, tolerance)` of a left pixel, using the
 /// reference remap and a nearest lookup in the right depth buffer.
@@ -56,6 +58,38 @@ fn visible_reference(i: &VisibleInput, mistake: Option<&str>) -> bool {
 
 /// Occlusion map: left color where visible to the right eye, red where not.
 const HIDDEN_COLOR: [u8; 4] = [230, 40, 40, 255];
+
+/// Hidden visibility cases per seed.
+const HIDDEN_VISIBLE: usize = 10;
+
+/// Hidden case `i`: inside the image or clearly outside it (never on its border; case 3 outside
+/// with agreeing depths, case 9 behind the right eye), depths that agree, differ a little
+/// inside the tolerance, or clearly beyond it in either direction (never on its edge).
+fn hidden_visible(rng: &mut SplitMix64, i: usize) -> VisibleInput {
+    let mut coordinate = |outside: bool| {
+        if outside {
+            let c = rng.range(0.02, 0.3);
+            if rng.next_u64().is_multiple_of(2) {
+                -c
+            } else {
+                1.0 + c
+            }
+        } else {
+            rng.range(0.01, 0.99)
+        }
+    };
+    let outside = i % 5 == 3;
+    let uv = (i % 10 != 9).then(|| [coordinate(outside), coordinate(false)]);
+    let remapped = rng.range(0.2, 0.98);
+    let tol = rng.range(1e-4, 5e-3);
+    let factor = match i % 3 {
+        0 => rng.range(-0.5, 0.5),
+        1 => rng.range(2.0, 20.0),
+        _ => -rng.range(2.0, 20.0),
+    };
+    let stored = (remapped + factor * tol).min(1.0);
+    (uv, remapped, stored, tol)
+}
 
 pub(super) fn visible_task(fx: &Fixture) -> TaskSpec {
     let mut inputs: Vec<(String, VisibleInput)> = vec![
@@ -141,7 +175,14 @@ pub(super) fn visible_task(fx: &Fixture) -> TaskSpec {
         points: 1.0,
         bonus: false,
         depends_on: &[],
-        hidden: Vec::new(),
+        hidden: hidden_cases("visible", HIDDEN_VISIBLE, |rng, i| {
+            let input = hidden_visible(rng, i);
+            Case {
+                label: format!("hidden: {input:?}"),
+                input: json!(input),
+                expected: flat(&visible_reference(&input, None)),
+            }
+        }),
         tolerance: Tolerance::EXACT,
         cases,
         mistakes: vec![
@@ -168,5 +209,28 @@ pub(super) fn visible_task(fx: &Fixture) -> TaskSpec {
             inputs: fixture_inputs.iter().map(|(_, _, i)| json!(i)).collect(),
             build: Box::new(build),
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_seed_s_hidden_cases_catch_each_known_mistake() {
+        for seed in 0..200u64 {
+            let mut rng = SplitMix64::for_task(seed, "visible");
+            let inputs: Vec<VisibleInput> = (0..HIDDEN_VISIBLE)
+                .map(|i| hidden_visible(&mut rng, i))
+                .collect();
+            for m in ["ignores-out-of-frame", "no-tolerance", "one-sided"] {
+                assert!(
+                    inputs
+                        .iter()
+                        .any(|i| visible_reference(i, None) != visible_reference(i, Some(m))),
+                    "seed {seed}: {m} passes every hidden case: {inputs:?}"
+                );
+            }
+        }
     }
 }
