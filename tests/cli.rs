@@ -183,15 +183,15 @@ fn obj_with_missing_material_library_renders_but_an_empty_face_does_not() {
 fn bad_scene_values_name_the_field_and_value() {
     let s = wuson();
     let cases: &[(&[&str], &[&str])] = &[
-        (&["--size", "0x10"], &["image.width = 0"]),
+        (&["--size", "0x10"], &["--size = 0x10", "at least 1 pixel"]),
         (
             &["--size", "100000x100000"],
-            &["image.width = 100000", "at most 16384"],
+            &["--size = 100000", "at most 16384"],
         ),
         (&["--size", "12by7"], &["--size = 12by7"]),
         (
             &["--size", "16000x16000"],
-            &["image size = 16000x16000", "pixels"],
+            &["--size = 16000x16000", "pixels"],
         ),
         (&["--set", "camera.near=0"], &["camera.near = 0"]),
         (&["--set", "camera.far=0.5"], &["camera.far = 0.5"]),
