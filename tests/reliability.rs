@@ -555,3 +555,25 @@ fn misleading_messages_now_name_the_real_problem() {
         );
     }
 }
+
+/// Issue 14 item 11: a GPU run that succeeds printed Mesa's "XDG_RUNTIME_DIR is invalid or not
+/// set" twice when the variable was missing; it now prints nothing on stderr.
+#[cfg(feature = "gpu")]
+#[test]
+fn a_successful_gpu_run_prints_no_errors_without_a_runtime_dir() {
+    let dir = out_dir("reliability-gpu-quiet");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args([
+            "render",
+            &s(&asset("scenes/wuson.toml")),
+            "--backend",
+            "gpu",
+        ])
+        .args(["--size", "64x48", "--out", &s(&dir)])
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .expect("run stereolab");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.trim().is_empty(), "stderr of a successful run: {err}");
+}

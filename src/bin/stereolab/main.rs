@@ -202,7 +202,32 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// Mesa's Vulkan driver complains twice on stderr ("XDG_RUNTIME_DIR is invalid or not set")
+/// when the variable is missing, although the GPU path needs no runtime folder: a run that
+/// succeeds must not print errors. Without a usable one, a private folder of this user's is
+/// named (created 0700 under the temporary folder).
+#[cfg(all(feature = "gpu", unix))]
+fn ensure_runtime_dir() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    let usable = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir());
+    if usable {
+        return;
+    }
+    // SAFETY: getuid has no preconditions.
+    let uid = unsafe { libc::getuid() };
+    let dir = std::env::temp_dir().join(format!("stereolab-runtime-{uid}"));
+    let ours = std::fs::create_dir_all(&dir).is_ok()
+        && std::fs::metadata(&dir).is_ok_and(|m| m.is_dir() && m.uid() == uid)
+        && std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).is_ok();
+    if ours {
+        // SAFETY: called first thing in main, before any other thread exists.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+    }
+}
+
 fn main() -> ExitCode {
+    #[cfg(all(feature = "gpu", unix))]
+    ensure_runtime_dir();
     let cli = Cli::parse();
     let _ = LOAD_OPTIONS.set(stereolab::scene::LoadOptions {
         allow_outside_paths: cli.allow_outside_paths,
