@@ -638,6 +638,18 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
     ] {
         assert!(handout.join(f).is_file(), "{f} missing from the handout");
     }
+    // The documents are named by title, never by the team's file numbers ("seed 003").
+    for f in files_under(&handout) {
+        let in_student_part = !f.starts_with(handout.join("stereolab"));
+        if in_student_part && f.extension().is_some_and(|e| e == "rs" || e == "md") {
+            let text = std::fs::read_to_string(&f).unwrap().to_lowercase();
+            assert!(
+                !text.contains("seed 00") && !text.contains("seed00"),
+                "{} names a source document by its file number",
+                f.display()
+            );
+        }
+    }
     let readme = std::fs::read_to_string(handout.join("README.md")).unwrap();
     for says in [
         "Only `src/stubs.rs` is\n  graded",

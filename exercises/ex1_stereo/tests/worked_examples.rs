@@ -6,7 +6,7 @@ use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
 /// The StereoGraphics guide's §5: camera at (0, 0, 9), 90° fov, separation 1, screen at the xy plane.
-fn seed003() -> (StereoSetup, Mat4) {
+fn stereographics_guide() -> (StereoSetup, Mat4) {
     let setup = StereoSetup {
         fov_y_degrees: 90.0,
         aspect: 1.0,
@@ -22,8 +22,8 @@ fn seed003() -> (StereoSetup, Mat4) {
 }
 
 #[test]
-fn seed003_point_projects_to_5_875_left_and_6_125_right() {
-    let (setup, mv) = seed003();
+fn stereographics_guide_point_projects_to_5_875_left_and_6_125_right() {
+    let (setup, mv) = stereographics_guide();
     for (eye, x) in [(0, 5.875), (1, 6.125)] {
         let m = ex1_stereo::stereo_matrices(&setup, mv, eye, Lighting::PerEye);
         let clip = m.projection * m.view * Vec3::new(8.0, -5.0, -3.0).extend(1.0);
@@ -101,7 +101,7 @@ fn stereographics_example_in_the_sheets_terms_projects_to_5_875_and_6_125() {
 
 #[test]
 fn remapping_to_the_right_and_back_returns_to_the_same_left_pixel() {
-    let (setup, mv) = seed003();
+    let (setup, mv) = stereographics_guide();
     let mvp = |eye| {
         let m = ex1_stereo::stereo_matrices(&setup, mv, eye, Lighting::PerEye);
         m.projection * m.view
