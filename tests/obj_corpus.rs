@@ -3,7 +3,8 @@
 //! with its `3.1+e2`, are refused with the reason. The concave 64-gon (a thin ring: an outline
 //! and a hole joined by a bridge edge) renders covering exactly its outline with back faces
 //! culled: a fan's triangles would cover the hole and leave parts of the ring out, as some
-//! of them face backwards.
+//! of them face backwards. Every model that loads renders, framed from its bounding box, to
+//! the same bytes twice.
 
 use std::path::{Path, PathBuf};
 
@@ -79,6 +80,77 @@ fn every_assimp_obj_model_loads_or_is_refused_with_the_reason() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// A scene in `dir` looking at `model` (copied there) from `eye` towards `target`.
+fn scene_for(
+    dir: &Path,
+    model: &Path,
+    eye: Vec3,
+    target: Vec3,
+    size: (u32, u32),
+    cull: bool,
+) -> Scene {
+    let name = model.file_name().unwrap().to_string_lossy().into_owned();
+    std::fs::copy(model, dir.join(&name)).unwrap();
+    let scene_path = dir.join(format!("{name}.toml"));
+    let toml = format!(
+        "outputs = [\"left\"]\n[image]\nwidth = {}\nheight = {}\n[camera]\n\
+         eye = [{}, {}, {}]\ntarget = [{}, {}, {}]\nfov_y = 40.0\nnear = {}\nfar = {}\n\
+         [raster]\ncull_back = {cull}\n\
+         [[mesh]]\nkind = \"obj\"\npath = \"{name}\"\n",
+        size.0,
+        size.1,
+        eye.x,
+        eye.y,
+        eye.z,
+        target.x,
+        target.y,
+        target.z,
+        eye.distance(target) / 10.0,
+        eye.distance(target) * 10.0,
+    );
+    std::fs::write(&scene_path, toml).unwrap();
+    Scene::load(&scene_path, &[]).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+#[test]
+fn every_loadable_assimp_model_renders_the_same_bytes_twice() {
+    let dir = out_dir("obj_corpus_all");
+    let mut names = Vec::new();
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(corpus())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let Ok(mesh) = load_obj(&path) else { continue };
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        // Framed automatically: from the bounding box's corner direction, far enough for all.
+        let (lo, hi) = mesh
+            .positions
+            .iter()
+            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            });
+        let center = (lo + hi) / 2.0;
+        let eye =
+            center + Vec3::new(0.6, 0.5, 1.0).normalize() * 2.0 * (hi - lo).length().max(1e-3);
+        let scene = scene_for(&dir, &path, eye, center, (64, 48), false);
+        let plan = Plan::new(&scene.outputs);
+        let a = render(&scene, &plan).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let b = render(&scene, &plan).unwrap();
+        let (fa, fb) = (a.view(View::Left).unwrap(), b.view(View::Left).unwrap());
+        assert!(
+            fa.color == fb.color && fa.depth == fb.depth,
+            "{name}: two renders differ"
+        );
+        let drawn = fa.depth.iter().filter(|&&d| d < 1.0).count();
+        assert!(drawn > 0, "{name}: nothing drawn (framing is off)");
+        names.push(name);
+    }
+    assert_eq!(names.len(), 19, "the models that load: {names:?}");
+}
+
 /// Even-odd point-in-polygon; a bridge edge walked both ways cancels itself.
 fn inside(p: (f32, f32), poly: &[(f32, f32)]) -> bool {
     let mut inside = false;
@@ -138,17 +210,7 @@ fn the_concave_64_gon_renders_as_exactly_its_outline_facing_forward() {
     let eye = center + normal * 1.45 * (hi - lo).max_element();
     let (w, h) = (320, 240);
     let dir = out_dir("obj_corpus_concave");
-    std::fs::copy(&model, dir.join("concave_polygon.obj")).unwrap();
-    let scene_path = dir.join("concave.toml");
-    let toml = format!(
-        "outputs = [\"left\"]\n[image]\nwidth = {w}\nheight = {h}\n[camera]\n\
-         eye = [{}, {}, {}]\ntarget = [{}, {}, {}]\nfov_y = 40.0\nnear = 0.5\nfar = 20\n\
-         [raster]\ncull_back = true\n\
-         [[mesh]]\nkind = \"obj\"\npath = \"concave_polygon.obj\"\n",
-        eye.x, eye.y, eye.z, center.x, center.y, center.z
-    );
-    std::fs::write(&scene_path, toml).unwrap();
-    let scene = Scene::load(&scene_path, &[]).expect("the scene loads");
+    let scene = scene_for(&dir, &model, eye, center, (w, h), true);
     let frame = render(&scene, &Plan::new(&scene.outputs)).expect("it renders");
     let fb = frame.view(View::Left).expect("the left view");
     let mvp = frame.matrices(View::Left).mvp;
