@@ -13,9 +13,11 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
-/// Concave faces with more corners than this are fanned: ear clipping is O(n²) here (each ear
-/// test scans the remaining corners), and the simplicity check is O(n²) too.
-pub const MAX_EAR_CLIP_CORNERS: usize = 4096;
+/// Concave faces with more corners than this are fanned. Each ear test scans the remaining
+/// corners and the simplicity check compares every pair of edges, so the work grows at least
+/// as n²: a 1024-corner concave star takes 5–9 ms (4096 corners: about 130 ms) in the test
+/// profile. (A hostile file made only of such faces costs about 1–2 ms per KB of face text.)
+pub const MAX_EAR_CLIP_CORNERS: usize = 1024;
 
 /// Triangles of the polygon `corners` (in order), as index triples into `corners`, with the
 /// polygon's winding. Fewer than 3 corners give no triangles.
@@ -286,6 +288,27 @@ mod tests {
             Vec3::new(0.0, 3.0, 0.0),
         ];
         assert_eq!(triangulate(&bowtie), fan(4));
+    }
+
+    #[test]
+    fn concave_faces_above_the_bound_are_fanned() {
+        // A star whose corners alternate between two radii: concave, and the fan from corner 0
+        // is not what ear clipping gives.
+        let star = |n: usize| -> Vec<Vec3> {
+            (0..n)
+                .map(|i| {
+                    let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                    let r = if i % 2 == 0 { 1.0 } else { 0.5 };
+                    Vec3::new(r * a.cos(), r * a.sin(), 0.0)
+                })
+                .collect()
+        };
+        assert_ne!(
+            triangulate(&star(MAX_EAR_CLIP_CORNERS)),
+            fan(MAX_EAR_CLIP_CORNERS)
+        );
+        let n = MAX_EAR_CLIP_CORNERS + 2;
+        assert_eq!(triangulate(&star(n)), fan(n));
     }
 
     /// Whether `p` is strictly inside the counter-clockwise triangle `abc`.
