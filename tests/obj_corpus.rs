@@ -189,7 +189,14 @@ fn face_corners(path: &Path) -> Vec<Vec3> {
 
 #[test]
 fn the_concave_64_gon_renders_as_exactly_its_outline_facing_forward() {
-    let model = corpus().join("concave_polygon.obj");
+    // The same face in both files; the second names a material with spaces.
+    for name in ["concave_polygon.obj", "space_in_material_name.obj"] {
+        concave_64_gon_renders_as_its_outline(name);
+    }
+}
+
+fn concave_64_gon_renders_as_its_outline(name: &str) {
+    let model = corpus().join(name);
     let corners = face_corners(&model);
     assert_eq!(
         corners.len(),
@@ -209,7 +216,7 @@ fn the_concave_64_gon_renders_as_exactly_its_outline_facing_forward() {
     let center = (lo + hi) / 2.0;
     let eye = center + normal * 1.45 * (hi - lo).max_element();
     let (w, h) = (320, 240);
-    let dir = out_dir("obj_corpus_concave");
+    let dir = out_dir(&format!("obj_corpus_{name}"));
     let scene = scene_for(&dir, &model, eye, center, (w, h), true);
     let frame = render(&scene, &Plan::new(&scene.outputs)).expect("it renders");
     let fb = frame.view(View::Left).expect("the left view");
@@ -249,11 +256,11 @@ fn the_concave_64_gon_renders_as_exactly_its_outline_facing_forward() {
     img.save(dir.join("left.png")).unwrap(); // to look at when this fails
     assert!(
         covered > 1000,
-        "the face covers {covered} pixels: framing is off"
+        "{name}: the face covers {covered} pixels: framing is off"
     );
     assert!(
         wrong.is_empty(),
-        "{} pixels away from the outline disagree with it (col, row, drawn): {:?}",
+        "{name}: {} pixels away from the outline disagree with it (col, row, drawn): {:?}",
         wrong.len(),
         &wrong[..wrong.len().min(20)]
     );
