@@ -21,6 +21,7 @@ mod grading;
 mod grading_batch;
 mod grading_trust;
 mod layout;
+mod obj_corpus;
 mod reliability;
 mod rig;
 mod scene_hashes;

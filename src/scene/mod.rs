@@ -3,6 +3,7 @@
 mod file;
 mod mesh;
 mod obj;
+mod polygon;
 pub mod terrain;
 pub mod terrain_data;
 
