@@ -351,6 +351,22 @@ pub fn excerpt(text: &str) -> String {
     out
 }
 
+/// [`read_input`] of a UTF-8 text file, without its byte-order mark ([`without_bom`]).
+///
+/// # Errors
+/// As [`read_input`], and `Parse` naming the first byte that is not UTF-8.
+pub fn read_text(path: &Path, max_bytes: u64) -> Result<String> {
+    let bytes = read_input(path, max_bytes)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        Error::parse(
+            path,
+            None,
+            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        )
+    })?;
+    Ok(without_bom(text))
+}
+
 /// `text` without a leading byte-order mark (U+FEFF), which Windows editors write at the start
 /// of UTF-8 files and which would otherwise become part of the first word.
 pub fn without_bom(text: String) -> String {

@@ -163,7 +163,7 @@ pub(crate) fn submission_binary(
     work: &Path,
 ) -> std::result::Result<PathBuf, String> {
     let path = stubs_path(dir, ex, solution);
-    let stubs = crate::files::read_input(&path, build::MAX_STUBS_BYTES).map_err(|e| {
+    let stubs = crate::files::read_text(&path, build::MAX_STUBS_BYTES).map_err(|e| {
         if solution && !path.exists() {
             format!(
                 "no {} here: the instructor's solution is not part of a handout ({e})",
@@ -173,8 +173,6 @@ pub(crate) fn submission_binary(
             format!("the submission's {}: {e}", path.display())
         }
     })?;
-    let stubs =
-        String::from_utf8(stubs).map_err(|_| format!("{} is not UTF-8 text", path.display()))?;
     let sources = build::Sources::new(ex, stubs)?;
     build::build(ex, &sources, work)
 }

@@ -120,15 +120,7 @@ impl Scene {
     /// # Errors
     /// As [`Scene::load`].
     pub fn load_with(path: &Path, sets: &[String], opts: &LoadOptions) -> Result<Scene> {
-        let bytes = crate::files::read_input(path, MAX_SCENE_BYTES)?;
-        let text = String::from_utf8(bytes).map_err(|e| {
-            Error::parse(
-                path,
-                None,
-                format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-            )
-        })?;
-        let text = crate::files::without_bom(text);
+        let text = crate::files::read_text(path, MAX_SCENE_BYTES)?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Scene::from_toml_with(&text, path, &opts.root(&base), sets, opts.max_triangles)
     }

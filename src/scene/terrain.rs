@@ -62,15 +62,7 @@ pub fn load_terrain_csv(path: &Path) -> Result<Terrain> {
 /// # Errors
 /// As [`load_terrain_csv`], and `Invalid` naming the point count and the budget.
 pub fn load_terrain_csv_within(path: &Path, max_triangles: u64) -> Result<Terrain> {
-    let bytes = crate::files::read_input(path, MAX_CSV_BYTES)?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        Error::parse(
-            path,
-            None,
-            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-        )
-    })?;
-    let text = crate::files::without_bom(text);
+    let text = crate::files::read_text(path, MAX_CSV_BYTES)?;
     let points = parse_csv(path, &text)?;
     drop(text);
     let most = 2 * points.len() as u64;
