@@ -137,16 +137,11 @@ pub enum CameraMode {
     Parallel,
 }
 
-/// Which modelview the shading sees (the exercise slides' "Effect on lighting").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum Lighting {
-    /// `MV± = T±·MV`, `MVP± = P_frustum±·MV±`: each eye lights from its own position.
-    #[default]
-    PerEye,
-    /// `P± = P_frustum±·T±`, `MVP± = P±·MV`: both eyes shade as the cyclopean eye does.
-    Cyclopic,
-}
+/// Which modelview the shading sees (the exercise slides' "Effect on lighting"): per-eye
+/// (`MV± = T±·MV`, each eye lights from its own position) or cyclopic (`P± = P_frustum±·T±`,
+/// both eyes shade as the cyclopean eye does). One type with the exercises, whose crate defines
+/// it (a student's crate cannot depend on stereolab).
+pub use exercise_api::Lighting;
 
 /// Eye separation: an absolute distance or the StereoGraphics guide's automatic rule.
 #[derive(Clone, Copy, Debug, PartialEq)]
