@@ -38,6 +38,8 @@ const KEPT_OUTPUT: usize = 8 << 10;
 /// The longest answer line read (a longer one is a broken answer, not a reason to run out of
 /// memory in the grader).
 const MAX_ANSWER_LINE: u64 = 16 << 20;
+/// How long the grader waits for a task's output pipes to end after its processes are killed.
+const DRAIN_WAIT: Duration = Duration::from_millis(500);
 /// The largest file the task may write (in its scratch folder).
 const MAX_FILE_BYTES: u64 = 16 << 20;
 
@@ -69,14 +71,18 @@ pub struct Run {
 /// A pipe drained on a thread, keeping the first [`KEPT_OUTPUT`] bytes.
 struct Drain {
     kept: Arc<Mutex<(Vec<u8>, u64)>>,
+    /// Closed (its sender dropped) when the pipe reached its end.
+    ended: mpsc::Receiver<()>,
 }
 
 impl Drain {
     fn start(source: Option<impl Read + Send + 'static>) -> Drain {
         let kept = Arc::new(Mutex::new((Vec::new(), 0u64)));
+        let (end, ended) = mpsc::channel::<()>();
         if let Some(mut source) = source {
             let k = Arc::clone(&kept);
             std::thread::spawn(move || {
+                let _end = end; // dropped when the pipe ends
                 let mut buf = [0u8; 8192];
                 while let Ok(n) = source.read(&mut buf) {
                     if n == 0 {
@@ -89,10 +95,13 @@ impl Drain {
                 }
             });
         }
-        Drain { kept }
+        Drain { kept, ended }
     }
 
-    fn take(&self) -> (String, u64) {
+    /// What the pipe carried, once it ended, or after `wait` if something still holds it open
+    /// (a process that escaped the task's group).
+    fn take(&self, wait: Duration) -> (String, u64) {
+        let _ = self.ended.recv_timeout(wait);
         let g = self.kept.lock().unwrap_or_else(|e| e.into_inner());
         (String::from_utf8_lossy(&g.0).into_owned(), g.1)
     }
@@ -206,10 +215,9 @@ pub fn run(binary: &Path, task: &str, inputs: &[Value], limits: Limits) -> Run {
     let status = status.or_else(|| child.wait().ok());
     untrack(pid);
     reap_orphans();
-    // What the drains hold by now (a grandchild that escaped the group may hold the pipes).
-    std::thread::sleep(Duration::from_millis(20));
-    run.stdout = out.take();
-    run.stderr = err.take();
+    // Everything the task printed: the pipes end now that its processes are gone.
+    run.stdout = out.take(DRAIN_WAIT);
+    run.stderr = err.take(DRAIN_WAIT);
     run.ending = if timed_out {
         Some(Ending {
             kind: "timeout",
