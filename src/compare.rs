@@ -82,6 +82,37 @@ pub fn compare(expected: &Framebuffer, actual: &Framebuffer) -> Result<Metrics> 
     Ok(m)
 }
 
+/// Depth bit for bit: of the pixels both framebuffers cover, how many hold the very same `f32`
+/// (same bits) in both, and how many there are: `(identical, both_covered)`. Depth that is
+/// equal only to within a tolerance decides coplanar overlaps differently, so parity of
+/// decals and coincident faces needs this count, not [`Metrics::max_depth_diff`].
+///
+/// # Errors
+/// Different sizes.
+pub fn depth_bits_identical(
+    expected: &Framebuffer,
+    actual: &Framebuffer,
+) -> Result<(usize, usize)> {
+    if (expected.width, expected.height) != (actual.width, actual.height) {
+        return Err(Error::invalid(
+            "compare",
+            format!(
+                "{}x{} vs {}x{}",
+                expected.width, expected.height, actual.width, actual.height
+            ),
+            "images must have the same size",
+        ));
+    }
+    let (mut same, mut both) = (0, 0);
+    for (e, a) in expected.depth.iter().zip(&actual.depth) {
+        if *e < 1.0 && *a < 1.0 {
+            both += 1;
+            same += usize::from(e.to_bits() == a.to_bits());
+        }
+    }
+    Ok((same, both))
+}
+
 /// Coverage of each pixel: depth < 1 (something was drawn).
 pub fn coverage(fb: &Framebuffer) -> Vec<bool> {
     fb.depth.iter().map(|d| *d < 1.0).collect()

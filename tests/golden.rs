@@ -8,7 +8,9 @@ use stereolab::scene::Scene;
 
 use crate::common::{asset, failure_dir};
 
-fn check_golden(name: &str, actual: &Framebuffer) {
+/// Compares `actual`'s colours with `assets/golden/NAME.png` byte for byte (or writes it with
+/// `UPDATE_GOLDENS=1`).
+pub(crate) fn check_golden(name: &str, actual: &Framebuffer) {
     let path = asset(&format!("golden/{name}.png"));
     if std::env::var_os("UPDATE_GOLDENS").is_some() {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();

@@ -3,7 +3,9 @@
 
 use std::path::Path;
 
-use crate::compare::{Comparison, compare, framebuffer_from_image, write_diff_strip};
+use crate::compare::{
+    Comparison, compare, depth_bits_identical, framebuffer_from_image, write_diff_strip,
+};
 use crate::effects::anaglyph;
 use crate::effects::occlusion::occlusion_image;
 use crate::effects::parallax::parallax_image;
@@ -44,6 +46,21 @@ pub fn compare_scene(
     rows.extend(compare_finalize(r, &cpu, scene, out)?);
     rows.extend(super::sirds_frame::compare_strips(r, &cpu, scene, out)?);
     Ok(rows)
+}
+
+/// Depth bit for bit over every pass of two frames of the same plan:
+/// `(identical, both_covered)` summed as [`depth_bits_identical`] counts them per pass.
+///
+/// # Errors
+/// Passes of different sizes.
+pub fn depth_identity(expected: &Frame, actual: &Frame) -> Result<(usize, usize)> {
+    let (mut same, mut both) = (0, 0);
+    for (e, a) in expected.passes.iter().zip(&actual.passes) {
+        let (s, b) = depth_bits_identical(&e.framebuffer, &a.framebuffer)?;
+        same += s;
+        both += b;
+    }
+    Ok((same, both))
 }
 
 /// Finalize parity apart from raster parity: every finalize output of the plan (anaglyphs,

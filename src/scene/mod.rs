@@ -9,7 +9,7 @@ pub mod terrain_data;
 
 pub(crate) use file::SceneFile;
 pub use mesh::Mesh;
-pub use obj::{load_obj, parse_obj};
+pub use obj::{load_obj, load_obj_with_notes, parse_obj, parse_obj_with_notes};
 
 use std::path::Path;
 
@@ -68,6 +68,10 @@ pub struct Scene {
     pub finalize: AnaglyphOptions,
     /// Autostereogram options (`[sirds]`).
     pub sirds: crate::effects::sirds::Settings,
+    /// What loading read in an unusual way and accepted, each naming its file and line (an
+    /// OBJ coordinate such as `3.1+e2`, read as assimp reads it); `stereolab render` prints
+    /// them.
+    pub notes: Vec<String>,
 }
 
 /// The largest scene file accepted (a scene is a few kilobytes of TOML; models and terrain are
@@ -228,11 +232,12 @@ impl Scene {
             ));
         }
         f.chromadepth.validate()?;
+        let mut notes = Vec::new();
         let objects = f
             .meshes
             .iter()
             .enumerate()
-            .map(|(i, m)| load_object(i, m, root, max_triangles))
+            .map(|(i, m)| load_object(i, m, root, max_triangles, &mut notes))
             .collect::<Result<Vec<_>>>()?;
         let triangles: u64 = objects.iter().map(|o| o.mesh.triangles.len() as u64).sum();
         if triangles > max_triangles {
@@ -258,6 +263,7 @@ impl Scene {
                 swap_eyes: f.finalize.swap_eyes,
             },
             sirds: crate::effects::sirds::Settings::from_spec(&f.sirds, root)?,
+            notes,
         })
     }
 
@@ -331,6 +337,7 @@ fn load_object(
     m: &file::MeshSpec,
     root: &InputRoot,
     max_triangles: u64,
+    notes: &mut Vec<String>,
 ) -> Result<Object> {
     let field = |f: &str| format!("mesh[{i}].{f}");
     let positive = |name: &str, v: Option<f32>, default: f32| -> Result<f32> {
@@ -376,7 +383,9 @@ fn load_object(
             let p = m.path.as_ref().ok_or_else(|| {
                 Error::invalid(field("path"), "missing", "an obj mesh needs a path")
             })?;
-            load_obj(&root.resolve(&field("path"), p)?)?
+            let (mesh, obj_notes) = load_obj_with_notes(&root.resolve(&field("path"), p)?)?;
+            notes.extend(obj_notes);
+            mesh
         }
         "sphere" => Mesh::sphere(positive("size", m.size, 1.0)?, detail, detail / 2),
         "cube" => Mesh::cube(positive("size", m.size, 1.0)?),

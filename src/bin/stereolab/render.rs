@@ -101,6 +101,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
         Backend::Gpu => render_gpu(&s, &plan, &out)?,
     };
     outln!("rendered {} ({}x{})", scene.display(), s.width, s.height);
+    for note in &s.notes {
+        outln!("  note: {note}");
+    }
     if backend == Backend::Gpu {
         let ms = frame
             .passes
