@@ -25,6 +25,8 @@ fn setup(v: Tri, bits: u32) -> Option<SetupTriangle> {
         y,
         z: 0.5,
         inv_w: 1.0,
+        depth_x: x,
+        depth_y: y,
     });
     let opts = RasterOptions {
         subpixel_bits: bits,

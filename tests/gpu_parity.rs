@@ -189,9 +189,10 @@ fn assert_same_coverage(name: &str, cpu: &Framebuffer, gpu: &Framebuffer) {
 /// difference is a rounding at a .5 boundary after pow/sqrt/rcp that llvmpipe computes with
 /// different precision than libm (docs/gpu-parity.md), never more than one step.
 const GRID_MAX_CHANNEL_DIFF: u8 = 1;
-/// Depth where both cover: the target of issue 6. Measured here: 9.6e-7 on the real model,
-/// 4.3e-7 on the clipped scene, up to 3.8e-6 on grid scenes whose triangles are no steeper
-/// than 1.6 depth units per pixel.
+/// Depth where both cover: the target of issue 6. Measured here before issue 20: 9.6e-7 on
+/// the real model, 4.3e-7 on the clipped scene, up to 3.8e-6 on grid scenes whose triangles
+/// are no steeper than 1.6 depth units per pixel; since the CPU evaluates depth as llvmpipe
+/// does, 0 on the real model (bit-identical) and a difference only on clipped triangles.
 const MAX_DEPTH_DIFF: f32 = 1e-5;
 /// Depth error per unit of depth slope, in pixels: both paths evaluate a float depth plane,
 /// from different reference points, so the difference is the slope times a position error of
@@ -336,6 +337,16 @@ const CHROMADEPTH_MEAN_CHANNEL_DIFF: f64 = 0.002;
 /// See [`CHROMADEPTH_MEAN_CHANNEL_DIFF`].
 const CHROMADEPTH_MIN_PSNR: f64 = 55.0;
 
+/// The occlusion map's WGSL mirror on the CPU's own eyes (`compare_finalize`). Measured on
+/// anaglyph.toml at 1024×768: identical until the depth plane followed llvmpipe (issue 20);
+/// since then one pixel of 2 × 786 432 gets another class (max 118, mean 0.00006, PSNR 71 dB):
+/// its remapped depth lies within rounding of the visibility tolerance, where the WGSL's f32
+/// arithmetic and the CPU's part-f64 arithmetic decide differently. Bounds with room for a
+/// few more such pixels.
+const OCCLUSION_WGSL_MEAN_CHANNEL_DIFF: f64 = 0.001;
+/// See [`OCCLUSION_WGSL_MEAN_CHANNEL_DIFF`].
+const OCCLUSION_WGSL_MIN_PSNR: f64 = 60.0;
+
 /// The center pass of a ChromaDepth scene and the outputs made from it.
 fn is_chromadepth(row: &str) -> bool {
     row == "center pass" || row.starts_with("chromadepth")
@@ -386,6 +397,20 @@ fn shipped_scenes_match_coverage_depth_and_color() {
                 );
                 continue;
             }
+            if row.name == "occlusion (wgsl)" {
+                // A class, not a shade: one pixel at a tolerance boundary flips (see
+                // `OCCLUSION_WGSL_MEAN_CHANNEL_DIFF`), so the mean and PSNR are bounded.
+                assert!(
+                    m.mean_channel_diff <= OCCLUSION_WGSL_MEAN_CHANNEL_DIFF
+                        && m.psnr >= OCCLUSION_WGSL_MIN_PSNR,
+                    "{}: {}: mean {} PSNR {}",
+                    path.display(),
+                    row.name,
+                    m.mean_channel_diff,
+                    m.psnr
+                );
+                continue;
+            }
             assert!(
                 m.max_channel_diff <= SHIPPED_MAX_CHANNEL_DIFF,
                 "{}: {}: max channel difference {}",
@@ -408,7 +433,8 @@ fn shipped_scenes_match_coverage_depth_and_color() {
 
 /// Share of the pixels both paths cover whose depth is the same `f32` on both, over every pass
 /// of every shipped scene (issue 20's target: 99%). Measured figures: docs/gpu-parity.md.
-const SHIPPED_DEPTH_IDENTICAL_PERCENT: f64 = 0.0;
+/// Measured: 99.10% (38.67% before issue 20).
+const SHIPPED_DEPTH_IDENTICAL_PERCENT: f64 = 99.0;
 
 #[test]
 fn shipped_scenes_have_bit_identical_depth_where_both_cover() {
@@ -422,8 +448,10 @@ fn shipped_scenes_have_bit_identical_depth_where_both_cover() {
             .render(&GpuScene::upload(r, &scene).expect("upload"), &plan)
             .expect("GPU render");
         let (s, b) = depth_identity(&cpu, &gpu).expect("same sizes");
+        let clipped: usize = cpu.passes.iter().map(|p| p.stats.clipped).sum();
         eprintln!(
-            "{}: depth bit-identical on {s} of {b} pixels both cover ({:.2}%)",
+            "{}: depth bit-identical on {s} of {b} pixels both cover ({:.2}%); \
+             {clipped} triangles clipped",
             path.display(),
             100.0 * s as f64 / b.max(1) as f64
         );
@@ -434,6 +462,94 @@ fn shipped_scenes_have_bit_identical_depth_where_both_cover() {
     assert!(
         share >= SHIPPED_DEPTH_IDENTICAL_PERCENT,
         "depth bit-identical on {share:.2}% < {SHIPPED_DEPTH_IDENTICAL_PERCENT}%"
+    );
+}
+
+/// Coincident coplanar faces: a tilted quad (two triangles, drawn first) and, in the very same
+/// plane, 40 triangles with other vertices (drawn second), seen in perspective. Where both
+/// cover a pixel their depths agree to within rounding, and LESS lets the second object win
+/// only where its rounded depth is strictly smaller: the winner is decided by the last bits.
+/// Both paths must pick the same winner on every pixel (colours differ by at most the usual
+/// rounding step, never by the two objects' difference).
+#[test]
+fn coincident_coplanar_triangles_have_the_same_winner_on_both_paths() {
+    let Some(r) = gpu() else { return };
+    let text = "outputs = [\"left\"]\n[image]\nwidth = 200\nheight = 150\n\
+                [camera]\neye = [0.7, 0.9, 3.1]\ntarget = [0.05, -0.03, 0]\nnear = 0.5\nfar = 20\n\
+                [[mesh]]\nkind = \"cube\"\n";
+    let mut scene = Scene::from_toml(text, Path::new("coplanar.toml"), Path::new("."), &[])
+        .expect("built-in scene parses");
+    // The plane z = 0.31·x − 0.17·y + 0.05 (object space).
+    let on_plane = |x: f32, y: f32| Vec3::new(x, y, 0.31 * x - 0.17 * y + 0.05);
+    let mut quad = Mesh::default();
+    for (x, y) in [(-1.1, -1.0), (1.05, -1.0), (1.1, 1.02), (-1.0, 1.0)] {
+        quad.positions.push(on_plane(x, y));
+    }
+    quad.triangles = vec![[0, 1, 2], [0, 2, 3]];
+    let mut rng = Rng(0x5eed_c0ff_ee11);
+    let mut decal = Mesh::default();
+    for _ in 0..40 {
+        let base = decal.positions.len() as u32;
+        for _ in 0..3 {
+            decal
+                .positions
+                .push(on_plane(rng.range(-0.9, 0.9), rng.range(-0.9, 0.9)));
+        }
+        decal.triangles.push([base, base + 1, base + 2]);
+    }
+    let object = |name: &str, mut mesh: Mesh, color: Vec3| {
+        mesh.compute_normals();
+        mesh.uvs = vec![glam::Vec2::ZERO; mesh.positions.len()];
+        Object {
+            name: name.into(),
+            mesh,
+            model: Mat4::IDENTITY,
+            color,
+        }
+    };
+    scene.objects = vec![
+        object("quad", quad, Vec3::new(0.9, 0.2, 0.1)),
+        object("decal", decal, Vec3::new(0.1, 0.3, 0.9)),
+    ];
+    let plan = Plan::new(&scene.outputs);
+    let cpu = stereolab::render::render(&scene, &plan).expect("CPU render");
+    let gpu = r
+        .render(&GpuScene::upload(r, &scene).expect("upload"), &plan)
+        .expect("GPU render");
+    let (c, g) = (&cpu.passes[0].framebuffer, &gpu.passes[0].framebuffer);
+    assert_same_coverage("gpu_coplanar", c, g);
+    // Who won each pixel, from its colour: the quad is red, the decal blue.
+    let winner = |p: [u8; 4]| p[0] > p[2];
+    let (mut quad_wins, mut decal_wins, mut differ) = (0, 0, Vec::new());
+    for (i, (a, b)) in c.color.iter().zip(&g.color).enumerate() {
+        if c.depth[i] >= 1.0 {
+            continue;
+        }
+        if winner(*a) {
+            quad_wins += 1;
+        } else {
+            decal_wins += 1;
+        }
+        if winner(*a) != winner(*b) {
+            differ.push((i as u32 % c.width, i as u32 / c.width));
+        }
+    }
+    let (same, both) = stereolab::compare::depth_bits_identical(c, g).expect("same size");
+    eprintln!(
+        "coplanar: quad wins {quad_wins}, decal wins {decal_wins}, other winner on {} pixels; \
+         depth bit-identical on {same} of {both}",
+        differ.len()
+    );
+    // Both objects must win somewhere inside the decal, or the test decides nothing.
+    assert!(
+        decal_wins > 500 && quad_wins > 500,
+        "quad {quad_wins}, decal {decal_wins}"
+    );
+    assert!(
+        differ.is_empty(),
+        "{} pixels show the other object on the GPU (col, row): {:?}",
+        differ.len(),
+        &differ[..differ.len().min(20)]
     );
 }
 

@@ -38,8 +38,14 @@ use glam::{Mat4, Vec4};
 
 /// OpenGL clip space to wgpu clip space: `z' = z/2 + w/2`, x, y and w unchanged, so NDC z in
 /// [−1, 1] (`glDepthRange(0, 1)` then maps it to `z/2 + 1/2`) becomes wgpu's [0, 1] with the
-/// same window depth. Rows 0, 1 and 3 are unit rows, so `GL_TO_WGPU_DEPTH · P` keeps x, y and w
-/// of `P` bit for bit; only z is rounded differently (relative 1e-7).
+/// same window depth. Rows 0, 1 and 3 are unit rows: x, y and w stay bit for bit.
+///
+/// It is applied to clip positions, never folded into a projection matrix: the shaders'
+/// `gl_to_wgpu_depth` (common.wgsl) computes `0.5·(z + w)` after the OpenGL projection, and
+/// the SIRDS strips multiply their clip positions by this matrix on the host, which rounds
+/// the same (`0.5·z + 0.5·w` is one rounding of the exact `0.5·(z + w)`). The CPU's window
+/// depth is computed from the same `0.5·(z + w)`, so the depth planes of both paths start from
+/// the same bits (docs/gpu-parity.md "Depth bit for bit").
 pub const GL_TO_WGPU_DEPTH: Mat4 = Mat4::from_cols(
     Vec4::new(1.0, 0.0, 0.0, 0.0),
     Vec4::new(0.0, 1.0, 0.0, 0.0),

@@ -18,7 +18,6 @@ use crate::render::{Frame, PassResult};
 use crate::scene::{Object, Scene};
 use crate::shade::BlinnPhong;
 
-use super::GL_TO_WGPU_DEPTH;
 use super::device::{GpuRenderer, PipelineKey};
 use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
 use super::resources::buffer_with;
@@ -194,9 +193,7 @@ impl GpuRenderer {
                         o.color,
                         s.light,
                     )),
-                    Shading::DepthOnly => (GL_TO_WGPU_DEPTH * (m.mvp * o.model))
-                        .to_cols_array()
-                        .to_vec(),
+                    Shading::DepthOnly => (m.mvp * o.model).to_cols_array().to_vec(),
                     Shading::ChromaDepth => match texgen {
                         Some(texgen) => chromadepth_uniforms(o, m, texgen, s),
                         None => {
@@ -327,7 +324,7 @@ impl GpuRenderer {
 fn shaded_uniforms(bp: &BlinnPhong) -> Vec<f32> {
     let mut f = Vec::with_capacity(56);
     f.extend(bp.modelview().to_cols_array());
-    f.extend((GL_TO_WGPU_DEPTH * bp.projection()).to_cols_array());
+    f.extend(bp.projection().to_cols_array());
     let n = bp.normal_matrix();
     for c in [n.x_axis, n.y_axis, n.z_axis] {
         f.extend([c.x, c.y, c.z, 0.0]);
@@ -350,7 +347,7 @@ fn chromadepth_uniforms(o: &Object, m: &EyeMatrices, texgen: Texgen, s: &Scene) 
     let light_eye = m.view.transform_point3(s.light.position);
     let mut f = Vec::with_capacity(56);
     f.extend(modelview.to_cols_array());
-    f.extend((GL_TO_WGPU_DEPTH * m.projection).to_cols_array());
+    f.extend(m.projection.to_cols_array());
     for c in [
         normal_matrix.x_axis,
         normal_matrix.y_axis,

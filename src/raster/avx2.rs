@@ -6,9 +6,12 @@ use std::arch::x86_64::*;
 
 use super::{Band, Plane, SetupTriangle};
 
-/// Whether this CPU runs the AVX2 loops; the bytes are the same either way.
+/// Whether this CPU runs the AVX2 loops (AVX2, FMA for the depth plane, POPCNT); the bytes are
+/// the same either way.
 pub(crate) fn available() -> bool {
-    is_x86_feature_detected!("avx2") && is_x86_feature_detected!("popcnt")
+    is_x86_feature_detected!("avx2")
+        && is_x86_feature_detected!("fma")
+        && is_x86_feature_detected!("popcnt")
 }
 
 /// `v` unchanged, opaque to the optimizer. A lane blend of a loaded vector stored back where it
@@ -17,7 +20,7 @@ pub(crate) fn available() -> bool {
 /// pass, the gain was within noise (the hot load stayed as hot: it waits on the cache, not on
 /// store forwarding), so the depth pass no longer uses it; the strip pass
 /// (`effects/sirds/per_vertex/avx2.rs`) still does.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(crate) fn opaque(mut v: __m256) -> __m256 {
     // SAFETY: an empty instruction sequence; it only hides the value's origin.
@@ -26,19 +29,19 @@ pub(crate) fn opaque(mut v: __m256) -> __m256 {
 }
 
 /// Lane indices 0..8.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 pub(crate) fn lane_ids() -> __m256i {
     _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)
 }
 
 /// Lanes `< remaining` set.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 pub(crate) fn tail_mask(remaining: usize) -> __m256i {
     _mm256_cmpgt_epi32(_mm256_set1_epi32(remaining.min(8) as i32), lane_ids())
 }
 
 /// `plane.at(fx, fy)` per lane: `(a0 + dadx·fx) + dady·fy`.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 pub(crate) fn plane_at(p: &Plane, fx: __m256, fy: f32) -> __m256 {
     let row = _mm256_set1_ps(p.dady * fy);
     _mm256_add_ps(
@@ -52,7 +55,7 @@ pub(crate) fn plane_at(p: &Plane, fx: __m256, fy: f32) -> __m256 {
 
 /// Columns `x .. x + 8` as floats, and each relative to `t`'s plane origin: the lanes of
 /// [`SetupTriangle::fx`].
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(crate) fn columns(t: &SetupTriangle, x: u32) -> (__m256, __m256) {
     let xf = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x as i32), lane_ids()));
@@ -61,8 +64,21 @@ pub(crate) fn columns(t: &SetupTriangle, x: u32) -> (__m256, __m256) {
     (xf, fx)
 }
 
+/// [`SetupTriangle::depth_at`] per lane, for the columns `xf` (as floats) of row `y`: llvmpipe's
+/// `fma(dzdy, y, fma(dzdx, x, a0))` with the same two fused operations, clamped to [0, 1].
+#[target_feature(enable = "avx2,fma")]
+pub(crate) fn depth_at(t: &SetupTriangle, xf: __m256, y: u32) -> __m256 {
+    let p = t.depth_plane();
+    let row = _mm256_fmadd_ps(_mm256_set1_ps(p.dzdx), xf, _mm256_set1_ps(p.a0));
+    clamp01(_mm256_fmadd_ps(
+        _mm256_set1_ps(p.dzdy),
+        _mm256_set1_ps(y as i32 as f32),
+        row,
+    ))
+}
+
 /// `v.clamp(0, 1)` per lane, NaN kept (as `f32::clamp`).
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 pub(crate) fn clamp01(v: __m256) -> __m256 {
     let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
     let v = _mm256_blendv_ps(v, zero, _mm256_cmp_ps::<_CMP_LT_OQ>(v, zero));
@@ -70,7 +86,7 @@ pub(crate) fn clamp01(v: __m256) -> __m256 {
 }
 
 /// `⌊v⌋` per lane for `|v| < 2³¹`: truncate, then step down where that rounded up.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 pub(crate) fn floor_i32(v: __m256) -> __m256i {
     let i = _mm256_cvttps_epi32(v);
     let above = _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_cvtepi32_ps(i), v);
@@ -85,7 +101,7 @@ pub(crate) fn floor_i32(v: __m256) -> __m256i {
 /// larger ones go span by span ([`SetupTriangle::spans`]). Both give the same coverage.
 ///
 /// [`SmallBox`]: super::SmallBox
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(crate) fn covered_vectors(
     t: &SetupTriangle,
@@ -135,7 +151,7 @@ pub(crate) fn covered_vectors(
 ///
 /// # Safety
 /// `p` points at eight readable values when `full`, else at the `mask` lanes.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(crate) unsafe fn load(p: *const f32, mask: __m256i, full: bool) -> __m256 {
     // SAFETY: as the caller promises.
@@ -154,7 +170,7 @@ pub(crate) unsafe fn load(p: *const f32, mask: __m256i, full: bool) -> __m256 {
 ///
 /// # Safety
 /// As [`load`], writable.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(crate) unsafe fn store(p: *mut f32, mask: __m256i, full: bool, v: __m256) {
     // SAFETY: as the caller promises.
@@ -172,7 +188,7 @@ pub(crate) unsafe fn store(p: *mut f32, mask: __m256i, full: bool, v: __m256) {
 ///
 /// # Safety
 /// The CPU must support AVX2 and POPCNT ([`available`]).
-#[target_feature(enable = "avx2,popcnt")]
+#[target_feature(enable = "avx2,fma,popcnt")]
 pub(crate) unsafe fn depth_triangle(t: &SetupTriangle, band: &mut Band) -> usize {
     let rows = (band.depth.len() / band.width.max(1) as usize) as u32;
     let (x0, y0, w) = (band.x0, band.y0, band.width as usize);
@@ -190,7 +206,7 @@ pub(crate) unsafe fn depth_triangle(t: &SetupTriangle, band: &mut Band) -> usize
 ///
 /// # Safety
 /// The CPU must support AVX2.
-#[target_feature(enable = "avx2,popcnt")]
+#[target_feature(enable = "avx2,fma,popcnt")]
 #[inline]
 unsafe fn depth_vector(
     t: &SetupTriangle,
@@ -200,8 +216,8 @@ unsafe fn depth_vector(
     depth: &mut [f32],
 ) -> usize {
     let full = depth.len() >= 8;
-    let (_, fx) = columns(t, x);
-    let z = clamp01(plane_at(&t.depth_plane(), fx, t.fy(y)));
+    let (xf, _) = columns(t, x);
+    let z = depth_at(t, xf, y);
     // SAFETY: eight lanes fit when `full`; otherwise `mask` covers only the span's pixels,
     // inside `depth`.
     unsafe {

@@ -12,7 +12,7 @@ mod setup;
 mod traverse;
 
 pub(crate) use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
-pub use setup::{Plane, Setup, SetupTriangle, WindowVertex, setup_triangle};
+pub use setup::{DepthPlane, Plane, Setup, SetupTriangle, WindowVertex, setup_triangle};
 pub use traverse::{Band, SmallBox, traverse};
 
 use rayon::prelude::*;

@@ -8,22 +8,45 @@ use super::RasterOptions;
 use super::clip::ClipVertex;
 
 /// A vertex in window space: x right, y down (row 0 at the top), z in [0, 1], and 1/w.
+///
+/// Two versions of x and y: `x`, `y` place the vertex for coverage and the varyings; `depth_x`,
+/// `depth_y` are the same point as llvmpipe's viewport transform rounds it, for the depth
+/// plane alone (see `WindowVertex::from_clip` and [`DepthPlane`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WindowVertex {
     /// Window x in pixels (pixel centers at +0.5).
     pub x: f32,
     /// Window y in pixels, downwards.
     pub y: f32,
-    /// Window depth, `glDepthRange(0, 1)`.
+    /// Window depth, `glDepthRange(0, 1)`, rounded as lavapipe rounds it.
     pub z: f32,
     /// 1 / clip w, for perspective-correct varyings.
     pub inv_w: f32,
+    /// Window x as llvmpipe computes it: `fma(x·(1/w), W/2, W/2)`.
+    pub depth_x: f32,
+    /// Window y as llvmpipe computes it: `fma(y·(1/w), −H/2, H/2)`.
+    pub depth_y: f32,
 }
 
 impl WindowVertex {
     /// Perspective divide and viewport transform: `x_win = (x/w)·W/2 + W/2`,
     /// `y_win = (y/w)·(−H/2) + H/2` (NDC y = +1 is the top row), `z_win = (z/w)/2 + 1/2`.
     /// `None` when w ≤ 0 (only possible for unclipped input).
+    ///
+    /// The depth plane's inputs are rounded as lavapipe rounds them, so that depth can match
+    /// it bit for bit (docs/gpu-parity.md "Depth bit for bit"):
+    /// - `z_win = (0.5·(z + w))·(1/w)`: the GPU path's vertex stage turns OpenGL's clip z
+    ///   into wgpu's as `0.5·(z + w)` (`gpu::GL_TO_WGPU_DEPTH`'s row, `gl_to_wgpu_depth` in
+    ///   the shaders), and llvmpipe's viewport (`generate_viewport` in Mesa's `draw_llvm.c`)
+    ///   multiplies by its `1/w` (an IEEE division), then applies Vulkan's depth scale 1 and
+    ///   offset 0, which change nothing. Mathematically this is `(z/w)/2 + 1/2`.
+    /// - `depth_x = fma(x·(1/w), W/2, W/2)`, `depth_y = fma(y·(1/w), −H/2, H/2)`: the same
+    ///   viewport code computes `(c·(1/w))·scale + translate` with `lp_build_fmuladd`, which
+    ///   LLVM fuses into one FMA instruction on a CPU that has it.
+    ///
+    /// `x` and `y` (coverage and varyings) keep the division `(x/w)` of OpenGL's formula: they
+    /// are snapped to 1/256 pixel for coverage, where the last bit almost never matters, and
+    /// changing them would shift colours of the golden images by a rounding step here and there.
     pub(crate) fn from_clip(v: &ClipVertex, width: u32, height: u32) -> Option<Self> {
         let p = v.pos;
         if p.w <= 0.0 {
@@ -37,12 +60,16 @@ impl WindowVertex {
         // After clipping |x|, |y|, |z| ≤ w holds mathematically; with extreme magnitudes the
         // intersection rounding can leave a vertex far outside. Clamping NDC to [−1, 1] changes
         // no sample point inside the viewport and keeps the fixed-point math from overflowing.
+        // The depth plane's positions are not clamped (llvmpipe does not): they only enter
+        // float arithmetic, whose overflow setup turns into an empty triangle.
         let ndc = |c: f32| (c / p.w).clamp(-1.0, 1.0);
         Some(WindowVertex {
             x: ndc(p.x) * hw + hw,
             y: ndc(p.y) * -hh + hh,
-            z: ndc(p.z) * 0.5 + 0.5,
+            z: (0.5 * (p.z + p.w)) * inv_w,
             inv_w,
+            depth_x: (p.x * inv_w).mul_add(hw, hw),
+            depth_y: (p.y * inv_w).mul_add(-hh, hh),
         })
     }
 }
@@ -87,6 +114,61 @@ impl Plane {
     }
 }
 
+/// The window-depth plane as llvmpipe sets it up and evaluates it, so that depth matches
+/// lavapipe's bit for bit: `z(px, py) = fma(dzdy, py, fma(dzdx, px, a0))` at pixel (`px`,
+/// `py`) given by its integer column and row, with `a0` the depth at the point (−½, −½), so
+/// that the integers land on pixel centres.
+///
+/// From Mesa 22.3's llvmpipe, which lavapipe runs:
+/// - setup (`init_args` and `calc_coef4` in `lp_state_setup.c`), from the window positions
+///   of the vertices in llvmpipe's order (below): `dxy01 = v0 − v1`, `dxy20 = v2 − v0`,
+///   `ooa = 1 / (dx01·dy20 − dy01·dx20)`, the four differences times `ooa`, then
+///   `dzdx = dz01·(dy20·ooa) − dz20·(dy01·ooa)`, `dzdy = dz20·(dx01·ooa) − dz01·(dx20·ooa)`
+///   and `a0 = z0 − (dzdx·(x0 − ½) + dzdy·(y0 − ½))`, each operation rounded on its own;
+/// - evaluation (`attribs_update_simple` in `lp_bld_interp.c`): `a0 + dadx·x + dady·y` as two
+///   `lp_build_fmuladd`, fused by LLVM into FMA instructions on a CPU that has them (here
+///   `f32::mul_add`: the same correctly rounded fused operation, on every CPU);
+/// - the vertex order (`triangle_both` in `lp_setup_tri.c`): as submitted when the snapped
+///   triangle is counter-clockwise on screen (our area `A < 0`), else `v0, v2, v1` (Vulkan's
+///   first provoking vertex: `rotate_fixed_position_12`);
+/// - then clamped to [0, 1] (`lp_build_depth_clamp` in `lp_state_fs.c`) and stored in the
+///   32-bit float depth buffer as it is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthPlane {
+    /// Depth at the point (−½, −½): pixel (0, 0)'s centre minus one step in x and y.
+    pub a0: f32,
+    /// Change per pixel to the right.
+    pub dzdx: f32,
+    /// Change per pixel down.
+    pub dzdy: f32,
+}
+
+impl DepthPlane {
+    /// llvmpipe's setup of the plane through three (x, y, z) window points, in that order;
+    /// `None` when the triangle has no area in floating point or a coefficient is not finite.
+    pub fn new(v: [(f32, f32, f32); 3]) -> Option<DepthPlane> {
+        let [(x0, y0, z0), (x1, y1, z1), (x2, y2, z2)] = v;
+        let (x0_center, y0_center) = (x0 - 0.5, y0 - 0.5);
+        let (dx01, dy01) = (x0 - x1, y0 - y1);
+        let (dx20, dy20) = (x2 - x0, y2 - y0);
+        let ooa = 1.0 / (dx01 * dy20 - dy01 * dx20);
+        let (dx20_ooa, dy20_ooa) = (dx20 * ooa, dy20 * ooa);
+        let (dx01_ooa, dy01_ooa) = (dx01 * ooa, dy01 * ooa);
+        let (dz01, dz20) = (z0 - z1, z2 - z0);
+        let dzdx = dz01 * dy20_ooa - dz20 * dy01_ooa;
+        let dzdy = dz20 * dx01_ooa - dz01 * dx20_ooa;
+        let a0 = z0 - (dzdx * x0_center + dzdy * y0_center);
+        let plane = DepthPlane { a0, dzdx, dzdy };
+        (a0.is_finite() && dzdx.is_finite() && dzdy.is_finite()).then_some(plane)
+    }
+
+    /// The depth at pixel (`px`, `py`), before clamping: `fma(dzdy, py, fma(dzdx, px, a0))`.
+    #[inline]
+    pub fn at_pixel(&self, px: f32, py: f32) -> f32 {
+        self.dzdy.mul_add(py, self.dzdx.mul_add(px, self.a0))
+    }
+}
+
 /// A triangle after setup: fixed-point edge functions, its pixel bounds, and the attribute
 /// planes. Traversal needs nothing else, so one setup serves every band of rows.
 #[derive(Clone, Debug)]
@@ -107,7 +189,7 @@ pub struct SetupTriangle {
     /// Window position of vertex 0: the planes' origin.
     pub(super) x0: f32,
     pub(super) y0: f32,
-    pub(super) z: Plane,
+    pub(super) z: DepthPlane,
     pub(super) inv_w: Plane,
     pub(super) var: [Plane; MAX_VARYINGS],
     pub(super) nvar: usize,
@@ -196,13 +278,17 @@ pub fn setup_triangle(
             dady: (da2 * dx1 - da1 * dx2) / det,
         }
     };
-    let z = plane([v[0].z, v[1].z, v[2].z]);
+    // llvmpipe's vertex order: as submitted when counter-clockwise on screen, else v0, v2, v1.
+    let order = if area > 0 { [0, 2, 1] } else { [0, 1, 2] };
+    let Some(z) = DepthPlane::new(order.map(|i| (v[i].depth_x, v[i].depth_y, v[i].z))) else {
+        return Setup::Empty; // no area in floating point, or gradients that overflow f32
+    };
     let inv_w = plane([v[0].inv_w, v[1].inv_w, v[2].inv_w]);
     let finite = |p: &Plane| p.a0.is_finite() && p.dadx.is_finite() && p.dady.is_finite();
-    if !finite(&z) || !finite(&inv_w) {
+    if !finite(&inv_w) {
         return Setup::Empty; // a sliver so thin its gradients overflow f32
     }
-    let mut var_planes = [z; MAX_VARYINGS];
+    let mut var_planes = [inv_w; MAX_VARYINGS];
     for (k, p) in var_planes.iter_mut().enumerate().take(nvar) {
         *p = if opts.perspective_correct {
             plane([
@@ -284,7 +370,7 @@ impl SetupTriangle {
     }
 
     /// The window-depth plane (before clamping).
-    pub(crate) fn depth_plane(&self) -> Plane {
+    pub(crate) fn depth_plane(&self) -> DepthPlane {
         self.z
     }
 
@@ -298,10 +384,13 @@ impl SetupTriangle {
         self.var[k]
     }
 
-    /// Window depth at (`fx`, `fy`), clamped to [0, 1]: what the depth test compares.
+    /// Window depth at pixel (`px`, `py`), clamped to [0, 1]: what the depth test compares
+    /// (llvmpipe's evaluation, [`DepthPlane`]). The AVX2 loops compute the same lanes.
     #[inline]
-    pub(crate) fn depth_at(&self, fx: f32, fy: f32) -> f32 {
-        self.z.at(fx, fy).clamp(0.0, 1.0)
+    pub fn depth_at(&self, px: u32, py: u32) -> f32 {
+        self.z
+            .at_pixel(px as i32 as f32, py as i32 as f32)
+            .clamp(0.0, 1.0)
     }
 
     /// The factor that turns an interpolated `a/w` back into `a` at (`fx`, `fy`): `w`, the
@@ -325,7 +414,66 @@ impl SetupTriangle {
 
 #[cfg(test)]
 mod tests {
-    use super::round_ties_even;
+    use super::{DepthPlane, round_ties_even};
+
+    /// llvmpipe's plane is the triangle's plane: at random pixels it agrees with the exact
+    /// plane (in f64, through the same three points) to within a few units in the last place,
+    /// and it does not depend on which vertex comes first beyond that rounding.
+    #[test]
+    fn depth_plane_is_the_plane_through_the_three_points() {
+        let mut seed = 0x1234_5678_9abc_def1u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for _ in 0..2000 {
+            let v: [(f32, f32, f32); 3] =
+                std::array::from_fn(|_| (next() * 300.0, next() * 200.0, next()));
+            let exact = |px: f64, py: f64| {
+                // The plane through the points, evaluated at the pixel centre (px + ½, py + ½).
+                let [(x0, y0, z0), (x1, y1, z1), (x2, y2, z2)] =
+                    v.map(|(x, y, z)| (x as f64, y as f64, z as f64));
+                let det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+                let a = ((z1 - z0) * (y2 - y0) - (z2 - z0) * (y1 - y0)) / det;
+                let b = ((z2 - z0) * (x1 - x0) - (z1 - z0) * (x2 - x0)) / det;
+                (
+                    z0 + a * (px + 0.5 - x0) + b * (py + 0.5 - y0),
+                    a.abs() + b.abs(),
+                )
+            };
+            let (Some(p), Some(q)) = (DepthPlane::new(v), DepthPlane::new([v[1], v[2], v[0]]))
+            else {
+                continue; // no area in f32
+            };
+            let [(x0, y0, _), (x1, y1, _), (x2, y2, _)] = v;
+            if ((x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)).abs() < 2000.0 {
+                continue; // slivers: an ulp of position moves their plane by far more
+            }
+            // A pixel within the triangle's bounds.
+            let (lo_x, hi_x) = (x0.min(x1).min(x2), x0.max(x1).max(x2));
+            let (lo_y, hi_y) = (y0.min(y1).min(y2), y0.max(y1).max(y2));
+            let px = (lo_x + next() * (hi_x - lo_x)).floor();
+            let py = (lo_y + next() * (hi_y - lo_y)).floor();
+            let (want, slope) = exact(px as f64, py as f64);
+            if slope > 1.0 {
+                continue; // steep: a position error of an ulp moves depth by slope × ulp
+            }
+            for plane in [p, q] {
+                let got = plane.at_pixel(px, py) as f64;
+                // A few ulps of the terms summed (far from the origin `a0` and the products
+                // grow, and so does the rounding: llvmpipe's own FIXME in lp_state_setup.c).
+                let terms = (plane.a0.abs() + (plane.dzdx * px).abs() + (plane.dzdy * py).abs())
+                    as f64
+                    + 1.0;
+                assert!(
+                    (got - want).abs() <= 16.0 * f32::EPSILON as f64 * terms,
+                    "{v:?} at ({px}, {py}): {got} vs {want}"
+                );
+            }
+        }
+    }
 
     /// The magic-number rounding snaps as `f32::round_ties_even` does: every quarter step
     /// around zero, around the 2²² switch-over and the snapping range of a 16384-pixel

@@ -232,7 +232,7 @@ pub fn traverse<S: Shader>(
             // Depth only: a branch-free span the compiler vectorizes; z is the same expression
             // as below, so the bits are the same.
             for (k, d) in band.depth[i_lo..=i_hi].iter_mut().enumerate() {
-                let z = t.depth_at(t.fx(x_lo + k as u32), fy);
+                let z = t.depth_at(x_lo + k as u32, py);
                 let pass = z < *d;
                 *d = if pass { z } else { *d };
                 fragments += pass as usize;
@@ -241,7 +241,7 @@ pub fn traverse<S: Shader>(
         }
         for (px, idx) in (x_lo..=x_hi).zip(i_lo..=i_hi) {
             let fx = t.fx(px);
-            let z = t.depth_at(fx, fy);
+            let z = t.depth_at(px, py);
             if opts.depth_test && z >= band.depth[idx] {
                 continue;
             }

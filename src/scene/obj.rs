@@ -29,7 +29,7 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
 }
 
 /// [`load_obj`], and the notes on what was read in an unusual way: each names the file and
-/// line (a coordinate like `3.1+e2`, read as assimp reads it, see [`assimp_number_len`]).
+/// line (a coordinate like `3.1+e2`, read as assimp's `fast_atof` reads it).
 /// `stereolab render` prints them.
 ///
 /// # Errors

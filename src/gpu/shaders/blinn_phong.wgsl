@@ -5,7 +5,7 @@
 struct Uniforms {
     // view · model (`BlinnPhong::modelview`).
     modelview: mat4x4<f32>,
-    // GL_TO_WGPU_DEPTH · projection: OpenGL clip space with z remapped to [0, w].
+    // The OpenGL projection (`gl_to_wgpu_depth` then remaps z to [0, w]).
     projection: mat4x4<f32>,
     // Inverse transpose of the modelview's linear part.
     normal_matrix: mat3x3<f32>,
@@ -30,7 +30,7 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
     let p_eye = transform_point3(u.modelview, position);
     out.p_eye = p_eye;
     out.n_eye = mul_vec3(u.normal_matrix, normal);
-    out.clip = mul_vec4(u.projection, vec4<f32>(p_eye, 1.0));
+    out.clip = gl_to_wgpu_depth(mul_vec4(u.projection, vec4<f32>(p_eye, 1.0)));
     return out;
 }
 

@@ -6,7 +6,7 @@
 struct Uniforms {
     // view · model of the center eye (`ChromaDepthShader::new`).
     modelview: mat4x4<f32>,
-    // GL_TO_WGPU_DEPTH · projection.
+    // The OpenGL projection (`gl_to_wgpu_depth` then remaps z to [0, w]).
     projection: mat4x4<f32>,
     // Inverse transpose of the modelview's linear part (lit only).
     normal_matrix: mat3x3<f32>,
@@ -66,7 +66,7 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
     out.s = texgen(p_eye);
     out.p_eye = p_eye;
     out.n_eye = mul_vec3(u.normal_matrix, normal);
-    out.clip = mul_vec4(u.projection, vec4<f32>(p_eye, 1.0));
+    out.clip = gl_to_wgpu_depth(mul_vec4(u.projection, vec4<f32>(p_eye, 1.0)));
     return out;
 }
 

@@ -20,6 +20,13 @@ fn mul_vec4(m: mat4x4<f32>, v: vec4<f32>) -> vec4<f32> {
     return r;
 }
 
+// GL_TO_WGPU_DEPTH (src/gpu/mod.rs) applied to a clip position: z' = 0.5·(z + w), one
+// rounding per operation, as the CPU's `WindowVertex::from_clip` computes it (depth bit for
+// bit: docs/gpu-parity.md).
+fn gl_to_wgpu_depth(c: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(c.x, c.y, 0.5 * (c.z + c.w), c.w);
+}
+
 // glam's `Mat3 * Vec3`: (c0·x + c1·y) + c2·z.
 fn mul_vec3(m: mat3x3<f32>, v: vec3<f32>) -> vec3<f32> {
     var r = m[0] * v.x;

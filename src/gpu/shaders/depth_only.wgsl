@@ -1,7 +1,7 @@
 // Depth only: a mirror of `DepthOnly` in src/shade.rs (no fragment stage at all).
 
 struct Uniforms {
-    // GL_TO_WGPU_DEPTH · mvp · model.
+    // mvp · model (OpenGL clip space; z goes to wgpu's below).
     mvp: mat4x4<f32>,
 }
 
@@ -15,5 +15,6 @@ fn vs_main(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
     r = r + u.mvp[1] * v.y;
     r = r + u.mvp[2] * v.z;
     r = r + u.mvp[3] * v.w;
-    return r;
+    // GL_TO_WGPU_DEPTH, as common.wgsl's `gl_to_wgpu_depth`.
+    return vec4<f32>(r.x, r.y, 0.5 * (r.z + r.w), r.w);
 }

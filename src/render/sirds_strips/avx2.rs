@@ -12,7 +12,7 @@ use std::arch::x86_64::*;
 use super::{Region, SpanTarget, Strip};
 use crate::raster::SetupTriangle;
 use crate::raster::avx2::{
-    clamp01, columns, covered_vectors, floor_i32, load, opaque, plane_at, store, tail_mask,
+    columns, covered_vectors, depth_at, floor_i32, load, opaque, plane_at, store, tail_mask,
 };
 
 /// [`super::span_sources`] for every pixel of triangle `t` in region `r` of the band starting
@@ -21,7 +21,7 @@ use crate::raster::avx2::{
 ///
 /// # Safety
 /// The CPU must support AVX2.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 pub(super) unsafe fn triangle_sources(
     t: &SetupTriangle,
     r: &Region,
@@ -43,7 +43,7 @@ pub(super) unsafe fn triangle_sources(
 ///
 /// # Safety
 /// The CPU must support AVX2.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 #[inline]
 unsafe fn sources_vector(
     t: &SetupTriangle,
@@ -58,7 +58,7 @@ unsafe fn sources_vector(
     let fy = t.fy(y);
     let half = _mm256_set1_ps(0.5);
     let (xf, fx) = columns(t, x);
-    let z = clamp01(plane_at(&t.depth_plane(), fx, fy));
+    let z = depth_at(t, xf, y);
     let (dp, sp) = (depth.as_mut_ptr(), sources.as_mut_ptr());
     // SAFETY: eight lanes fit in both when `full`; otherwise `mask` covers only covered
     // pixels, inside both.
@@ -103,7 +103,7 @@ unsafe fn sources_vector(
 ///
 /// # Safety
 /// The CPU must support AVX2; every lane's `i0` and `i1` lies inside `row`.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 #[inline]
 unsafe fn fetch_pair(row: &[[u8; 4]], i0: __m256i, i1: __m256i) -> (__m256i, __m256i) {
     let base = row.as_ptr() as *const i32;
@@ -151,7 +151,7 @@ unsafe fn fetch_pair(row: &[[u8; 4]], i0: __m256i, i1: __m256i) -> (__m256i, __m
 /// # Safety
 /// The CPU must support AVX2; every source in `sources` is NaN or inside `row` (as
 /// [`super::in_bounds`] ensured).
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 pub(super) unsafe fn resolve_row(
     row: &mut [[u8; 4]],
     sources: &[f32],

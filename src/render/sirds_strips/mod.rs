@@ -291,7 +291,7 @@ fn span_sources(
     for (k, (d, p)) in depth.iter_mut().zip(sources).enumerate() {
         let x = x_lo + k as u32;
         let fx = t.fx(x);
-        let z = t.depth_at(fx, fy);
+        let z = t.depth_at(x, y);
         let sep = t.varying_at(0, fx, fy, target.perspective_correct);
         let src = source_coordinate(x, sep, target.toward);
         // Branch-free, so the compiler can vectorize the span (SSE2, NEON).
