@@ -295,3 +295,27 @@ fn bench_runs_one_group_and_refuses_an_unknown_one() {
     assert!(text.contains("subpixel"), "{text}");
     assert!(!text.contains("sirds"), "only the raster group ran: {text}");
 }
+
+#[test]
+fn render_notes_a_number_read_as_assimp_reads_it_with_its_line() {
+    let dir = out_dir("cli_obj_note");
+    let obj = dir.join("junk_exponent.obj");
+    std::fs::write(&obj, "v -1 -1 0\nv 1 -1 0.1+e2\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let scene = obj_scene(&dir, &obj);
+    let out = stereolab(&["render", &scene, "--out", dir.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains(
+            "  note: {}:2: 'v' coordinate '0.1+e2' read as 0.1, as assimp reads it: it stops \
+             before '+e2' (if 0.1e+2 was meant, write that)"
+                .replace("{}", &obj.display().to_string())
+                .as_str()
+        ),
+        "{stdout}"
+    );
+}
