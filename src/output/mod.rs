@@ -148,7 +148,7 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
 /// rotation of each eye towards the fusion point), 0 for off-axis and parallel (parallel axes).
 ///
 /// # Errors
-/// As [`StereoRig::resolve`](crate::math::rig::StereoRig::resolve).
+/// As [`StereoRig::resolve`](crate::math::StereoRig::resolve).
 pub fn rig_metadata(scene: &Scene) -> Result<RigMetadata> {
     use crate::math::CameraMode;
     let r = scene.rig.resolve(&scene.camera, scene.aspect())?;

@@ -300,6 +300,8 @@ fn load_pfm(path: &Path, head: &[u8], near: Near) -> Result<DepthSamples> {
         }
     }
     let span = hi - lo;
+    // No finite sample, or a map of one value: all background.
+    let flat = span.is_nan() || span <= 0.0;
     let (w, h) = (width as usize, height as usize);
     let mut samples = vec![0u16; n];
     for (y, row) in samples.chunks_exact_mut(w).enumerate() {
@@ -307,7 +309,7 @@ fn load_pfm(path: &Path, head: &[u8], near: Near) -> Result<DepthSamples> {
         let src = (h - 1 - y) * w;
         for (x, out) in row.iter_mut().enumerate() {
             let v = sample(src + x);
-            let z = if !v.is_finite() || !(span > 0.0) {
+            let z = if !v.is_finite() || flat {
                 0.0
             } else if near == Near::White {
                 (v - lo) / span
