@@ -156,6 +156,12 @@ fn check_own(
         lo as f32 <= want_lo + 3.0 && hi as f32 >= want_hi - 3.0,
         "the range found must cover the intended one: {line}"
     );
+    // ... and not run far past it (a harmonic at twice the separation would; the loosest
+    // measured: 55 px for 72 px, cross-eyed per-vertex eq. 3, a few chance matches).
+    assert!(
+        lo as f32 >= 0.7 * want_lo && hi as f32 <= 1.1 * want_hi + 3.0,
+        "the range found must not reach far past the intended one: {line}"
+    );
     assert!(rt.within_one >= floor, "{line}");
     line
 }
