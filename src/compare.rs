@@ -447,6 +447,56 @@ pub fn compare_images(
     })
 }
 
+/// Compares two stereo photos (MPO, JPS or PNS, in any combination) eye by eye: each file is
+/// split into its left and right views
+/// ([`read_stereo`](crate::output::stereo_photo::read_stereo)), and each view is compared as
+/// [`compare_images`] compares two files; rows `<actual>-left` and `<actual>-right`.
+///
+/// # Errors
+/// Unreadable files, or views of different sizes.
+pub fn compare_stereo_photos(
+    expected: &Path,
+    actual: &Path,
+    background: Option<[u8; 4]>,
+    out: Option<&Path>,
+) -> Result<Vec<Comparison>> {
+    use crate::output::stereo_photo::read_stereo;
+    let (e, a) = (read_stereo(expected)?, read_stereo(actual)?);
+    let stem = actual
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "image".into());
+    [("left", &e.0, &a.0), ("right", &e.1, &a.1)]
+        .into_iter()
+        .map(|(eye, ei, ai)| {
+            let to_fb = |img: &RgbaImage| {
+                let bg = background.unwrap_or_else(|| img.get_pixel(0, 0).0);
+                framebuffer_from_image(img, bg)
+            };
+            let (ef, af) = (to_fb(ei), to_fb(ai));
+            let metrics = compare(&ef, &af).map_err(|err| match err {
+                Error::Invalid { value, .. } => Error::invalid(
+                    format!("{} vs {} ({eye} eye)", expected.display(), actual.display()),
+                    value,
+                    "views must have the same size",
+                ),
+                other => other,
+            })?;
+            let name = format!("{stem}-{eye}");
+            let strip = out
+                .map(|dir| write_diff_strip(&ef, &af, dir, &format!("{name}-diff")))
+                .transpose()?;
+            Ok(Comparison {
+                name,
+                metrics,
+                has_depth: false,
+                strip,
+                max_levels_16: None,
+            })
+        })
+        .collect()
+}
+
 /// Whether an image holds 16 bits per channel (16-bit PNG or PGM, as depth maps often are).
 fn is_16_bit(img: &image::DynamicImage) -> bool {
     use image::ColorType::{L16, La16, Rgb16, Rgba16};

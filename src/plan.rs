@@ -54,6 +54,13 @@ pub enum Output {
     Sirds,
     /// The depth map the SIRDS encodes (16-bit, white = near).
     SirdsDepth,
+    /// Left and right as a CIPA DC-007 multi-picture JPEG (`mpo.mpo`), what stereo cameras
+    /// write and 3D viewers open.
+    Mpo,
+    /// Right | left side by side in one JPEG (`jps.jps`), the cross-eyed order viewers expect.
+    Jps,
+    /// Right | left side by side in one PNG (`pns.pns`).
+    Pns,
 }
 
 /// Which camera a pass renders from.
@@ -120,6 +127,9 @@ impl Output {
         Output::Parallax,
         Output::Sirds,
         Output::SirdsDepth,
+        Output::Mpo,
+        Output::Jps,
+        Output::Pns,
     ];
 
     /// The name used in scene files and for the PNG written.
@@ -147,7 +157,22 @@ impl Output {
             Output::Parallax => "parallax",
             Output::Sirds => "sirds",
             Output::SirdsDepth => "sirds_depth",
+            Output::Mpo => "mpo",
+            Output::Jps => "jps",
+            Output::Pns => "pns",
         }
+    }
+
+    /// The file an output is written to: `<name>.png`, or `<name>.mpo|jps|pns` for the
+    /// stereo photo formats.
+    pub fn file_name(self) -> String {
+        let ext = match self {
+            Output::Mpo => "mpo",
+            Output::Jps => "jps",
+            Output::Pns => "pns",
+            _ => "png",
+        };
+        format!("{}.{ext}", self.name())
     }
 
     /// Parses a name as written in a scene file.

@@ -26,4 +26,6 @@ mod reliability;
 mod rig;
 mod scene_hashes;
 mod sirds;
+mod sirds_interop;
 mod stability;
+mod stereo_photo;

@@ -37,6 +37,15 @@ fn image_hash(img: &Image) -> (u32, u32, u64) {
             i.height(),
             fnv1a(i.as_raw().iter().flat_map(|v| v.to_le_bytes()), seed),
         ),
+        // The pixels of both views (not the JPEG encoding, which belongs to the image crate).
+        Image::Stereo(p) => (
+            p.left.width(),
+            p.left.height(),
+            fnv1a(
+                p.left.as_raw().iter().chain(p.right.as_raw()).copied(),
+                seed,
+            ),
+        ),
     }
 }
 

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::{Row, median_ms};
-use crate::effects::sirds::decode::{DecodeOptions, decode, round_trip};
+use crate::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
 use crate::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
 use crate::effects::sirds::{Algorithm, Filter, Pattern, PerVertexOptions, Start, depth_range};
 use crate::error::Result;
@@ -176,6 +176,73 @@ fn large_depth_map(iters: usize) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// Decoding without being told the separations: a per-pixel SIRDS of a 600×300 sphere over a
+/// ramp decoded over the range its set-up produces (the old way), the full-range search
+/// alone, and search + decode; error: RMS decoded separation; note: time against the known
+/// range, in this run.
+fn decode_search(iters: usize) -> Result<Vec<Row>> {
+    use crate::effects::sirds::decode::decode_auto;
+    use crate::effects::sirds::search::{SearchOptions, search};
+    let (w, h) = (600, 300);
+    let depth = sphere_over_ramp(w, h);
+    let d = crate::effects::sirds::Geometry::default().to_pixels()?;
+    let pixels = per_pixel(
+        &depth,
+        &d,
+        &Pattern::BlackWhite { seed: 1 },
+        &PerPixelOptions::default(),
+    )?;
+    let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
+    let known = DecodeOptions::for_disparity(&d);
+    let so = SearchOptions::default();
+    let rt_known = round_trip(&decode(&pixels, w, h, &known)?, &intended, &known);
+    let auto = decode_auto(&pixels, w, h, &so)?;
+    let rt_auto = match (&auto.decoded, &auto.options) {
+        (Some(dec), Some(o)) => Some(round_trip(dec, &intended, o)),
+        _ => None,
+    };
+    let t_known = median_ms(iters, || decode(&pixels, w, h, &known).is_ok());
+    let t_search = median_ms(iters, || search(&pixels, w, h, &so).is_ok());
+    let t_auto = median_ms(iters, || decode_auto(&pixels, w, h, &so).is_ok());
+    let row = |setting: String, rt: Option<RoundTrip>, ms: f64| Row {
+        area: "sirds".into(),
+        knob: "decode 600x300".into(),
+        setting,
+        error: rt.map(|r| r.rms),
+        error_unit: "rms decoded sep, px".into(),
+        ms,
+        note: format!(
+            "{:.2}x the known range{}",
+            ms / t_known,
+            rt.map(|r| format!(", {:.1}% within ±1 px", r.within_one * 100.0))
+                .unwrap_or_default()
+        ),
+    };
+    Ok(vec![
+        row(
+            format!(
+                "known range {}..={} px",
+                known.min_separation, known.max_separation
+            ),
+            Some(rt_known),
+            t_known,
+        ),
+        row(
+            format!("search {}..={} px", so.min_separation, w / 3),
+            None,
+            t_search,
+        ),
+        row(
+            format!(
+                "search + decode (found {:?})",
+                auto.search.found.unwrap_or((0, 0))
+            ),
+            rt_auto,
+            t_auto,
+        ),
+    ])
+}
+
 /// Median wall time of `iters` runs of a whole process (stdout into `stdout`), after one
 /// warm-up run; `Err` with what failed.
 fn process_ms(
@@ -288,6 +355,7 @@ pub fn rows(iters: usize) -> Result<Vec<Row>> {
     let mut rows = table_1(iters)?;
     rows.extend(knobs(iters.min(5))?);
     rows.extend(large_depth_map(iters)?);
+    rows.extend(decode_search(iters.min(5))?);
     rows.extend(netpbm(iters.min(5))?);
     Ok(rows)
 }

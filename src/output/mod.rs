@@ -3,6 +3,7 @@
 pub mod animate;
 pub mod chromadepth;
 pub mod sirds;
+pub mod stereo_photo;
 
 use std::path::{Path, PathBuf};
 
@@ -15,6 +16,7 @@ use crate::framebuffer::Framebuffer;
 use crate::plan::{Output, View};
 use crate::render::Frame;
 use crate::scene::Scene;
+use stereo_photo::{PhotoFormat, RigMetadata, StereoPhoto};
 
 /// One finished output image.
 pub enum Image {
@@ -22,10 +24,13 @@ pub enum Image {
     Rgba(image::RgbaImage),
     /// 16-bit grayscale (depth).
     Gray16(image::ImageBuffer<image::Luma<u16>, Vec<u16>>),
+    /// Both eyes in a stereo photo format (MPO, JPS, PNS), encoded when saved.
+    Stereo(stereo_photo::StereoPhoto),
 }
 
 impl Image {
-    /// Writes the image as PNG, all or nothing ([`files::write_atomic`]).
+    /// Writes the image as PNG (a stereo photo in its own format), all or nothing
+    /// ([`files::write_atomic`]).
     ///
     /// # Errors
     /// The file cannot be written, or its name is a link or a special file.
@@ -33,6 +38,7 @@ impl Image {
         match self {
             Image::Rgba(i) => files::write_png(path, i),
             Image::Gray16(i) => files::write_png(path, i),
+            Image::Stereo(photo) => files::write_bytes(path, &photo.encode()?),
         }
     }
 }
@@ -121,10 +127,47 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
         Output::Parallax => Image::Rgba(parallax_image(eye(View::Left)?, &scene.parallax_rig()?)?),
         Output::Sirds => Image::Rgba(sirds::from_frame(frame, scene)?.to_rgba_image()),
         Output::SirdsDepth => Image::Gray16(sirds::scene_depth(frame, scene)?.0.to_image()),
+        Output::Mpo | Output::Jps | Output::Pns => {
+            let format = match output {
+                Output::Mpo => PhotoFormat::Mpo,
+                Output::Jps => PhotoFormat::Jps,
+                _ => PhotoFormat::Pns,
+            };
+            Image::Stereo(StereoPhoto {
+                format,
+                left: eye(View::Left)?.to_rgba_image(),
+                right: eye(View::Right)?.to_rgba_image(),
+                rig: Some(rig_metadata(scene)?),
+            })
+        }
     })
 }
 
-/// Produces and writes every requested output as `DIR/<name>.png`; returns the paths.
+/// The MPO's baseline and convergence from the scene's rig: the resolved eye separation, and
+/// the angle between the optical axes — `2 atan((d/2)/z0)` for toe-in (the SGI course notes'
+/// rotation of each eye towards the fusion point), 0 for off-axis and parallel (parallel axes).
+///
+/// # Errors
+/// As [`StereoRig::resolve`](crate::math::StereoRig::resolve).
+pub fn rig_metadata(scene: &Scene) -> Result<RigMetadata> {
+    use crate::math::CameraMode;
+    let r = scene.rig.resolve(&scene.camera, scene.aspect())?;
+    let convergence_deg = match scene.rig.mode {
+        CameraMode::ToeIn => {
+            2.0 * (r.eye_separation / 2.0 / r.zero_parallax_distance)
+                .atan()
+                .to_degrees()
+        }
+        CameraMode::OffAxis | CameraMode::Parallel => 0.0,
+    };
+    Ok(RigMetadata {
+        baseline: r.eye_separation,
+        convergence_deg,
+    })
+}
+
+/// Produces and writes every requested output as `DIR/<name>.png` (`.mpo`, `.jps`, `.pns` for
+/// the stereo photo formats); returns the paths.
 ///
 /// # Errors
 /// The folder cannot be created, or an output fails.
@@ -150,7 +193,7 @@ pub(crate) fn write_all_with(
         .outputs
         .iter()
         .map(|&o| {
-            let path = dir.join(format!("{}.png", o.name()));
+            let path = dir.join(o.file_name());
             files::check_output_path(&path)?;
             Ok((path, make(o)?))
         })

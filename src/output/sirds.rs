@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use crate::effects::sirds::depthfile::{DepthMapping, DepthSamples, Near};
 use crate::effects::sirds::{
     Algorithm, DepthMap, DepthRange, Disparity, Settings, Sirds, depth_range, pattern, per_pixel,
 };
@@ -143,23 +144,24 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
 ///
 /// # Errors
 /// The depth map cannot be read or is too large, or the file cannot be written.
-pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result<(u32, u32)> {
-    let img = crate::framebuffer::open_image(depth, "depth map")?;
-    let (width, height) = (img.width(), img.height());
-    crate::framebuffer::check_size(width, height).map_err(|e| e.in_file(depth))?;
-    let (samples, max): (Vec<u16>, f32) = match img {
-        image::DynamicImage::ImageLuma8(g) => {
-            (g.into_raw().into_iter().map(u16::from).collect(), 255.0)
-        }
-        image::DynamicImage::ImageLuma16(g) => (g.into_raw(), 65535.0),
-        other => (other.to_luma16().into_raw(), 65535.0),
-    };
+pub fn stream_depth_map(
+    depth: &Path,
+    near: Near,
+    settings: &Settings,
+    out: &Path,
+) -> Result<(u32, u32, DepthMapping)> {
+    let DepthSamples {
+        width,
+        height,
+        samples,
+        mapping,
+    } = DepthSamples::load(depth, near)?;
     let invert = settings.cross_eyed;
     let w = width as usize;
     let depth_row = |y: u32, row: &mut Vec<f32>| {
         let line = &samples[y as usize * w..(y as usize + 1) * w];
         row.extend(line.iter().map(|&v| {
-            let z = v as f32 / max;
+            let z = v as f32 / 65535.0;
             if invert { 1.0 - z } else { z }
         }));
     };
@@ -185,5 +187,5 @@ pub fn stream_depth_map(depth: &Path, settings: &Settings, out: &Path) -> Result
             },
         )
     })?;
-    Ok((width, height))
+    Ok((width, height, mapping))
 }

@@ -6,6 +6,7 @@ use std::time::Duration;
 
 use clap::Args;
 use stereolab::compare::{self, Comparison, Thresholds};
+use stereolab::output::stereo_photo::PhotoFormat;
 #[cfg(feature = "gpu")]
 use stereolab::plan::Plan;
 use stereolab::scene::Scene;
@@ -81,6 +82,14 @@ pub fn run(args: CompareArgs) -> Result<()> {
             problems = p;
             rows
         }
+        Some(second)
+            if PhotoFormat::from_path(&first).is_some()
+                || PhotoFormat::from_path(&second).is_some() =>
+        {
+            // Stereo photos (MPO, JPS, PNS): split into left and right, one row per eye.
+            let bg = background.as_deref().map(parse_rgb).transpose()?;
+            compare::compare_stereo_photos(&first, &second, bg, out.as_deref())?
+        }
         Some(second) => {
             let bg = background.as_deref().map(parse_rgb).transpose()?;
             vec![compare::compare_images(
@@ -126,7 +135,10 @@ pub fn run(args: CompareArgs) -> Result<()> {
 /// A file name with an image extension stereolab reads.
 fn is_image_name(path: &std::path::Path) -> bool {
     path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
-        ["png", "ppm", "pgm", "pbm", "pam", "pnm", "gif"].contains(&e.to_ascii_lowercase().as_str())
+        [
+            "png", "ppm", "pgm", "pbm", "pam", "pnm", "gif", "mpo", "jps", "pns",
+        ]
+        .contains(&e.to_ascii_lowercase().as_str())
     })
 }
 

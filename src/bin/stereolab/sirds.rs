@@ -3,7 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use stereolab::effects::sirds::decode::{DecodeOptions, decode, depth_from_separation};
+use stereolab::effects::sirds::decode::depth_from_separation;
+use stereolab::effects::sirds::depthfile::Near;
 use stereolab::effects::sirds::{DepthMap, Settings, SirdsSpec, from_depth_map};
 use stereolab::output::animate::{AnimationOptions, animate};
 use stereolab::output::sirds::{from_frame, save, stream_depth_map};
@@ -16,10 +17,14 @@ use stereolab::{Error, Result};
 pub struct SirdsArgs {
     /// Scene file (TOML): its geometry and `[sirds]` table.
     pub scene: Option<PathBuf>,
-    /// Make a SIRDS of this depth-map image instead (white = near; PNG, PGM, ...) with the
-    /// per-pixel algorithm.
+    /// Make a SIRDS of this depth-map image instead with the per-pixel algorithm: 8- or 16-bit
+    /// PNG, netpbm PGM/PPM/PAM (full scale: v / max), or float PFM (its own min..max).
     #[arg(long, conflicts_with = "scene")]
     pub depth: Option<PathBuf>,
+    /// With --depth: which values are near, `white` (larger; netpbm, stereolab) or `black`
+    /// (smaller; distance maps, Z-buffers).
+    #[arg(long, default_value = "white", value_parser = ["white", "black"], requires = "depth")]
+    pub near: String,
     /// Decode this autostereogram: write the depth it encodes to --out and say whether it is
     /// one at all.
     #[arg(long, conflicts_with_all = ["scene", "depth"])]
@@ -38,6 +43,10 @@ pub struct SirdsArgs {
     /// Animation: keep one random-dot seed in every frame (default: a new pattern per frame).
     #[arg(long, requires = "frames")]
     pub fixed_seed: bool,
+    /// With --decode: also write the views the viewer's eyes see (left.png, right.png) and a
+    /// red–cyan anaglyph of them (anaglyph.png) into this folder.
+    #[arg(long, requires = "decode", value_name = "DIR")]
+    pub pair: Option<PathBuf>,
 }
 
 /// Settings from `--set sirds.key=value` alone (no scene file).
@@ -99,88 +108,28 @@ fn report(args: &SirdsArgs) -> Result<String> {
         (None, None) => PathBuf::from("sirds.png"),
     };
     if let Some(path) = &args.decode {
-        let settings = settings_from_sets(&args.sets)?;
-        let img = stereolab::framebuffer::open_image(path, "image")?.to_rgba8();
-        let (w, h) = img.dimensions();
-        let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
-        let d = settings.geometry.to_pixels()?;
-        let decoded = super::with_spinner(&format!("decoding {}", path.display()), || {
-            decode(&pixels, w, h, &DecodeOptions::for_disparity(&d))
-        })
-        .map_err(|e| e.in_file(path))?;
-        let z: Vec<f32> = depth_from_separation(&decoded, &d)
-            .into_iter()
-            .map(|z| {
-                if z.is_finite() {
-                    z.clamp(0.0, 1.0)
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let depth = DepthMap {
-            width: w,
-            height: h,
-            z,
-        }
-        .to_image();
-        let format = image::ImageFormat::from_path(&out)
-            .map_err(|e| Error::invalid("--out", out.display(), format!("no image format: {e}")))?;
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        let encoded = if format == image::ImageFormat::Pnm {
-            // The image crate would pick PAM for 16-bit gray: a .ppm gets binary P6 (8-bit gray
-            // in RGB), a .pgm binary P5 at 16 bits, as netpbm writes them.
-            use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
-            if has_extension(&out, &["pgm"]) {
-                // P5 with maxval 65535: two bytes a sample, most significant first (netpbm).
-                let (w, h) = depth.dimensions();
-                let b = bytes.get_mut();
-                b.extend_from_slice(format!("P5\n{w} {h}\n65535\n").as_bytes());
-                b.extend(depth.as_raw().iter().flat_map(|v| v.to_be_bytes()));
-                Ok(())
-            } else {
-                let sub = PnmSubtype::Pixmap(SampleEncoding::Binary);
-                image::DynamicImage::ImageLuma16(depth)
-                    .into_rgb8()
-                    .write_with_encoder(PnmEncoder::new(&mut bytes).with_subtype(sub))
-            }
-        } else {
-            image::DynamicImage::ImageLuma16(depth).write_to(&mut bytes, format)
-        };
-        encoded.map_err(|e| Error::invalid("--out", out.display(), e.to_string()))?;
-        stereolab::files::write_bytes(&out, bytes.get_ref())?;
-        return Ok(format!(
-            "{}: {:.1}% of pixels matched a separation in {}..={} px: {}\n  wrote {}\n",
-            path.display(),
-            decoded.matched_share * 100.0,
-            (d.min_separation().floor() as u32).saturating_sub(2),
-            d.max_separation().ceil() as u32 + 2,
-            if decoded.is_autostereogram() {
-                "an autostereogram"
-            } else {
-                "not an autostereogram (no consistent repetition)"
-            },
-            out.display()
-        ));
+        return decode_report(args, path, &out);
     }
     if let Some(path) = &args.depth {
         let settings = settings_from_sets(&args.sets)?;
+        let near = Near::parse(&args.near)?;
         let d = settings.geometry.to_pixels()?;
         let is_ppm = matches!(
             out.extension().and_then(|e| e.to_str()),
             Some("ppm" | "pnm")
         );
-        let (w, h) = super::with_spinner("making the autostereogram", || {
+        let (w, h, mapping) = super::with_spinner("making the autostereogram", || {
             if is_ppm && !settings.guide_dots {
-                stream_depth_map(path, &settings, &out)
+                stream_depth_map(path, near, &settings, &out)
             } else {
-                let sirds = from_depth_map(DepthMap::load(path)?, &settings)?;
+                let (map, mapping) = DepthMap::load_with(path, near)?;
+                let sirds = from_depth_map(map, &settings)?;
                 save(&sirds.pixels, sirds.width, sirds.height, &out)?;
-                Ok((sirds.width, sirds.height))
+                Ok((sirds.width, sirds.height, mapping))
             }
         })?;
         return Ok(format!(
-            "per-pixel SIRDS of {} ({w}x{h}), separations {:.1}..{:.1} px\n  wrote {}\n",
+            "per-pixel SIRDS of {} ({w}x{h}), separations {:.1}..{:.1} px\n  depth map {mapping}\n  wrote {}\n",
             path.display(),
             d.min_separation(),
             d.max_separation(),
@@ -228,4 +177,189 @@ fn report(args: &SirdsArgs) -> Result<String> {
             .unwrap_or_default(),
         out.display()
     ))
+}
+
+/// `stereolab sirds --decode`: searches the full plausible separation range, decodes, writes
+/// the depth (and with `--pair` the two views and their anaglyph); returns the report.
+fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
+    use stereolab::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
+    use stereolab::effects::sirds::decode::{decode_auto, nearness_linear};
+    use stereolab::effects::sirds::pair::views;
+    use stereolab::effects::sirds::search::SearchOptions;
+
+    let settings = settings_from_sets(&args.sets)?;
+    let img = stereolab::framebuffer::open_image(path, "image")?.to_rgba8();
+    let (w, h) = img.dimensions();
+    let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    let auto = super::with_spinner(&format!("decoding {}", path.display()), || {
+        decode_auto(&pixels, w, h, &SearchOptions::default())
+    })
+    .map_err(|e| e.in_file(path))?;
+    let search = &auto.search;
+    let mut report = format!(
+        "{}: searched separations {}..={} px",
+        path.display(),
+        search.searched.0,
+        search.searched.1
+    );
+    if search.strips.0 < search.strips.1 {
+        report += &format!(
+            " in {} of its {} strips of 7 rows (the work budget)",
+            search.strips.0, search.strips.1
+        );
+    }
+    let (Some(decoded), Some((lo, hi))) = (&auto.decoded, search.found) else {
+        return Err(Error::invalid(
+            "--decode",
+            path.display(),
+            format!(
+                "{report}: only {:.1}% of the image repeats, in no region consistently: not an autostereogram (no consistent repetition), nothing written",
+                search.matched_share * 100.0
+            ),
+        ));
+    };
+    // The regions that made the range (not those left out as harmonics).
+    let dominant: Vec<u32> = search
+        .regions
+        .iter()
+        .map(|r| r.dominant)
+        .filter(|d| (lo..=hi).contains(d))
+        .collect();
+    report += &format!(
+        "\n  found {lo}..={hi} px (dominant repeat per region: {}..={} px in {} regions)\n",
+        dominant.iter().min().copied().unwrap_or(lo),
+        dominant.iter().max().copied().unwrap_or(hi),
+        dominant.len()
+    );
+    // Depth: through the viewing model when the user named the set-up (--set), else linear
+    // in the range found (near repeats sooner when wall-eyed, later when cross-eyed).
+    let z: Vec<f32> = if args.sets.is_empty() {
+        let (near, far) = if settings.cross_eyed {
+            (hi as f32, lo as f32)
+        } else {
+            (lo as f32, hi as f32)
+        };
+        report += &format!(
+            "  depth: linear in separation, {near} px = white (near) .. {far} px = black (far)\n"
+        );
+        nearness_linear(decoded, near, far)
+    } else {
+        let d = settings.geometry.to_pixels()?;
+        report += &format!(
+            "  depth: through the {:?} model of the --set viewing set-up ({:.1}..{:.1} px){}\n",
+            d.model,
+            d.min_separation(),
+            d.max_separation(),
+            if settings.cross_eyed {
+                ", cross-eyed"
+            } else {
+                ""
+            }
+        );
+        depth_from_separation(decoded, &d)
+            .into_iter()
+            .map(|z| if settings.cross_eyed { 1.0 - z } else { z })
+            .collect()
+    };
+    let z = z
+        .into_iter()
+        .map(|z| {
+            if z.is_finite() {
+                z.clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    write_depth(
+        &DepthMap {
+            width: w,
+            height: h,
+            z,
+        },
+        out,
+    )?;
+    report += &format!(
+        "  {:.1}% of pixels matched a separation in {}..={} px: {}\n  wrote {}\n",
+        decoded.matched_share * 100.0,
+        auto.options.map_or(lo, |o| o.min_separation),
+        auto.options.map_or(hi, |o| o.max_separation),
+        if auto.is_autostereogram() {
+            "an autostereogram"
+        } else {
+            "not an autostereogram (no consistent repetition)"
+        },
+        out.display()
+    );
+    if let Some(dir) = &args.pair {
+        let v = views(&pixels, decoded, settings.cross_eyed)?;
+        let fb = |color: Vec<[u8; 4]>| -> Result<stereolab::framebuffer::Framebuffer> {
+            let mut fb = stereolab::framebuffer::Framebuffer::new(w, h, [0, 0, 0, 255])?;
+            fb.color = color;
+            Ok(fb)
+        };
+        let (left, right) = (fb(v.left)?, fb(v.right)?);
+        let ana = anaglyph(
+            &left,
+            &right,
+            AnaglyphKind::DuboisRedCyan,
+            AnaglyphOptions::default(),
+        )?;
+        let names = [
+            dir.join("left.png"),
+            dir.join("right.png"),
+            dir.join("anaglyph.png"),
+        ];
+        for p in &names {
+            stereolab::files::check_output_path(p)?;
+        }
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        stereolab::files::write_png(&names[0], &left.to_rgba_image())?;
+        stereolab::files::write_png(&names[1], &right.to_rgba_image())?;
+        stereolab::files::write_png(&names[2], &ana)?;
+        report += &format!(
+            "  stereo pair ({} viewing, background at zero parallax: {:.1} px)\n",
+            if settings.cross_eyed {
+                "cross-eyed"
+            } else {
+                "wall-eyed"
+            },
+            v.zero_parallax_separation
+        );
+        for p in names {
+            report += &format!("  wrote {}\n", p.display());
+        }
+    }
+    Ok(report)
+}
+
+/// Writes a decoded depth map (white = near) as `out`'s extension asks: PNG (16-bit), a .pgm
+/// as netpbm's binary P5 at 16 bits, a .ppm as binary P6 (8-bit gray in RGB).
+fn write_depth(map: &DepthMap, out: &Path) -> Result<()> {
+    let depth = map.to_image();
+    let format = image::ImageFormat::from_path(out)
+        .map_err(|e| Error::invalid("--out", out.display(), format!("no image format: {e}")))?;
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    let encoded = if format == image::ImageFormat::Pnm {
+        // The image crate would pick PAM for 16-bit gray: a .ppm gets binary P6 (8-bit gray
+        // in RGB), a .pgm binary P5 at 16 bits, as netpbm writes them.
+        use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
+        if has_extension(out, &["pgm"]) {
+            // P5 with maxval 65535: two bytes a sample, most significant first (netpbm).
+            let (w, h) = depth.dimensions();
+            let b = bytes.get_mut();
+            b.extend_from_slice(format!("P5\n{w} {h}\n65535\n").as_bytes());
+            b.extend(depth.as_raw().iter().flat_map(|v| v.to_be_bytes()));
+            Ok(())
+        } else {
+            let sub = PnmSubtype::Pixmap(SampleEncoding::Binary);
+            image::DynamicImage::ImageLuma16(depth)
+                .into_rgb8()
+                .write_with_encoder(PnmEncoder::new(&mut bytes).with_subtype(sub))
+        }
+    } else {
+        image::DynamicImage::ImageLuma16(depth).write_to(&mut bytes, format)
+    };
+    encoded.map_err(|e| Error::invalid("--out", out.display(), e.to_string()))?;
+    stereolab::files::write_bytes(out, bytes.get_ref())
 }

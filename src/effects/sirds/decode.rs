@@ -5,6 +5,7 @@
 use rayon::prelude::*;
 
 use super::disparity::Disparity;
+use super::search::{Search, SearchOptions};
 use crate::error::{Error, Result};
 
 /// Decoder settings.
@@ -277,5 +278,90 @@ pub fn depth_from_separation(decoded: &Decoded, d: &Disparity) -> Vec<f32> {
         .separation
         .iter()
         .map(|&s| d.nearness_of_separation(s))
+        .collect()
+}
+
+/// An autostereogram decoded without knowing its viewing set-up: the separations found by
+/// [`search`](super::search::search), then [`decode`] over that range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AutoDecoded {
+    /// What the search over the full plausible range found.
+    pub search: Search,
+    /// The decoder's options over the range found (`None` when nothing repeats).
+    pub options: Option<DecodeOptions>,
+    /// The decoded separations (`None` when nothing repeats).
+    pub decoded: Option<Decoded>,
+}
+
+impl AutoDecoded {
+    /// Share of pixels matched: the decoder's where it ran, else the search's.
+    pub fn matched_share(&self) -> f64 {
+        self.decoded
+            .as_ref()
+            .map_or(self.search.matched_share, |d| d.matched_share)
+    }
+
+    /// Whether the image is an autostereogram: the search found a range and the decoder
+    /// matched at least [`AUTOSTEREOGRAM_SHARE`] of the pixels in it.
+    pub fn is_autostereogram(&self) -> bool {
+        self.decoded
+            .as_ref()
+            .is_some_and(Decoded::is_autostereogram)
+    }
+}
+
+/// Finds the separations of `pixels` (row-major RGBA) over the full plausible range
+/// ([`search`](super::search::search): a few pixels to a third of the width, bounded cost),
+/// then decodes in quarter pixels over the range found, widened by 2 px on each side.
+///
+/// # Errors
+/// As [`search`](super::search::search) and [`decode`].
+pub fn decode_auto(
+    pixels: &[[u8; 4]],
+    width: u32,
+    height: u32,
+    opts: &SearchOptions,
+) -> Result<AutoDecoded> {
+    let search = super::search::search(pixels, width, height, opts)?;
+    let Some((lo, hi)) = search.found else {
+        return Ok(AutoDecoded {
+            search,
+            options: None,
+            decoded: None,
+        });
+    };
+    let margin = 2;
+    let options = DecodeOptions {
+        min_separation: lo.saturating_sub(margin).max(1),
+        max_separation: (hi + margin).min(width - 1),
+        half_width: 3,
+        half_height: 3,
+        max_cost_ratio: opts.max_cost_ratio,
+    };
+    let decoded = decode(pixels, width, height, &options)?;
+    Ok(AutoDecoded {
+        search,
+        options: Some(options),
+        decoded: Some(decoded),
+    })
+}
+
+/// Nearness from separation without a viewing model: linear between the separations
+/// `near` (nearness 1) and `far` (nearness 0), clamped; `NaN` stays `NaN`. For a wall-eyed
+/// autostereogram `near < far` (near points repeat sooner), for a cross-eyed one `near > far`.
+/// One separation only (`near == far`): a flat picture, all background (0).
+pub fn nearness_linear(decoded: &Decoded, near: f32, far: f32) -> Vec<f32> {
+    decoded
+        .separation
+        .iter()
+        .map(|&s| {
+            if s.is_nan() {
+                s
+            } else if far == near {
+                0.0
+            } else {
+                ((far - s) / (far - near)).clamp(0.0, 1.0)
+            }
+        })
         .collect()
 }

@@ -8,6 +8,8 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::framebuffer::{Framebuffer, check_size};
 
+pub use super::depthfile::{DepthMapping, DepthSamples, Near};
+
 /// Normalized nearness per pixel, row 0 at the top: 0 = background plane (far), 1 = front of
 /// the depth range (TIW's `Z`; in image files white is near, as for netpbm's `pamstereogram`).
 #[derive(Clone, Debug, PartialEq)]
@@ -152,20 +154,23 @@ impl DepthMap {
         Ok(DepthMap { width, height, z })
     }
 
-    /// Reads a grayscale (or color: its luma) image, white = near: `z = value / max`.
+    /// Reads a depth-map file, white = near (see [`DepthSamples::load`]).
     ///
     /// # Errors
-    /// The file cannot be read or decoded, or has a zero side.
+    /// As [`DepthSamples::load`].
     pub fn load(path: &Path) -> Result<DepthMap> {
-        let img = crate::framebuffer::open_image(path, "depth map")?;
-        let gray = img.to_luma16();
-        let (w, h) = gray.dimensions();
-        let z = gray
-            .into_raw()
-            .iter()
-            .map(|&v| v as f32 / 65535.0)
-            .collect();
-        DepthMap::new(w, h, z).map_err(|e| e.in_file(path))
+        Ok(DepthMap::load_with(path, Near::White)?.0)
+    }
+
+    /// Reads a depth-map file with either end near, and says how its values were mapped.
+    ///
+    /// # Errors
+    /// As [`DepthSamples::load`].
+    pub fn load_with(path: &Path, near: Near) -> Result<(DepthMap, DepthMapping)> {
+        let d = DepthSamples::load(path, near)?;
+        let z = d.samples.iter().map(|&v| v as f32 / 65535.0).collect();
+        let map = DepthMap::new(d.width, d.height, z).map_err(|e| e.in_file(path))?;
+        Ok((map, d.mapping))
     }
 
     /// The nearness of a rendered depth buffer: covered pixels by their eye-space distance,

@@ -15,10 +15,13 @@
 //! - a rotating model as an animated GIF: [`output::animate`](crate::output::animate).
 
 pub mod decode;
+pub mod depthfile;
 pub mod depthmap;
 pub mod disparity;
+pub mod pair;
 pub mod pattern;
 pub mod per_pixel;
+pub mod search;
 pub mod settings;
 
 pub use depthmap::{DepthMap, DepthRange};

@@ -1,0 +1,352 @@
+//! Depth maps from other tools: 8- and 16-bit PNG, netpbm PGM/PPM/PAM, float PFM, with white
+//! or black meaning near.
+//!
+//! # Range mapping
+//!
+//! Every file becomes normalized nearness `z` ∈ [0, 1] (1 = front of the depth range,
+//! 0 = the background plane; see [`DepthMap`](super::DepthMap)):
+//!
+//! - **Integer images** (PNG, PGM, PPM, PAM at any bit depth; color ones by their luma):
+//!   the format's full scale, `z = v / max` where `max` is 255, 65535 or the netpbm maxval
+//!   (the image crate rescales a netpbm maxval to 8 or 16 bits). The full scale keeps a map's
+//!   absolute depths: a map that never reaches white never reaches the front, as in netpbm's
+//!   `pamstereogram`. With `--near black`, `z = 1 − v / max`.
+//! - **PFM** (floats have no full scale): the file's own finite range, `z = (v − min) /
+//!   (max − min)` (white: larger values nearer), `z = (max − v) / (max − min)` with `--near
+//!   black` (for maps of distance, where larger is farther). Infinite and NaN samples (a
+//!   renderer's "no hit") are the background, `z = 0`. A map of one value is all background.
+//!
+//! Samples are kept as 16-bit nearness (`round(z · 65535)`): 1/65535 of the range is far
+//! below one pixel of separation, and a 4096 × 3072 map takes 25 MB, not 50.
+//!
+//! # PFM
+//!
+//! The Portable Float Map as Netpbm's `pfm` documentation and Paul Debevec's HDRShop define it:
+//! a text header of three whitespace-separated tokens, `PF` (three channels) or `Pf` (one),
+//! `width height`, and a scale whose sign gives the byte order (negative: little-endian,
+//! positive: big-endian; its magnitude is not used here), each ended by one whitespace byte;
+//! then `width · height · channels` IEEE-754 32-bit floats, rows from the **bottom** of the
+//! image to the top, left to right, channels interleaved.
+
+use std::fmt;
+use std::io::Read as _;
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::framebuffer::{MAX_IMAGE_PIXELS, check_size};
+
+/// Which end of a depth map's values is near.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Near {
+    /// Larger values (white) are nearer: netpbm, stereolab's own `sirds_depth`, most
+    /// autostereogram tools.
+    #[default]
+    White,
+    /// Smaller values (black) are nearer: distance maps, Z-buffers.
+    Black,
+}
+
+impl Near {
+    /// Parses `white` or `black`.
+    ///
+    /// # Errors
+    /// `Invalid` naming `--near` and the two accepted words.
+    pub fn parse(text: &str) -> Result<Near> {
+        match text {
+            "white" => Ok(Near::White),
+            "black" => Ok(Near::Black),
+            other => Err(Error::invalid(
+                "--near",
+                other,
+                "must be white (larger values near) or black (smaller values near)",
+            )),
+        }
+    }
+}
+
+/// How a file's values became nearness: what `stereolab sirds --depth` prints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DepthMapping {
+    /// The file's format in words, e.g. `8-bit gray PNG`.
+    pub format: String,
+    /// The value mapped to the background (`z = 0`).
+    pub far_value: f64,
+    /// The value mapped to the front (`z = 1`).
+    pub near_value: f64,
+    /// Whether `far_value`..`near_value` is the format's full scale (integers) or the file's
+    /// own range (floats).
+    pub full_scale: bool,
+    /// The smallest and largest (finite) values the file holds.
+    pub found: (f64, f64),
+    /// Samples that were not finite (PFM only), mapped to the background.
+    pub non_finite: usize,
+}
+
+impl fmt::Display for DepthMapping {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}: {} → background (z = 0) .. {} → front (z = 1), linear ({}); the file holds {}..{}",
+            self.format,
+            self.far_value,
+            self.near_value,
+            if self.full_scale {
+                "the format's full scale"
+            } else {
+                "the file's own range"
+            },
+            self.found.0,
+            self.found.1
+        )?;
+        if self.non_finite > 0 {
+            write!(f, ", {} non-finite samples as background", self.non_finite)?;
+        }
+        Ok(())
+    }
+}
+
+/// A depth map read from a file as 16-bit nearness.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DepthSamples {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Row-major nearness, `round(z · 65535)`, row 0 at the top.
+    pub samples: Vec<u16>,
+    /// How the file's values were mapped.
+    pub mapping: DepthMapping,
+}
+
+/// The largest PFM header accepted, bytes (three short tokens).
+const MAX_PFM_HEADER: usize = 256;
+
+impl DepthSamples {
+    /// Reads a depth map: PFM by its `PF`/`Pf` magic, anything else through the image crate
+    /// (PNG, PGM/PPM/PAM, ...). Sizes are checked from the header before anything is
+    /// allocated.
+    ///
+    /// # Errors
+    /// `Io` when the file cannot be read; `Parse` naming the file for a broken or truncated
+    /// header or body, an oversized image, or a format the image crate cannot read.
+    pub fn load(path: &Path, near: Near) -> Result<DepthSamples> {
+        crate::files::check_input(path)?;
+        let mut head = Vec::with_capacity(MAX_PFM_HEADER);
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_PFM_HEADER as u64).read_to_end(&mut head))
+            .map_err(|e| Error::io(path, e))?;
+        if head.starts_with(b"PF") || head.starts_with(b"Pf") {
+            return load_pfm(path, &head, near);
+        }
+        load_integer(path, near)
+    }
+}
+
+fn load_integer(path: &Path, near: Near) -> Result<DepthSamples> {
+    let img = crate::framebuffer::open_image(path, "depth map")?;
+    let (width, height) = (img.width(), img.height());
+    check_size(width, height).map_err(|e| e.in_file(path))?;
+    let kind = if img.color().has_color() {
+        "color (its luma)"
+    } else {
+        "gray"
+    };
+    let bits = img.color().bits_per_pixel() / u16::from(img.color().channel_count());
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("image")
+        .to_ascii_uppercase();
+    let (mut samples, max): (Vec<u16>, u16) = match img {
+        image::DynamicImage::ImageLuma8(g) => {
+            (g.into_raw().into_iter().map(u16::from).collect(), 255)
+        }
+        other if bits <= 8 => (
+            other
+                .to_luma8()
+                .into_raw()
+                .into_iter()
+                .map(u16::from)
+                .collect(),
+            255,
+        ),
+        other => (other.to_luma16().into_raw(), 65535),
+    };
+    let (lo, hi) = samples
+        .iter()
+        .fold((u16::MAX, 0u16), |(a, b), &v| (a.min(v), b.max(v)));
+    // v / max as 16-bit nearness: 8-bit v · 257 is exactly v / 255 of 65535.
+    let scale = 65535 / max;
+    for v in &mut samples {
+        let z = *v * scale;
+        *v = if near == Near::Black { 65535 - z } else { z };
+    }
+    let (far_value, near_value) = match near {
+        Near::White => (0.0, f64::from(max)),
+        Near::Black => (f64::from(max), 0.0),
+    };
+    Ok(DepthSamples {
+        width,
+        height,
+        samples,
+        mapping: DepthMapping {
+            format: format!("{bits}-bit {kind} {ext}"),
+            far_value,
+            near_value,
+            full_scale: true,
+            found: (f64::from(lo), f64::from(hi)),
+            non_finite: 0,
+        },
+    })
+}
+
+/// The PFM header: channels, width, height, little-endian, and its length in bytes.
+fn pfm_header(path: &Path, head: &[u8]) -> Result<(usize, u32, u32, bool, usize)> {
+    let bad = |what: String| Error::parse(path, None, format!("PFM header: {what}"));
+    // Three tokens, each ended by one whitespace byte.
+    let mut tokens: Vec<&str> = Vec::new();
+    let mut pos = 0;
+    while tokens.len() < 4 {
+        while pos < head.len() && head[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while pos < head.len() && !head[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        if pos >= head.len() {
+            return Err(bad(format!(
+                "expected `PF|Pf width height scale` in the first {MAX_PFM_HEADER} bytes"
+            )));
+        }
+        tokens.push(std::str::from_utf8(&head[start..pos]).map_err(|_| bad("not text".into()))?);
+    }
+    let body = pos + 1; // the single whitespace byte after the scale
+    let channels = match tokens[0] {
+        "PF" => 3,
+        "Pf" => 1,
+        other => {
+            return Err(bad(format!(
+                "magic {other:?}, want PF (color) or Pf (gray)"
+            )));
+        }
+    };
+    let side = |t: &str, name: &str| {
+        t.parse::<u32>()
+            .map_err(|_| bad(format!("{name} {t:?} is not a whole number")))
+    };
+    let (w, h) = (side(tokens[1], "width")?, side(tokens[2], "height")?);
+    let scale: f32 = tokens[3]
+        .parse()
+        .map_err(|_| bad(format!("scale {:?} is not a number", tokens[3])))?;
+    if scale == 0.0 || !scale.is_finite() {
+        return Err(bad(format!(
+            "scale {scale} must be a non-zero number (its sign is the byte order)"
+        )));
+    }
+    Ok((channels, w, h, scale < 0.0, body))
+}
+
+fn load_pfm(path: &Path, head: &[u8], near: Near) -> Result<DepthSamples> {
+    let (channels, width, height, little, body) = pfm_header(path, head)?;
+    check_size(width, height).map_err(|e| e.in_file(path))?;
+    let n = width as usize * height as usize;
+    debug_assert!(n as u64 <= MAX_IMAGE_PIXELS);
+    let want = body + n * channels * 4;
+    let size = crate::files::check_input(path)?;
+    let bytes = if size == want as u64 {
+        crate::files::read_input(path, want as u64)?
+    } else {
+        Vec::new()
+    };
+    if bytes.len() != want {
+        return Err(Error::parse(
+            path,
+            None,
+            format!(
+                "PFM body: {} bytes, a {width}x{height} {}-channel map needs {}",
+                size.saturating_sub(body as u64),
+                channels,
+                want - body
+            ),
+        ));
+    }
+    let value = |i: usize| {
+        let b: [u8; 4] = bytes[body + 4 * i..body + 4 * i + 4]
+            .try_into()
+            .expect("4 bytes");
+        if little {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        }
+    };
+    // Rec. 709 luma, as the image crate weighs color.
+    let sample = |i: usize| {
+        if channels == 1 {
+            value(i)
+        } else {
+            0.2126 * value(3 * i) + 0.7152 * value(3 * i + 1) + 0.0722 * value(3 * i + 2)
+        }
+    };
+    let (mut lo, mut hi, mut non_finite) = (f32::INFINITY, f32::NEG_INFINITY, 0usize);
+    for i in 0..n {
+        let v = sample(i);
+        if v.is_finite() {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        } else {
+            non_finite += 1;
+        }
+    }
+    let span = hi - lo;
+    // No finite sample, or a map of one value: all background.
+    let flat = span.is_nan() || span <= 0.0;
+    let (w, h) = (width as usize, height as usize);
+    let mut samples = vec![0u16; n];
+    for (y, row) in samples.chunks_exact_mut(w).enumerate() {
+        // PFM rows run from the bottom up.
+        let src = (h - 1 - y) * w;
+        for (x, out) in row.iter_mut().enumerate() {
+            let v = sample(src + x);
+            let z = if !v.is_finite() || flat {
+                0.0
+            } else if near == Near::White {
+                (v - lo) / span
+            } else {
+                (hi - v) / span
+            };
+            *out = (z.clamp(0.0, 1.0) * 65535.0).round() as u16;
+        }
+    }
+    let (lo, hi) = if lo <= hi {
+        (f64::from(lo), f64::from(hi))
+    } else {
+        (0.0, 0.0)
+    };
+    let (far_value, near_value) = match near {
+        Near::White => (lo, hi),
+        Near::Black => (hi, lo),
+    };
+    Ok(DepthSamples {
+        width,
+        height,
+        samples,
+        mapping: DepthMapping {
+            format: format!(
+                "32-bit float {} PFM ({}-endian)",
+                if channels == 1 {
+                    "gray"
+                } else {
+                    "color (its luma)"
+                },
+                if little { "little" } else { "big" }
+            ),
+            far_value,
+            near_value,
+            full_scale: false,
+            found: (lo, hi),
+            non_finite,
+        },
+    })
+}
