@@ -140,6 +140,24 @@ fn decks_show_every_figure_and_only_existing_ones() {
         }
     }
     assert!(slides >= 60, "{slides} slides in all, want at least 60");
+    // Every exercise task is introduced on a slide: its stub's name appears in a deck.
+    let all_decks: String = decks
+        .iter()
+        .map(|d| std::fs::read_to_string(d).expect("deck"))
+        .collect();
+    let exercises = crate::common::root().join("exercises");
+    for ex in ["ex1_stereo", "ex2_chromadepth", "ex3_sirds"] {
+        let stubs =
+            std::fs::read_to_string(exercises.join(ex).join("src/stubs.rs")).expect("stubs");
+        for line in stubs.lines().filter(|l| l.starts_with("pub fn ")) {
+            let name = &line[7..line.find('(').expect("fn name")];
+            assert!(
+                all_decks.contains(&format!("`{name}`"))
+                    || all_decks.contains(&format!("::{name}`")),
+                "exercise task {ex}::{name} is introduced on no slide"
+            );
+        }
+    }
     for f in stereolab::figures::all() {
         assert!(
             shown.contains(&format!("{}.png", f.name)),

@@ -276,14 +276,31 @@ impl Canvas {
         );
     }
 
-    /// The figure as PNG bytes.
+    /// The figure as PNG bytes: opaque RGB, best compression with adaptive filters (the
+    /// figures live in the repository, so a smaller file is worth the encoder's time;
+    /// deterministic, byte for byte).
     ///
     /// # Errors
     /// The encoder fails (a bug).
     pub fn png(&self) -> Result<Vec<u8>> {
-        self.pm
-            .encode_png()
-            .map_err(|e| Error::internal("figure PNG", e.to_string()))
+        use image::ImageEncoder;
+        use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+        let rgb: Vec<u8> = self
+            .pm
+            .data()
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        let mut out = Vec::new();
+        PngEncoder::new_with_quality(&mut out, CompressionType::Best, FilterType::Adaptive)
+            .write_image(
+                &rgb,
+                self.pm.width(),
+                self.pm.height(),
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(|e| Error::internal("figure PNG", e.to_string()))?;
+        Ok(out)
     }
 
     /// The page as an RGBA image (the tests read figures back this way).

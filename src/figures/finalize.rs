@@ -315,7 +315,7 @@ pub fn remap_occlusion(ctx: &Context) -> Result<Canvas> {
     let outs = [Output::Left, Output::RemapLeft, Output::Occlusion];
     let (s, frame) = rendered(ctx.scene, 200, 150, &outs, |_| {})?;
     let occ = image_of(Output::Occlusion, &frame, &s)?;
-    let cells = vec![
+    let cells = [
         ("left eye".to_string(), image_of(Output::Left, &frame, &s)?),
         (
             "remap_left: from the right eye".to_string(),

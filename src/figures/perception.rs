@@ -12,7 +12,7 @@ use crate::plan::{Output, View};
 use crate::scene::Scene;
 use crate::text::Align;
 
-/// The curve [`parallax_vs_depth`] draws: `steps + 1` points `(z, p)` from near to far, `p` the
+/// The curve of the `parallax_vs_depth` figure: `steps + 1` points `(z, p)` from near to far, `p` the
 /// screen parallax of a point at eye distance z in percent of the image width. It is the
 /// renderer's own `p(z) = d·(b − z0/z)` ([`ParallaxRig::parallax`], balance b and parallel
 /// axes included), never a copy of the formula.
@@ -308,18 +308,21 @@ pub fn parallax_map(ctx: &Context) -> Result<Canvas> {
         .view(View::Left)
         .ok_or_else(|| Error::internal("figures", "no left pass"))?;
     let b = budget_of(fb, &s.parallax_rig()?)?;
-    let mut c = Canvas::new(img.width() + 20, img.height() + 56)?;
-    c.image(&img, 10, 10, 1);
+    let caption = format!(
+        "measured: {:+.2}% … {:+.2}% of the width; {:.1}% of pixels beyond ±3%",
+        b.percent(b.min_pixels),
+        b.percent(b.max_pixels),
+        100.0 * b.share_beyond()
+    )
+    .replace('-', "−");
+    let width = (crate::text::width(&caption, SMALL).ceil() as u32 + 24).max(img.width() + 20);
+    let mut c = Canvas::new(width, img.height() + 40)?;
+    c.image(&img, (width - img.width()) / 2, 10, 1);
     c.text(
         c.width() / 2.0,
         img.height() as f32 + 16.0,
         SMALL,
-        &format!(
-            "measured: {:+.2}% … {:+.2}% of the width; {:.1}% of pixels beyond ±3%",
-            b.percent(b.min_pixels),
-            b.percent(b.max_pixels),
-            100.0 * b.share_beyond()
-        ),
+        &caption,
         INK,
         Align::Center,
     );

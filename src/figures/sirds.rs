@@ -252,8 +252,9 @@ pub fn passes(ctx: &Context) -> Result<Canvas> {
     for i in 0..r.iterations {
         let x = (x0 + i * r.strip_width) as f32;
         c.line((x, 30.0), (x, 30.0 + s.height as f32), (255, 200, 0), 1.5);
+        let width = r.strip_width.min(s.width - i * r.strip_width);
         c.boxed_text(
-            x + r.strip_width as f32 / 2.0,
+            x + width as f32 / 2.0,
             34.0,
             SMALL,
             &format!("{}", i + 1),
