@@ -36,10 +36,55 @@ pub fn width(text: &str, size: f32) -> f32 {
 /// Draws `text` with its top-left corner at `(x, y)`, `size` pixels high, in `color`, onto
 /// `img` (pixels outside the image are skipped).
 pub fn draw(img: &mut RgbaImage, x: f32, y: f32, size: f32, text: &str, color: [u8; 3]) {
+    let (w, h) = img.dimensions();
+    draw_rgba(img.as_mut(), w, h, x, y, size, text, color, false);
+}
+
+/// How a label sits on its point: by its left edge, its center or its right edge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Align {
+    /// The point is the label's left edge.
+    Left,
+    /// The point is the label's horizontal center.
+    Center,
+    /// The point is the label's right edge.
+    Right,
+}
+
+/// Draws `text` onto an opaque RGBA8 buffer of `width`×`height` pixels (row-major, 4 bytes a
+/// pixel; a tiny-skia `Pixmap`'s data is one when every pixel is opaque, as a figure's white
+/// page is). `(x, y)` is the top-left corner of the text box; with `vertical` the text reads
+/// bottom to top (a y-axis label) and `(x, y)` is the top-left corner of the rotated box, which
+/// is `size · 1.2` wide and [`width`] high.
+#[allow(clippy::too_many_arguments)]
+pub fn draw_rgba(
+    buf: &mut [u8],
+    width: u32,
+    height: u32,
+    x: f32,
+    y: f32,
+    size: f32,
+    text: &str,
+    color: [u8; 3],
+    vertical: bool,
+) {
     let font = font();
     let scaled = font.as_scaled(PxScale::from(size));
-    let baseline = y + scaled.ascent();
-    let mut caret = x;
+    // Glyphs are laid out from (0, 0) and mapped onto the buffer by `place`: unrotated, or
+    // turned a quarter counter-clockwise (text x runs up the page).
+    let run = self::width(text, size);
+    let place = |gx: i64, gy: i64| -> (i64, i64) {
+        if vertical {
+            (
+                x.round() as i64 + gy,
+                y.round() as i64 + run.ceil() as i64 - gx,
+            )
+        } else {
+            (x.round() as i64 + gx, y.round() as i64 + gy)
+        }
+    };
+    let baseline = scaled.ascent();
+    let mut caret = 0.0;
     let mut prev = None;
     for c in text.chars() {
         let id = scaled.glyph_id(c);
@@ -55,16 +100,21 @@ pub fn draw(img: &mut RgbaImage, x: f32, y: f32, size: f32, text: &str, color: [
         };
         let bounds = outlined.px_bounds();
         outlined.draw(|gx, gy, coverage| {
-            let px = bounds.min.x as i64 + i64::from(gx);
-            let py = bounds.min.y as i64 + i64::from(gy);
+            let (px, py) = place(
+                bounds.min.x as i64 + i64::from(gx),
+                bounds.min.y as i64 + i64::from(gy),
+            );
             let (Ok(px), Ok(py)) = (u32::try_from(px), u32::try_from(py)) else {
                 return;
             };
-            if px >= img.width() || py >= img.height() {
+            if px >= width || py >= height {
                 return;
             }
             let a = coverage.clamp(0.0, 1.0);
-            let p = img.get_pixel_mut(px, py);
+            let i = 4 * (py as usize * width as usize + px as usize);
+            let Some(p) = buf.get_mut(i..i + 4) else {
+                return;
+            };
             for k in 0..3 {
                 let v = f32::from(p[k]) * (1.0 - a) + f32::from(color[k]) * a;
                 p[k] = v.round() as u8;
@@ -113,6 +163,27 @@ mod tests {
                 (9..=11 + w as u32).contains(&x) && (10..=32).contains(&y),
                 "({x}, {y})"
             );
+        }
+    }
+
+    #[test]
+    fn vertical_text_is_the_horizontal_text_turned_a_quarter() {
+        let (size, text) = (16.0, "depth z");
+        let w = width(text, size).ceil() as u32;
+        let mut flat = vec![255u8; 4 * (w as usize + 4) * 24];
+        draw_rgba(&mut flat, w + 4, 24, 0.0, 0.0, size, text, [0, 0, 0], false);
+        let mut up = vec![255u8; 4 * 24 * (w as usize + 4)];
+        draw_rgba(&mut up, 24, w + 4, 0.0, 0.0, size, text, [0, 0, 0], true);
+        let ink = |b: &[u8]| b.chunks(4).filter(|p| p[0] < 128).count();
+        assert!(ink(&flat) > 60);
+        assert_eq!(ink(&flat), ink(&up));
+        // Flat pixel (gx, gy) lands at (gy, w − gx) when turned.
+        for gy in 0..24u32 {
+            for gx in 0..w {
+                let a = flat[4 * (gy * (w + 4) + gx) as usize];
+                let b = up[4 * ((w - gx) * 24 + gy) as usize];
+                assert_eq!(a, b, "({gx}, {gy})");
+            }
         }
     }
 }

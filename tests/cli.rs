@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use crate::common::{asset, out_dir};
+use crate::common::{asset, out_dir, root};
 
 fn stereolab(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_stereolab"))
@@ -263,23 +263,43 @@ fn scene_syntax_errors_and_unknown_fields_give_the_line() {
 }
 
 #[test]
-fn figures_draws_both_eyes_frusta_and_the_plot() {
+fn figures_draws_every_figure_and_names_a_missing_bench_file() {
     let dir = out_dir("cli_figures");
-    let out = stereolab(&["figures", &wuson(), "--out", dir.to_str().unwrap()]);
+    let bench = stereolab::figures::all();
+    let csv = root().join("slides/data/bench.csv");
+    let out = stereolab(&[
+        "figures",
+        &wuson(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--bench",
+        csv.to_str().unwrap(),
+    ]);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    for f in &bench {
+        assert!(dir.join(format!("{}.png", f.name)).is_file(), "{}", f.name);
+    }
     let top = image::open(dir.join("rig_off_axis.png"))
         .unwrap()
         .to_rgba8();
     let has = |rgb: [u8; 3]| top.pixels().any(|p| p.0[..3] == rgb);
     assert!(
-        has([220, 40, 40]) && has([20, 170, 200]),
+        has([210, 40, 40]) && has([20, 140, 190]),
         "left (red) and right (cyan) frusta must both be drawn"
     );
-    assert!(dir.join("parallax_vs_depth.png").exists() && dir.join("rig_toe_in.png").exists());
+    let err = fails(&[
+        "figures",
+        &wuson(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--bench",
+        dir.join("nope.csv").to_str().unwrap(),
+    ]);
+    assert!(err.contains("nope.csv"), "{err}");
 }
 
 #[test]

@@ -629,7 +629,10 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
     }
     // Everything the stubs and the handout's README cite is in the handout.
     for f in [
-        "slides/01-stereo-rig.md",
+        "slides/01-perception.md",
+        "slides/06-sirds.md",
+        "slides/figures/parallax_vs_depth.png",
+        "slides/README.md",
         "stereolab/README.md",
         "stereolab/docs/sources.md",
         "stereolab/docs/anaglyph-matrices.md",
@@ -637,6 +640,10 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
         "documents/course-copy.txt",
     ] {
         assert!(handout.join(f).is_file(), "{f} missing from the handout");
+    }
+    // The decks travel as sources: no local npm install or build.
+    for f in ["slides/node_modules", "slides/build"] {
+        assert!(!handout.join(f).exists(), "{f} copied into the handout");
     }
     // The documents are named by title, never by the team's file numbers ("seed 003").
     for f in files_under(&handout) {

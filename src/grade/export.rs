@@ -82,8 +82,12 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     copy_tree(&root.join("src"), &lib.join("src"), &|_| false)?;
     // The crate documentation includes docs/formulas.md, and the code cites the rest.
     copy_tree(&root.join("docs"), &lib.join("docs"), &|_| false)?;
-    // The slides the stubs cite, at the handout's top level.
-    copy_tree(&root.join("slides"), &dir.join("slides"), &|_| false)?;
+    // The course decks, at the handout's top level: Markdown, figures, the npm manifest and
+    // lock file to build them; not a local `npm ci` or build.
+    copy_tree(&root.join("slides"), &dir.join("slides"), &|p| {
+        p.parent() == Some(&root.join("slides"))
+            && (p.ends_with("node_modules") || p.ends_with("build"))
+    })?;
     // The scenes with their models and terrain, and the font the library compiles in.
     for assets in ["assets/scenes", "assets/fonts"] {
         copy_tree(&root.join(assets), &lib.join(assets), &|_| false)?;
@@ -181,7 +185,11 @@ What is here:
   graded**: the grader builds a clean copy of each crate with your `src/stubs.rs` in it, so
   changes to other files (and added dependencies) do not reach the grade. Your crate may use
   `glam` and `exercise_api` (the types the stubs take and return), nothing else.
-- `slides/`: the course slides on the stereo rig.
+- `slides/`: the course decks (Marp Markdown), one per topic; each exercise is introduced on the
+  slide that teaches its formula. `ex1_stereo`: `01-perception.md` (parallax),
+  `02-rig.md` (frusta, stereo matrices), `03-finalize.md` (anaglyphs), `04-remap.md`
+  (remapping, visibility); `ex2_chromadepth`: `05-chromadepth.md`; `ex3_sirds`:
+  `06-sirds.md`. Read the Markdown as it is, or build HTML/PDF as `slides/README.md` says.
 - `stereolab/`: the renderer and the grader. `stereolab/docs/sources.md` names the course's
   source documents (title, authors, where to get them); `stereolab/docs/formulas.md` collects the
   formulas; `stereolab/docs/anaglyph-matrices.md` holds the published anaglyph matrices the
