@@ -29,6 +29,8 @@ pub fn setup(tri: [(f32, f32); 3]) -> Result<SetupTriangle> {
         y,
         z: 0.5,
         inv_w: 1.0,
+        depth_x: x,
+        depth_y: y,
     });
     let var: Varyings = [0.0; MAX_VARYINGS];
     match setup_triangle(

@@ -41,6 +41,14 @@ pub fn image_of(output: Output, frame: &Frame, scene: &Scene) -> Result<RgbaImag
             let v = (g.get_pixel(x, y)[0] >> 8) as u8;
             Rgba([v, v, v, 255])
         }),
+        // A stereo photo shows as its files hold it: cross-eyed, the right eye on the left.
+        Image::Stereo(p) => {
+            let (w, h) = (p.left.width(), p.left.height());
+            let mut out = RgbaImage::new(2 * w, h);
+            image::imageops::replace(&mut out, &p.right, 0, 0);
+            image::imageops::replace(&mut out, &p.left, i64::from(w), 0);
+            out
+        }
     })
 }
 
