@@ -27,3 +27,5 @@ mod rig;
 mod scene_hashes;
 mod sirds;
 mod stability;
+#[cfg(feature = "viewer")]
+mod viewer;
