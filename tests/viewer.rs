@@ -425,6 +425,20 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
         .sum();
     let mean = diff as f64 / shown.as_raw().len() as f64;
     assert!(mean < 2.0, "the window differs from the screenshot PNG by {mean:.2} per channel");
+
+    // 5. A live SIRDS (key 7) from one depth-only center pass, the model turning (T).
+    v.key("7");
+    let s6 = v.wait("the SIRDS", |s| s["output"] == "sirds");
+    assert_eq!(s6["passes"], serde_json::json!(["Center DepthOnly"]));
+    let still = v.picture(&s6);
+    v.key("t");
+    let frames = s6["frames"].as_u64().unwrap();
+    let s7 = v.wait("the model turning", |s| {
+        s["turn_degrees"].as_f64().is_some_and(|t| t > 5.0) && s["frames"].as_u64() > Some(frames + 2)
+    });
+    let turned = v.picture(&s7);
+    turned.save(out.join("sirds_turning.png")).unwrap();
+    assert!(still != turned, "the SIRDS did not change while the model turned");
     assert!(
         start.elapsed() < Duration::from_secs(120),
         "the viewer test took {:?}",

@@ -472,7 +472,7 @@ mod tests {
         let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/wuson.toml");
         let sets = ["stereo.zero_parallax=4.0".to_string()];
         let mut scene = Scene::load(&path, &sets).unwrap();
-        scene.set_size(64, 48).unwrap();
+        scene.set_size(128, 96).unwrap();
         let session = Session::new(&scene, &path, &sets).unwrap();
         let mut p = session.initial.clone();
         p.orbit(37.0, 12.0);
