@@ -274,7 +274,7 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
             // The zero-parallax plane in front of the model: all of it behind the screen,
             // so the red and cyan images lie visibly apart.
             "--set",
-            "stereo.zero_parallax=2.5",
+            "stereo.zero_parallax=3.2",
             // ChromaDepth's D1/D2 close around the model (what the sliders set), so its
             // ramp spans red to blue; F fits them to the bounding sphere instead.
             "--set",
@@ -307,6 +307,9 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
     );
     let max_px = |s: &serde_json::Value| s["parallax_max_px"].as_f64().unwrap();
     assert!(max_px(&s1) > max_px(&s0) * 1.5, "{s0} {s1}");
+    // The growing separation takes the model's parallax past the ±3% budget.
+    assert_eq!(s0["beyond_budget"], false, "{s0}");
+    assert_eq!(s1["beyond_budget"], true, "{s1}");
 
     // 2. ChromaDepth (key 5): the red-to-blue ramp, from one center pass (no eye passes).
     v.key("5");
@@ -351,7 +354,7 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
     let s3 = v.wait("side by side", |s| s["output"] == "side_by_side");
     assert!(
         s3["parallax_min_px"].as_f64().unwrap() > 0.0,
-        "with z0 = 2.5 the whole model lies behind the screen: {s3}"
+        "with z0 = 3.2 the whole model lies behind the screen: {s3}"
     );
     let pic3 = v.picture(&s3);
     let bg = pic3.get_pixel(2, 2).0;

@@ -89,8 +89,9 @@ pub(super) fn run(scene: Scene, session: Session, opts: ViewOptions) -> Result<(
         Box::new({
             let shared = Arc::clone(&shared);
             move |cc| {
+                let aspect = scene.aspect();
                 let worker = spawn_worker(scene, session.clone(), Arc::clone(&shared), cc.egui_ctx.clone());
-                Ok(Box::new(App::new(session, opts, shared, worker)))
+                Ok(Box::new(App::new(aspect, session, opts, shared, worker)))
             }
         }),
     );
@@ -169,17 +170,31 @@ struct App {
     frames: u64,
     shots: Vec<PathBuf>,
     last_turn: Instant,
+    /// The automatic separation at the start (the slider spans 0 to 4 times it).
+    auto_separation: f32,
+    /// The scene's width / height.
+    aspect: f32,
 }
 
 impl App {
     fn new(
+        aspect: f32,
         session: Session,
         opts: ViewOptions,
         shared: Arc<Shared>,
         worker: std::thread::JoinHandle<()>,
     ) -> App {
         let params = session.initial.clone();
+        let auto_separation = {
+            let mut rig = params.rig;
+            rig.separation = Separation::Auto;
+            rig.user_offset = 1.0;
+            rig.resolve(&params.camera, aspect)
+                .map_or(0.1, |r| r.eye_separation)
+        };
         App {
+            auto_separation,
+            aspect,
             session,
             opts,
             shared,
@@ -456,8 +471,24 @@ impl App {
                 .logarithmic(false),
         );
         ui.add(egui::Slider::new(&mut rig.user_balance, 0.0..=2.0).text("balance"));
-        if let Separation::Absolute(d) = &mut rig.separation {
-            ui.add(egui::Slider::new(d, 0.0..=2.0).text("eye separation d"));
+        // The separation itself (before the user offset): "auto" (the guide's 3.5% of the
+        // view width at z0) until the slider moves it, then an absolute distance.
+        let auto = self.auto_separation;
+        let mut d = match rig.separation {
+            Separation::Absolute(d) => d,
+            Separation::Auto => rig
+                .resolve(&self.params.camera, self.aspect)
+                .map_or(auto, |r| r.eye_separation / rig.user_offset.max(1e-6)),
+        };
+        let label = match rig.separation {
+            Separation::Auto => "eye separation (auto)",
+            Separation::Absolute(_) => "eye separation",
+        };
+        if ui
+            .add(egui::Slider::new(&mut d, 0.0..=4.0 * auto).text(label))
+            .changed()
+        {
+            rig.separation = Separation::Absolute(d);
         }
         let cam = self.params.camera.clone();
         let (lo, hi) = (cam.near * 1.001, cam.far * 0.999);
@@ -482,9 +513,17 @@ impl App {
         for (i, name) in ["D1 (red)", "D2 (blue)"].into_iter().enumerate() {
             let (n, f) = (self.params.camera.near, self.params.camera.far);
             let resolved = self.shown.as_ref().and_then(|s| s.chromadepth_range()).map(|r| r[i]);
-            let mut v = self.params.chromadepth_d[i].or(resolved).unwrap_or(n + (f - n) * 0.5);
+            let Some(mut v) = self.params.chromadepth_d[i].or(resolved) else {
+                ui.label(format!("{name}: no range fits the scene"));
+                continue;
+            };
+            let fitted = if self.params.chromadepth_d[i].is_none() {
+                " (fitted)"
+            } else {
+                ""
+            };
             if ui
-                .add(egui::Slider::new(&mut v, n..=f).logarithmic(true).text(name))
+                .add(egui::Slider::new(&mut v, n..=f).logarithmic(true).text(format!("{name}{fitted}")))
                 .changed()
             {
                 self.params.chromadepth_d[i] = Some(v);

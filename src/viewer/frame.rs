@@ -44,7 +44,7 @@ pub struct Shown {
     pub width: u32,
     /// Image height.
     pub height: u32,
-    /// The ChromaDepth D1, D2 the center pass used (fitted or set), for ChromaDepth outputs.
+    /// The ChromaDepth D1, D2 (set, or fitted to the bounding sphere) a ChromaDepth pass uses.
     pub chromadepth: Option<[f32; 2]>,
 }
 
@@ -74,12 +74,16 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
         .find_map(|v| frame.view(v))
         .map(|fb| budget_of(fb, &rig))
         .transpose()?;
+    // The D1/D2 a ChromaDepth pass uses (set, or fitted to the bounding sphere), also for the
+    // other outputs, so the sliders start where the ramp would be; `None` where no range fits.
     let chromadepth = match frame.plan.pass(View::Center) {
         Some(p) if p.shading == Shading::ChromaDepth => {
             let t = resolve_texgen(scene, &frame.center, &scene.chromadepth)?;
             Some([t.d1, t.d2])
         }
-        _ => None,
+        _ => resolve_texgen(scene, &frame.center, &scene.chromadepth)
+            .ok()
+            .map(|t| [t.d1, t.d2]),
     };
     let picked_parallax = picked.and_then(|p| point_parallax_pixels(&frame.eyes, p, scene.width));
     Ok(Shown {
@@ -131,7 +135,7 @@ impl Shown {
         self.width as f32 / self.height as f32
     }
 
-    /// The ChromaDepth range of this frame, if it rendered the ChromaDepth pass.
+    /// The ChromaDepth range of this frame's camera (set, or fitted), if one fits.
     pub fn chromadepth_range(&self) -> Option<[f32; 2]> {
         self.chromadepth
     }
