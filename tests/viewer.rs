@@ -221,7 +221,10 @@ fn parse_xwd(b: &[u8]) -> image::RgbImage {
     let (byte_order, bpp, stride) = (u(7), u(11) as usize, u(12) as usize);
     let masks = [u(14), u(15), u(16)];
     let ncolors = u(19) as usize;
-    assert_eq!(bpp, 32, "xwd: expected 32 bits per pixel (a 24-bit Xvfb screen)");
+    assert_eq!(
+        bpp, 32,
+        "xwd: expected 32 bits per pixel (a 24-bit Xvfb screen)"
+    );
     let data = &b[header + ncolors * 12..];
     image::RgbImage::from_fn(width, height, |x, y| {
         let i = y as usize * stride + x as usize * 4;
@@ -286,7 +289,10 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
 
     // 1. The separation key widens the parallax between the red and cyan images.
     let s0 = v.wait("the anaglyph", |s| s["output"] == "anaglyph_gray");
-    assert_eq!(s0["passes"], serde_json::json!(["Left Color", "Right Color"]));
+    assert_eq!(
+        s0["passes"],
+        serde_json::json!(["Left Color", "Right Color"])
+    );
     let pic0 = v.picture(&s0);
     pic0.save(out.join("anaglyph_before.png")).unwrap();
     let shift0 = anaglyph_shift(&pic0);
@@ -330,8 +336,11 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
         let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / xs.len().max(1) as f64;
         (xs.len(), mean)
     };
-    let ((red, red_x), (green, _), (blue, blue_x)) =
-        (hue(&pic2, &is_red), hue(&pic2, &is_green), hue(&pic2, &is_blue));
+    let ((red, red_x), (green, _), (blue, blue_x)) = (
+        hue(&pic2, &is_red),
+        hue(&pic2, &is_green),
+        hue(&pic2, &is_blue),
+    );
     assert!(
         red > 300 && green > 300 && blue > 100,
         "the ChromaDepth ramp should show red, green and blue: {red} red, {green} green, \
@@ -339,7 +348,10 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
     );
     // The camera looks at the model's rear (near, left) and its head (far, right): red in
     // front, blue behind, as ChromaDepth glasses need.
-    assert!(red_x + 40.0 < blue_x, "red at x {red_x:.0}, blue at x {blue_x:.0}");
+    assert!(
+        red_x + 40.0 < blue_x,
+        "red at x {red_x:.0}, blue at x {blue_x:.0}"
+    );
     // F: D1/D2 fitted to the bounding sphere, whose middle the model fills: hardly any red.
     let frames = s2["frames"].as_u64().unwrap();
     v.key("f");
@@ -347,7 +359,10 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
     let fitted = v.picture(&s2f);
     fitted.save(out.join("chromadepth_fitted.png")).unwrap();
     let (red_fitted, _) = hue(&fitted, &is_red);
-    assert!(red_fitted * 10 < red, "{red_fitted} red pixels after F, {red} before");
+    assert!(
+        red_fitted * 10 < red,
+        "{red_fitted} red pixels after F, {red} before"
+    );
 
     // 3. A click on the model (side by side, key 1) moves zero parallax to it.
     v.key("1");
@@ -372,7 +387,9 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
     let c = (mx / model.len() as u64, my / model.len() as u64);
     let &(px, py) = model
         .iter()
-        .min_by_key(|&&(x, y)| (u64::from(x).abs_diff(c.0)).pow(2) + (u64::from(y).abs_diff(c.1)).pow(2))
+        .min_by_key(|&&(x, y)| {
+            (u64::from(x).abs_diff(c.0)).pow(2) + (u64::from(y).abs_diff(c.1)).pow(2)
+        })
         .unwrap();
     let r = &s3["image_rect"];
     let (wx, wy) = (
@@ -385,8 +402,14 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
     });
     let picked = s4["picked_parallax_px"].as_f64().unwrap();
     let z0 = s4["zero_parallax"].as_f64().unwrap();
-    assert!(picked.abs() < 0.05, "parallax at the clicked point: {picked} px, not 0");
-    assert!(z0 > 3.5 && z0 < 7.0, "z0 = {z0}: not the model's distance (about 4.9)");
+    assert!(
+        picked.abs() < 0.05,
+        "parallax at the clicked point: {picked} px, not 0"
+    );
+    assert!(
+        z0 > 3.5 && z0 < 7.0,
+        "z0 = {z0}: not the model's distance (about 4.9)"
+    );
     assert!(
         s4["parallax_min_px"].as_f64().unwrap() < 0.0
             && s4["parallax_max_px"].as_f64().unwrap() > 0.0,
@@ -427,7 +450,10 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
         .map(|(a, b)| u64::from(a.abs_diff(*b)))
         .sum();
     let mean = diff as f64 / shown.as_raw().len() as f64;
-    assert!(mean < 2.0, "the window differs from the screenshot PNG by {mean:.2} per channel");
+    assert!(
+        mean < 2.0,
+        "the window differs from the screenshot PNG by {mean:.2} per channel"
+    );
 
     // 5. A live SIRDS (key 7) from one depth-only center pass, the model turning (T).
     v.key("7");
@@ -437,11 +463,15 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
     v.key("t");
     let frames = s6["frames"].as_u64().unwrap();
     let s7 = v.wait("the model turning", |s| {
-        s["turn_degrees"].as_f64().is_some_and(|t| t > 5.0) && s["frames"].as_u64() > Some(frames + 2)
+        s["turn_degrees"].as_f64().is_some_and(|t| t > 5.0)
+            && s["frames"].as_u64() > Some(frames + 2)
     });
     let turned = v.picture(&s7);
     turned.save(out.join("sirds_turning.png")).unwrap();
-    assert!(still != turned, "the SIRDS did not change while the model turned");
+    assert!(
+        still != turned,
+        "the SIRDS did not change while the model turned"
+    );
     assert!(
         start.elapsed() < Duration::from_secs(120),
         "the viewer test took {:?}",
@@ -460,7 +490,10 @@ fn viewer_without_a_display_names_display() {
         .expect("run stereolab view");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.starts_with("error: ") && err.contains("DISPLAY"), "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("DISPLAY"),
+        "{err}"
+    );
     assert!(!err.contains("panicked"), "{err}");
 }
 
@@ -469,13 +502,27 @@ fn viewer_benchmark_runs_without_a_window() {
     let out = stereolab()
         .args(["view"])
         .arg(asset("scenes/wuson.toml"))
-        .args(["--size", "96x64", "--output", "anaglyph_dubois", "--benchmark-frames", "4"])
+        .args([
+            "--size",
+            "96x64",
+            "--output",
+            "anaglyph_dubois",
+            "--benchmark-frames",
+            "4",
+        ])
         .env_remove("DISPLAY")
         .output()
         .expect("run stereolab view --benchmark-frames");
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(text.contains("4 frames of an orbit"), "{text}");
-    assert!(text.contains("pass Left Color") && text.contains("pass Right Color"), "{text}");
+    assert!(
+        text.contains("pass Left Color") && text.contains("pass Right Color"),
+        "{text}"
+    );
     assert!(text.contains("frames/s"), "{text}");
 }

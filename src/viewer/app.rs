@@ -26,13 +26,19 @@ const KEYS: &[(&str, &str)] = &[
     ("wheel", "zoom"),
     ("click", "zero parallax at the point clicked (its depth)"),
     ("R", "reset camera and rig"),
-    ("keypad + / =", "separation × 1.1 (UserOffsetAdjustment, guide §7)"),
+    (
+        "keypad + / =",
+        "separation × 1.1 (UserOffsetAdjustment, guide §7)",
+    ),
     ("keypad − / -", "separation ÷ 1.1"),
     ("] / [", "balance × 1.1 / ÷ 1.1 (UserBalanceAdjustment)"),
     ("M", "rig mode: off-axis, toe-in, parallel in turn"),
     ("L", "lighting: per-eye or cyclopic"),
     ("PageDown / PageUp", "next / previous output"),
-    ("1 … 9, 0", "side_by_side, anaglyph_dubois, anaglyph_color, parallax, chromadepth, chromadepth_anaglyph, sirds, occlusion, left, cross_eyed"),
+    (
+        "1 … 9, 0",
+        "side_by_side, anaglyph_dubois, anaglyph_color, parallax, chromadepth, chromadepth_anaglyph, sirds, occlusion, left, cross_eyed",
+    ),
     ("F", "ChromaDepth: fit D1/D2 to the bounding sphere"),
     ("T", "turn the model (SIRDS demonstration)"),
     ("N", "SIRDS: a new dot pattern every frame, or a fixed one"),
@@ -90,7 +96,12 @@ pub(super) fn run(scene: Scene, session: Session, opts: ViewOptions) -> Result<(
             let shared = Arc::clone(&shared);
             move |cc| {
                 let aspect = scene.aspect();
-                let worker = spawn_worker(scene, session.clone(), Arc::clone(&shared), cc.egui_ctx.clone());
+                let worker = spawn_worker(
+                    scene,
+                    session.clone(),
+                    Arc::clone(&shared),
+                    cc.egui_ctx.clone(),
+                );
                 Ok(Box::new(App::new(aspect, session, opts, shared, worker)))
             }
         }),
@@ -269,7 +280,10 @@ impl App {
             self.picked = None;
         }
         let all = Output::ALL;
-        let at = all.iter().position(|&o| o == self.params.output).unwrap_or(0);
+        let at = all
+            .iter()
+            .position(|&o| o == self.params.output)
+            .unwrap_or(0);
         if pressed(Key::PageDown) {
             self.set_output(ctx, all[(at + 1) % all.len()]);
         }
@@ -355,7 +369,11 @@ impl App {
             "screenshot: wrote {} and {}; `stereolab render{} {} --out DIR` writes DIR/{}.png, the same bytes",
             png.display(),
             toml.display(),
-            if outside { " --allow-outside-paths" } else { "" },
+            if outside {
+                " --allow-outside-paths"
+            } else {
+                ""
+            },
             toml.display(),
             shown.params.output.name()
         ))
@@ -462,7 +480,11 @@ impl App {
         });
         ui.horizontal(|ui| {
             for l in [Lighting::PerEye, Lighting::Cyclopic] {
-                ui.radio_value(&mut rig.lighting, l, format!("{} lighting", lighting_name(l)));
+                ui.radio_value(
+                    &mut rig.lighting,
+                    l,
+                    format!("{} lighting", lighting_name(l)),
+                );
             }
         });
         ui.add(
@@ -497,7 +519,11 @@ impl App {
             ZeroParallax::Fraction(t) => cam.near + t * (cam.far - cam.near),
         };
         let before = z0;
-        ui.add(egui::Slider::new(&mut z0, lo..=hi).logarithmic(true).text("zero parallax z0"));
+        ui.add(
+            egui::Slider::new(&mut z0, lo..=hi)
+                .logarithmic(true)
+                .text("zero parallax z0"),
+        );
         if z0 != before {
             rig.zero_parallax = ZeroParallax::Distance(z0);
             self.picked = None;
@@ -512,7 +538,11 @@ impl App {
         ui.heading("ChromaDepth");
         for (i, name) in ["D1 (red)", "D2 (blue)"].into_iter().enumerate() {
             let (n, f) = (self.params.camera.near, self.params.camera.far);
-            let resolved = self.shown.as_ref().and_then(|s| s.chromadepth_range()).map(|r| r[i]);
+            let resolved = self
+                .shown
+                .as_ref()
+                .and_then(|s| s.chromadepth_range())
+                .map(|r| r[i]);
             let Some(mut v) = self.params.chromadepth_d[i].or(resolved) else {
                 ui.label(format!("{name}: no range fits the scene"));
                 continue;
@@ -523,7 +553,11 @@ impl App {
                 ""
             };
             if ui
-                .add(egui::Slider::new(&mut v, n..=f).logarithmic(true).text(format!("{name}{fitted}")))
+                .add(
+                    egui::Slider::new(&mut v, n..=f)
+                        .logarithmic(true)
+                        .text(format!("{name}{fitted}")),
+                )
                 .changed()
             {
                 self.params.chromadepth_d[i] = Some(v);
@@ -535,7 +569,11 @@ impl App {
         ui.separator();
         ui.heading("SIRDS");
         ui.horizontal(|ui| {
-            ui.radio_value(&mut self.params.sirds_algorithm, Algorithm::PerVertex, "per-vertex");
+            ui.radio_value(
+                &mut self.params.sirds_algorithm,
+                Algorithm::PerVertex,
+                "per-vertex",
+            );
             ui.radio_value(&mut self.params.sirds_algorithm, Algorithm::PerPixel, "TIW");
         });
         ui.horizontal(|ui| {
@@ -687,8 +725,7 @@ impl App {
         let size = tex.size_vec2();
         let avail = ui.available_size();
         let scale = (avail.x / size.x).min(avail.y / size.y).min(1.0);
-        let (rect, response) =
-            ui.allocate_exact_size(size * scale, egui::Sense::click_and_drag());
+        let (rect, response) = ui.allocate_exact_size(size * scale, egui::Sense::click_and_drag());
         ui.painter().image(
             tex.id(),
             rect,

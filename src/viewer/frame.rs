@@ -183,7 +183,11 @@ impl Shown {
             .iter()
             .map(|(name, t)| format!("pass {name}: {:.1} ms", ms(*t)))
             .collect();
-        lines.push(format!("{}: {:.1} ms", self.params.output.name(), ms(self.effect)));
+        lines.push(format!(
+            "{}: {:.1} ms",
+            self.params.output.name(),
+            ms(self.effect)
+        ));
         lines.push(format!("frame: {:.1} ms", ms(self.total)));
         lines
     }

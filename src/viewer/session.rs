@@ -210,7 +210,11 @@ impl Session {
         set("stereo", "lighting", Some(word(lighting_name(r.lighting))));
         set("chromadepth", "d1", p.chromadepth_d[0].map(num));
         set("chromadepth", "d2", p.chromadepth_d[1].map(num));
-        set("finalize", "linear_light", Some(Value::Boolean(p.linear_light)));
+        set(
+            "finalize",
+            "linear_light",
+            Some(Value::Boolean(p.linear_light)),
+        );
         set("finalize", "swap_eyes", Some(Value::Boolean(p.swap_eyes)));
         let algorithm = match p.sirds_algorithm {
             Algorithm::PerVertex => "per-vertex",
@@ -230,19 +234,13 @@ impl Session {
         let seed = i64::try_from(p.sirds_seed)
             .map_err(|_| Error::invalid("sirds.seed", p.sirds_seed, "must fit in 63 bits"))?;
         set("sirds", "seed", Some(Value::Integer(seed)));
-        t.insert(
-            "outputs".into(),
-            Value::Array(vec![word(p.output.name())]),
-        );
+        t.insert("outputs".into(), Value::Array(vec![word(p.output.name())]));
         let base = self.path.parent().unwrap_or(Path::new(""));
         let same_folder = same_dir(base, dir);
         if let Some(Value::Array(meshes)) = t.get_mut("mesh") {
             for (m, place) in meshes.iter_mut().zip(&self.placements) {
                 if let Value::Table(m) = m {
-                    m.insert(
-                        "rotate".into(),
-                        vec3(turned(place.rotate, p.turn_degrees)),
-                    );
+                    m.insert("rotate".into(), vec3(turned(place.rotate, p.turn_degrees)));
                     if !same_folder {
                         absolute_path(m, "path", base)?;
                     }
@@ -373,10 +371,8 @@ impl Params {
         let yawed = glam::Quat::from_axis_angle(up, yaw.to_radians()) * offset;
         let elevation = yawed.normalize_or(Vec3::Z).dot(up).clamp(-1.0, 1.0).acos();
         let limit = 5f32.to_radians();
-        let p = (-pitch.to_radians()).clamp(
-            limit - elevation,
-            std::f32::consts::PI - limit - elevation,
-        );
+        let p = (-pitch.to_radians())
+            .clamp(limit - elevation, std::f32::consts::PI - limit - elevation);
         let right = yawed.cross(up).normalize_or(Vec3::X);
         let pitched = glam::Quat::from_axis_angle(right, -p) * yawed;
         self.camera.eye = (target + pitched).to_array();
@@ -432,7 +428,11 @@ impl Params {
 /// Horizontal screen parallax of world point `p` in pixels of a `width`-pixel image: where
 /// the right eye sees it minus where the left eye does, `(x_r − x_l)/2 · W` in NDC; `None`
 /// behind either eye.
-pub fn point_parallax_pixels(eyes: &[crate::math::EyeMatrices; 2], p: Vec3, width: u32) -> Option<f32> {
+pub fn point_parallax_pixels(
+    eyes: &[crate::math::EyeMatrices; 2],
+    p: Vec3,
+    width: u32,
+) -> Option<f32> {
     let l = project_ndc(&eyes[0].mvp, p)?;
     let r = project_ndc(&eyes[1].mvp, p)?;
     Some((r.x - l.x) * 0.5 * width as f32)
