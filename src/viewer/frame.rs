@@ -1,7 +1,7 @@
 //! One viewer frame: the plan for the one output shown, its passes, the output image, and the
 //! readouts that teach (passes run and their times, the parallax range against the budget).
 //! All of it is the library's own work ([`Plan::new`], [`crate::render()`],
-//! [`output::produce`], [`info::parallax_range`]); the viewer adds timing and nothing else.
+//! [`output::produce`], [`crate::info::parallax_range`]); the viewer adds timing and nothing else.
 
 use std::time::{Duration, Instant};
 
