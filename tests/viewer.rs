@@ -321,6 +321,17 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
     v.key("5");
     let s2 = v.wait("ChromaDepth", |s| s["output"] == "chromadepth");
     assert_eq!(s2["passes"], serde_json::json!(["Center ChromaDepth"]));
+    // The title names the scene and the output.
+    let name = Command::new(need("xdotool", "xdotool"))
+        .args(["getwindowname", &v.window])
+        .env("DISPLAY", &x.display)
+        .output()
+        .expect("run xdotool");
+    let name = String::from_utf8_lossy(&name.stdout);
+    assert!(
+        name.contains("wuson.toml") && name.contains("chromadepth"),
+        "title: {name}"
+    );
     let pic2 = v.picture(&s2);
     pic2.save(out.join("chromadepth.png")).unwrap();
     let is_red = |[r, g, b]: [u8; 3]| r > 150 && g < 110 && b < 110;
