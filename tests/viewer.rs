@@ -483,6 +483,23 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
         still != turned,
         "the SIRDS did not change while the model turned"
     );
+
+    // 6. Toe-in (M) shows vertical parallax, which off-axis never has; L switches lighting.
+    v.key("1");
+    let s8 = v.wait("side by side again", |s| s["output"] == "side_by_side");
+    assert_eq!(s8["mode"], "off-axis");
+    assert!(s8["vertical_percent"].as_f64().unwrap() < 1e-3, "{s8}");
+    v.key("m");
+    let s9 = v.wait("toe-in", |s| {
+        s["mode"] == "toe-in" && s["frames"].as_u64() > s8["frames"].as_u64()
+    });
+    let vertical = s9["vertical_percent"].as_f64().unwrap();
+    assert!(
+        vertical > 0.01,
+        "toe-in's vertical parallax: {vertical}% of the height"
+    );
+    v.key("l");
+    v.wait("cyclopic lighting", |s| s["lighting"] == "cyclopic");
     assert!(
         start.elapsed() < Duration::from_secs(120),
         "the viewer test took {:?}",
