@@ -8,9 +8,9 @@ use std::time::Instant;
 use eframe::egui;
 use glam::Vec3;
 
+use super::ViewOptions;
 use super::frame::{Shown, render_shown};
 use super::session::{KEYPAD_FACTOR, Params, Session, lighting_name, mode_name};
-use super::{ViewOptions, check_display};
 use crate::effects::parallax::PARALLAX_BUDGET_PERCENT;
 use crate::effects::sirds::Algorithm;
 use crate::effects::sirds::settings::{Filter, Start};
@@ -75,7 +75,6 @@ struct Job {
 }
 
 pub(super) fn run(scene: Scene, session: Session, opts: ViewOptions) -> Result<()> {
-    check_display(std::env::var_os("DISPLAY"))?;
     let title = title(&session.path, session.initial.output);
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
@@ -185,6 +184,8 @@ struct App {
     auto_separation: f32,
     /// The scene's width / height.
     aspect: f32,
+    /// Physical pixels per egui point (`image_rect` is in physical pixels).
+    pixels_per_point: f32,
 }
 
 impl App {
@@ -206,6 +207,7 @@ impl App {
         App {
             auto_separation,
             aspect,
+            pixels_per_point: 1.0,
             session,
             opts,
             shared,
@@ -425,7 +427,7 @@ impl App {
             "error": self.error,
             "status": self.status,
             "shots": self.shots.iter().map(|s| s.display().to_string()).collect::<Vec<_>>(),
-            "pixels_per_point": self.image_rect.map(|_| 1.0),
+            "pixels_per_point": self.pixels_per_point,
         });
         if let Some(r) = self.image_rect {
             v["image_rect"] = serde_json::json!([r.min.x, r.min.y, r.max.x, r.max.y]);
@@ -733,6 +735,7 @@ impl App {
             egui::Color32::WHITE,
         );
         let ppp = ui.ctx().pixels_per_point();
+        self.pixels_per_point = ppp;
         let physical = egui::Rect::from_min_max(
             (rect.min.to_vec2() * ppp).to_pos2(),
             (rect.max.to_vec2() * ppp).to_pos2(),

@@ -89,9 +89,9 @@ fn median(mut v: Vec<Duration>) -> Duration {
     v.get(v.len() / 2).copied().unwrap_or_default()
 }
 
-/// Renders `frames` frames of a full orbit about the target (360°/`frames` per frame), with
-/// the worker's own frame function, and returns the medians. The model turns with the orbit
-/// when `params.turn_degrees` is not reset between frames (it is not touched here).
+/// Renders `frames` frames of a full orbit of the camera about its target (360°/`frames`
+/// per frame) with the worker's own frame function ([`render_shown`]: passes, output,
+/// readouts), and returns the medians. Nothing else changes between frames.
 ///
 /// # Errors
 /// `frames` is 0 or above 100 000, or a frame fails.
