@@ -22,7 +22,8 @@
 //! --nocapture` prints the graph):
 //! [`error`] → [`files`] → [`math`], [`framebuffer`], [`shade`] → [`raster`] → [`effects`] → [`plan`] →
 //! [`scene`] → [`fixtures`] → [`render`](mod@render) → [`output`] → [`info`], [`figures`], [`compare`] →
-//! `gpu` (feature `gpu`), [`exercise`] → [`grade`], [`bench`](mod@bench).
+//! `gpu` (feature `gpu`), [`exercise`] → [`grade`], [`bench`](mod@bench) → `viewer` (feature
+//! `viewer`: `stereolab view`).
 //!
 //! The repository's `docs/ARCHITECTURE.md` has the conventions (coordinates, llvmpipe's
 //! rasterization rules, determinism), `docs/sources.md` the course's five source documents.
@@ -51,6 +52,8 @@ pub mod render;
 pub mod scene;
 pub mod shade;
 pub mod text;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 
 pub use error::{Error, Result};
 pub use framebuffer::{EyePair, Framebuffer};

@@ -20,6 +20,7 @@
 //! - `info`, `figures`, `compare`: reports, the slides' figures, image metrics.
 //! - `gpu`, `exercise`: the wgpu parity path; the exercise protocol.
 //! - `grade`, `bench`: the auto-grader; the benchmarks.
+//! - `viewer`: `stereolab view`, the interactive window over the library (feature `viewer`).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -40,6 +41,7 @@ const LAYERS: &[&[&str]] = &[
     &["info", "figures", "compare"],
     &["gpu", "exercise"],
     &["grade", "bench"],
+    &["viewer"],
 ];
 
 fn layer_of(module: &str) -> Option<usize> {

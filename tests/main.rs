@@ -29,3 +29,5 @@ mod sirds;
 mod sirds_interop;
 mod stability;
 mod stereo_photo;
+#[cfg(feature = "viewer")]
+mod viewer;

@@ -147,9 +147,7 @@ impl Scene {
     ) -> Result<Scene> {
         let mut table: toml::Table =
             toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
-        for s in sets {
-            apply_set(&mut table, s)?;
-        }
+        apply_sets(&mut table, sets)?;
         let file: SceneFile = table.try_into().map_err(|e: toml::de::Error| {
             // After --set the spans refer to nothing; re-parse the text for a line number when we can.
             match toml::from_str::<SceneFile>(text) {
@@ -431,18 +429,24 @@ fn load_object(
             "must be a finite number > 0",
         ));
     }
-    let r = m.rotate.map(f32::to_radians);
-    let model = Mat4::from_scale_rotation_translation(
-        Vec3::splat(m.scale),
-        Quat::from_euler(EulerRot::ZYX, r[2], r[1], r[0]),
-        m.translate.into(),
-    );
     Ok(Object {
         name: format!("mesh[{i}] {}", m.kind),
         mesh,
-        model,
+        model: model_matrix(m.translate, m.rotate, m.scale),
         color: m.color.into(),
     })
+}
+
+/// A `[[mesh]]`'s object → world matrix from its `translate`, `rotate` (degrees about X, then
+/// Y, then Z) and uniform `scale`, as the scene file defines it. `stereolab view` turns a model
+/// by changing `rotate` and calling this, so a turned model saved as TOML loads the same.
+pub fn model_matrix(translate: [f32; 3], rotate_degrees: [f32; 3], scale: f32) -> Mat4 {
+    let r = rotate_degrees.map(f32::to_radians);
+    Mat4::from_scale_rotation_translation(
+        Vec3::splat(scale),
+        Quat::from_euler(EulerRot::ZYX, r[2], r[1], r[0]),
+        translate.into(),
+    )
 }
 
 /// A TOML error with the line it points at.
@@ -451,6 +455,15 @@ fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
         .span()
         .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
     Error::parse(path, line, e.message().to_string())
+}
+
+/// Applies `--set key=value` overrides to a scene file's table, in order (what
+/// [`Scene::load`] does before it reads the table; `stereolab view` writes the result back).
+///
+/// # Errors
+/// `Invalid` naming the `--set` that does not apply.
+pub fn apply_sets(table: &mut toml::Table, sets: &[String]) -> Result<()> {
+    sets.iter().try_for_each(|s| apply_set(table, s))
 }
 
 /// Applies one `key.path=value` override; the value is read as TOML (`0.3`, `"auto"`, `[1,2,3]`)

@@ -25,6 +25,8 @@ mod grade;
 mod info;
 mod render;
 mod sirds;
+#[cfg(feature = "viewer")]
+mod view;
 
 use std::io::Write as _;
 use std::path::Path;
@@ -87,6 +89,9 @@ enum Command {
     /// Autostereograms (SIRDS): from a scene, from a depth map (--depth), animated (--frames),
     /// or decoded back to depth (--decode).
     Sirds(sirds::SirdsArgs),
+    /// The interactive viewer: any output live, camera, rig, readouts, screenshots.
+    #[cfg(feature = "viewer")]
+    View(view::ViewArgs),
 }
 
 #[cfg(not(feature = "gpu"))]
@@ -199,6 +204,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Figures(args) => figures::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Sirds(args) => sirds::run(&args),
+        #[cfg(feature = "viewer")]
+        Command::View(args) => view::run(args),
     }
 }
 
@@ -239,6 +246,10 @@ fn main() -> ExitCode {
     // thread's 8 MB of stack carries over.
     let pool = rayon::ThreadPoolBuilder::new().stack_size(8 << 20).build();
     let result = match pool {
+        // A window's event loop belongs on the main thread (winit's rule); the viewer's frames
+        // render on its own worker thread, in rayon's global pool.
+        #[cfg(feature = "viewer")]
+        _ if matches!(cli.command, Command::View(_)) => run(cli),
         Ok(pool) => pool.install(|| run(cli)),
         Err(_) => run(cli),
     };
@@ -280,6 +291,11 @@ mod tests {
                 "figures",
                 "bench",
                 "sirds",
+                "view",
+                "--benchmark-frames",
+                "--state-file",
+                "--shots",
+                "--output",
                 "batch",
                 "bundle",
                 "all",

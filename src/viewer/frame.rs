@@ -1,0 +1,194 @@
+//! One viewer frame: the plan for the one output shown, its passes, the output image, and the
+//! readouts that teach (passes run and their times, the parallax range against the budget).
+//! All of it is the library's own work ([`Plan::new`], [`crate::render()`],
+//! [`output::produce`], [`crate::info::parallax_range`]); the viewer adds timing and nothing else.
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+
+use crate::effects::parallax::{ParallaxBudget, budget_of};
+use crate::error::Result;
+use crate::info::{ParallaxRange, parallax_range};
+use crate::output::{self, Image};
+use crate::plan::{Output, Plan, Shading, View};
+use crate::render::chromadepth::resolve_texgen;
+use crate::render::{Frame, render};
+use crate::scene::Scene;
+
+use super::session::{Params, point_parallax_pixels, unproject};
+
+/// A finished frame and what the viewer shows beside it.
+pub struct Shown {
+    /// The parameters it was rendered with.
+    pub params: Params,
+    /// The output image, as `stereolab render` would write it.
+    pub image: Image,
+    /// The rendered passes (framebuffers with depth, matrices): what a click looks into.
+    pub frame: Frame,
+    /// Each pass: a name (`Left Color`) and its time.
+    pub passes: Vec<(String, Duration)>,
+    /// Making the output from the passes (finalize, layouts, ChromaDepth glasses, SIRDS
+    /// strips or TIW).
+    pub effect: Duration,
+    /// Passes and effect together, the frame time.
+    pub total: Duration,
+    /// Parallax of every vertex seen by both eyes (`stereolab info`'s range); also the
+    /// vertical parallax toe-in makes.
+    pub range: ParallaxRange,
+    /// The per-pixel budget of an eye the plan rendered (window violations), if any did.
+    pub budget: Option<ParallaxBudget>,
+    /// Screen parallax in pixels of the point last clicked, under this frame's rig.
+    pub picked_parallax: Option<f32>,
+    /// Image width (the parallax readouts' pixels are of this width).
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The ChromaDepth D1, D2 (set, or fitted to the bounding sphere) a ChromaDepth pass uses.
+    pub chromadepth: Option<[f32; 2]>,
+}
+
+/// Renders `scene` (already set to `params`) for its one output and measures the readouts;
+/// `picked` is the world point last clicked.
+///
+/// # Errors
+/// Whatever rendering or the output fails with (an invalid rig, a ChromaDepth range outside
+/// the clip planes, …).
+pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Result<Shown> {
+    let plan = Plan::new(&[params.output]);
+    let start = Instant::now();
+    let frame = render(scene, &plan)?;
+    let passes_done = Instant::now();
+    let image = output::produce(params.output, &frame, scene)?;
+    let effect = passes_done.elapsed();
+    let total = start.elapsed();
+    let passes = frame
+        .passes
+        .iter()
+        .map(|p| (format!("{:?} {:?}", p.pass.view, p.pass.shading), p.time))
+        .collect();
+    let range = parallax_range(scene)?;
+    let rig = scene.parallax_rig()?;
+    let budget = [View::Left, View::Right]
+        .into_iter()
+        .find_map(|v| frame.view(v))
+        .map(|fb| budget_of(fb, &rig))
+        .transpose()?;
+    // The D1/D2 a ChromaDepth pass uses (set, or fitted to the bounding sphere), also for the
+    // other outputs, so the sliders start where the ramp would be; `None` where no range fits.
+    let chromadepth = match frame.plan.pass(View::Center) {
+        Some(p) if p.shading == Shading::ChromaDepth => {
+            let t = resolve_texgen(scene, &frame.center, &scene.chromadepth)?;
+            Some([t.d1, t.d2])
+        }
+        _ => resolve_texgen(scene, &frame.center, &scene.chromadepth)
+            .ok()
+            .map(|t| [t.d1, t.d2]),
+    };
+    let picked_parallax = picked.and_then(|p| point_parallax_pixels(&frame.eyes, p, scene.width));
+    Ok(Shown {
+        params: params.clone(),
+        image,
+        frame,
+        passes,
+        effect,
+        total,
+        range,
+        budget,
+        picked_parallax,
+        width: scene.width,
+        height: scene.height,
+        chromadepth,
+    })
+}
+
+impl Shown {
+    /// The image as 8-bit RGBA for the screen (16-bit depth shown by its high byte).
+    pub fn display_rgba(&self) -> image::RgbaImage {
+        match &self.image {
+            Image::Rgba(i) => i.clone(),
+            Image::Gray16(g) => image::RgbaImage::from_fn(g.width(), g.height(), |x, y| {
+                let v = (g.get_pixel(x, y).0[0] >> 8) as u8;
+                image::Rgba([v, v, v, 255])
+            }),
+        }
+    }
+
+    /// Width of the output image (side by side is twice the scene's width).
+    pub fn image_width(&self) -> u32 {
+        match &self.image {
+            Image::Rgba(i) => i.width(),
+            Image::Gray16(i) => i.width(),
+        }
+    }
+
+    /// Height of the output image.
+    pub fn image_height(&self) -> u32 {
+        match &self.image {
+            Image::Rgba(i) => i.height(),
+            Image::Gray16(i) => i.height(),
+        }
+    }
+
+    /// The scene's width / height.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// The ChromaDepth range of this frame's camera (set, or fitted), if one fits.
+    pub fn chromadepth_range(&self) -> Option<[f32; 2]> {
+        self.chromadepth
+    }
+
+    /// The world point under pixel (`x`, `y`) of the output image, if the model is there: the
+    /// pixel is traced back to the pass it came from (the left half of a side-by-side image is
+    /// the left eye, …) and that pass's depth is unprojected.
+    pub fn pick(&self, x: u32, y: u32) -> Option<Vec3> {
+        let (w, h) = (self.width, self.height);
+        let (view, px, py) = match self.params.output {
+            Output::SideBySide => (if x < w { View::Left } else { View::Right }, x % w, y),
+            Output::CrossEyed => (if x < w { View::Right } else { View::Left }, x % w, y),
+            Output::AboveBelow => (if y < h { View::Left } else { View::Right }, x, y % h),
+            // Both views squashed 1:2, the left on top: a rough pick in the top view.
+            Output::AboveBelowSquashed => (View::Left, x, (y * 2).min(h - 1)),
+            _ => {
+                let view = [View::Left, View::Center, View::Right]
+                    .into_iter()
+                    .find(|&v| self.frame.view(v).is_some())?;
+                (view, x, y)
+            }
+        };
+        let fb = self.frame.view(view)?;
+        if px >= fb.width || py >= fb.height {
+            return None;
+        }
+        let d = *fb.depth.get((py * fb.width + px) as usize)?;
+        (d < 1.0).then(|| {
+            unproject(
+                &self.frame.matrices(view).mvp,
+                px,
+                py,
+                d,
+                fb.width,
+                fb.height,
+            )
+        })
+    }
+
+    /// The passes run, one per line with its time, then the effect and the total.
+    pub fn timing_lines(&self) -> Vec<String> {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let mut lines: Vec<String> = self
+            .passes
+            .iter()
+            .map(|(name, t)| format!("pass {name}: {:.1} ms", ms(*t)))
+            .collect();
+        lines.push(format!(
+            "{}: {:.1} ms",
+            self.params.output.name(),
+            ms(self.effect)
+        ));
+        lines.push(format!("frame: {:.1} ms", ms(self.total)));
+        lines
+    }
+}
