@@ -102,7 +102,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
     };
     outln!("rendered {} ({}x{})", scene.display(), s.width, s.height);
     for note in &s.notes {
-        outln!("  note: {note}");
+        if note.starts_with("warning:") {
+            outln!("  {note}");
+        } else {
+            outln!("  note: {note}");
+        }
     }
     if backend == Backend::Gpu {
         let ms = frame
