@@ -233,3 +233,15 @@ fn a_model_far_from_the_origin_is_warned_about_with_the_precision_lost() {
         "origin",
     );
 }
+
+#[test]
+fn a_render_that_draws_nothing_says_so() {
+    // The model moved far out of the view: every pass draws 0 fragments.
+    let out = render(
+        "anaglyph.toml",
+        "hard-nothing",
+        &["mesh.0.translate=[1000,0,0]"],
+    );
+    assert_warned(&out, &["no pass drew a fragment", "camera.eye"]);
+    assert_no_warning_naming(&render("anaglyph.toml", "hard-something", &[]), "fragment");
+}
