@@ -20,6 +20,7 @@ mod gpu_sirds;
 mod grading;
 mod grading_batch;
 mod grading_trust;
+mod hard_cases;
 mod layout;
 mod obj_corpus;
 mod reliability;

@@ -289,10 +289,28 @@ impl StereoRig {
     pub fn eyes(&self, camera: &Camera, aspect: f32) -> Result<[EyeMatrices; 2]> {
         camera.validate()?;
         let r = self.resolve(camera, aspect)?;
-        Ok([
+        let eyes = [
             self.eye(camera, aspect, &r, -1.0),
             self.eye(camera, aspect, &r, 1.0),
-        ])
+        ];
+        // Every range check can pass and the matrices still overflow (toe-in's look-at squares
+        // the eye offset): refuse them here, before anything renders with NaN cameras.
+        if eyes
+            .iter()
+            .any(|e| !(e.view.is_finite() && e.projection.is_finite() && e.mvp.is_finite()))
+        {
+            return Err(Error::invalid(
+                "stereo.eye_separation",
+                r.eye_separation,
+                format!(
+                    "makes the {:?} eye matrices non-finite in single precision; use a \
+                     separation comparable to the scene (about 1/30 of the zero-parallax \
+                     distance {}), or \"auto\"",
+                    self.mode, r.zero_parallax_distance
+                ),
+            ));
+        }
+        Ok(eyes)
     }
 
     /// One eye; `side` is −1 for left, +1 for right.

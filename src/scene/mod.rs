@@ -1,5 +1,6 @@
 //! Scenes: the TOML file, OBJ models, procedural shapes.
 
+mod checks;
 mod file;
 mod mesh;
 mod obj;
@@ -7,6 +8,7 @@ mod polygon;
 pub mod terrain;
 pub mod terrain_data;
 
+pub use checks::{DEPTH_RESOLUTION_WARN, ORIGIN_PRECISION_WARN, depth_resolution};
 pub(crate) use file::SceneFile;
 pub use mesh::Mesh;
 pub use obj::{load_obj, load_obj_with_notes, parse_obj, parse_obj_with_notes};
@@ -198,8 +200,11 @@ impl Scene {
             lighting: f.stereo.lighting,
         };
         let aspect = f.image.width as f32 / f.image.height as f32;
-        rig.resolve(&f.camera, aspect)?;
+        // The eyes themselves: a separation can pass every range check and still overflow the
+        // matrices (toe-in at 1e20 units gives NaN cameras).
+        rig.eyes(&f.camera, aspect)?;
         check_finite("light.position", &f.light.position)?;
+        checks::check_light(&f.light)?;
         check_finite("image.background", &f.image.background)?;
         let light = Light {
             position: f.light.position.into(),
@@ -241,7 +246,9 @@ impl Scene {
         if triangles > max_triangles {
             return Err(over_budget("mesh", triangles, max_triangles));
         }
-        Ok(Scene {
+        let sirds = crate::effects::sirds::Settings::from_spec(&f.sirds, root)?;
+        checks::check_sirds_clip(&sirds, &f.camera)?;
+        let mut scene = Scene {
             width: f.image.width,
             height: f.image.height,
             background: to_rgba8(f.image.background.into()),
@@ -260,9 +267,12 @@ impl Scene {
                 linear_light: f.finalize.linear_light,
                 swap_eyes: f.finalize.swap_eyes,
             },
-            sirds: crate::effects::sirds::Settings::from_spec(&f.sirds, root)?,
+            sirds,
             notes,
-        })
+        };
+        let warnings = checks::precision_warnings(&scene)?;
+        scene.notes.extend(warnings);
+        Ok(scene)
     }
 
     /// Lets the AVX2 loops run where the CPU has them (`true`, the default) or keeps every pass
@@ -294,7 +304,7 @@ impl Scene {
         check_size(width, height)?;
         self.width = width;
         self.height = height;
-        self.rig.resolve(&self.camera, self.aspect())?;
+        self.rig.eyes(&self.camera, self.aspect())?;
         Ok(())
     }
 

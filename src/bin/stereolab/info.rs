@@ -23,5 +23,8 @@ pub struct InfoArgs {
 pub fn run(args: InfoArgs) -> Result<()> {
     let s = super::load_scene(&args.scene, &args.sets, None)?;
     out!("{}", info::describe(&s)?);
+    for warning in s.notes.iter().filter(|n| n.starts_with("warning:")) {
+        outln!("{warning}");
+    }
     Ok(())
 }

@@ -102,7 +102,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
     };
     outln!("rendered {} ({}x{})", scene.display(), s.width, s.height);
     for note in &s.notes {
-        outln!("  note: {note}");
+        if note.starts_with("warning:") {
+            outln!("  {note}");
+        } else {
+            outln!("  note: {note}");
+        }
     }
     if backend == Backend::Gpu {
         let ms = frame
@@ -125,6 +129,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
             p.stats.fragments,
             p.stats.clipped,
             p.stats.culled
+        );
+    }
+    // Nothing drawn at all is never what a scene means: say so instead of exiting quietly with
+    // background-only images (the precision cases are refused at load; this catches the rest).
+    let cpu_passes = frame.passes.iter().filter(|_| backend == Backend::Cpu);
+    if cpu_passes.clone().count() > 0 && cpu_passes.clone().all(|p| p.stats.fragments == 0) {
+        outln!(
+            "  warning: no pass drew a fragment: the images show only the background; check \
+             that the meshes lie inside the view (camera.eye, camera.target, camera.near, \
+             camera.far, each mesh's translate and scale)"
         );
     }
     if let Some(report) = info::frame_budget_report(&frame, &s)? {

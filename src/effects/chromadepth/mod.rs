@@ -83,12 +83,20 @@ impl ChromaDepthSettings {
     /// Checks what can be checked before rendering (automatic D1/D2 are checked when resolved).
     ///
     /// # Errors
-    /// `Invalid` naming the field: non-finite D1/D2, D1 == D2, D1 > D2, texels outside
+    /// `Invalid` naming the field: non-finite D1/D2, D1/D2 ≤ 0 (behind the eye), D1 == D2, D1 > D2, texels outside
     /// 2..=65536, glasses shift outside 0..=0.1.
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [("chromadepth.d1", self.d1), ("chromadepth.d2", self.d2)] {
             if let Some(v) = v.filter(|v| !v.is_finite()) {
                 return Err(Error::invalid(name, v, "must be a finite distance"));
+            }
+            if let Some(v) = v.filter(|v| *v <= 0.0) {
+                return Err(Error::invalid(
+                    name,
+                    v,
+                    "must be a distance > 0 in front of the eye (eye-space depth; behind the \
+                     eye nothing is drawn); leave it out for the automatic range",
+                ));
             }
         }
         if let (Some(d1), Some(d2)) = (self.d1, self.d2) {

@@ -1,0 +1,247 @@
+//! Issue 18's adversarial inputs, tried as a user would with `--set`: each must end in a refusal
+//! (non-zero exit, the field and the remedy named) or a warning in the CLI output, never in a
+//! silently wrong image with exit 0.
+
+use std::process::{Command, Output};
+
+use crate::common::{asset, out_dir};
+
+fn stereolab(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(args)
+        .output()
+        .expect("run stereolab")
+}
+
+/// `stereolab info` of an asset scene with `--set` overrides (the checks run at load, so
+/// `info` sees them as `render` does).
+fn info(scene: &str, sets: &[&str]) -> Output {
+    let scene = asset(&format!("scenes/{scene}"))
+        .to_string_lossy()
+        .into_owned();
+    let mut args = vec!["info", scene.as_str()];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    stereolab(&args)
+}
+
+/// A small `stereolab render`, whose output holds the warnings.
+fn render(scene: &str, name: &str, sets: &[&str]) -> Output {
+    let scene = asset(&format!("scenes/{scene}"))
+        .to_string_lossy()
+        .into_owned();
+    let dir = out_dir(name).to_string_lossy().into_owned();
+    let mut args = vec![
+        "render",
+        scene.as_str(),
+        "--size",
+        "96x64",
+        "--out",
+        dir.as_str(),
+    ];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    stereolab(&args)
+}
+
+/// The run failed and its message names every one of `words`.
+fn assert_refused(out: &Output, words: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "must be refused, got exit 0; stderr: {err}"
+    );
+    for w in words {
+        assert!(err.contains(w), "the refusal must name {w:?}: {err}");
+    }
+}
+
+/// The run succeeded and printed a `warning:` line naming every one of `words`.
+fn assert_warned(out: &Output, words: &[&str]) {
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "must succeed with a warning; stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let warning = text
+        .lines()
+        .find(|l| l.contains("warning:") && words.iter().all(|w| l.contains(w)));
+    assert!(
+        warning.is_some(),
+        "expected a warning naming {words:?}:\n{text}"
+    );
+}
+
+fn assert_no_warning_naming(out: &Output, word: &str) {
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        !text
+            .lines()
+            .any(|l| l.contains("warning:") && l.contains(word)),
+        "no warning about {word} expected:\n{text}"
+    );
+}
+
+#[test]
+fn light_factors_that_are_nan_infinite_or_negative_are_refused_by_name() {
+    for (field, value) in [
+        ("ambient", "nan"),
+        ("ambient", "-0.1"),
+        ("specular", "inf"),
+        ("specular", "-1"),
+        ("shininess", "nan"),
+        ("shininess", "-32"),
+    ] {
+        let set = format!("light.{field}={value}");
+        let out = info("anaglyph.toml", &[&set]);
+        assert_refused(&out, &[&format!("light.{field}"), "finite number ≥ 0"]);
+    }
+    // The defaults and ordinary values still load.
+    assert!(
+        info("anaglyph.toml", &["light.shininess=0"])
+            .status
+            .success()
+    );
+}
+
+#[test]
+fn an_eye_separation_that_overflows_the_cameras_is_refused_in_every_mode() {
+    let out = info(
+        "anaglyph.toml",
+        &["stereo.mode=\"toe-in\"", "stereo.eye_separation=1e20"],
+    );
+    assert_refused(&out, &["stereo.eye_separation", "non-finite", "\"auto\""]);
+    // Render refuses it too (before: NaN cameras, empty images, exit 0).
+    let out = render(
+        "anaglyph.toml",
+        "hard-toe-in",
+        &["stereo.mode=\"toe-in\"", "stereo.eye_separation=1e20"],
+    );
+    assert_refused(&out, &["stereo.eye_separation"]);
+    // Off-axis with a separation whose shift overflows the frustum.
+    let out = info("anaglyph.toml", &["stereo.eye_separation=3e38"]);
+    assert_refused(&out, &["stereo.eye_separation"]);
+}
+
+#[test]
+fn a_near_plane_that_rounds_every_depth_to_one_is_refused_with_the_remedy() {
+    for sets in [
+        ["camera.near=1e-7", "camera.far=1e7"],
+        ["camera.near=1e-9", "camera.far=20"],
+    ] {
+        let out = render("anaglyph.toml", "hard-near", &sets);
+        assert_refused(
+            &out,
+            &["camera.near", "window depth 1.0", "raise camera.near"],
+        );
+    }
+}
+
+#[test]
+fn a_near_plane_that_coarsens_the_depth_buffer_is_warned_about_with_both_resolutions() {
+    for sets in [
+        ["camera.near=1e-6", "camera.far=1e7"],
+        ["camera.near=1e-5", "camera.far=1e5"],
+    ] {
+        let out = render("anaglyph.toml", "hard-near-warn", &sets);
+        assert_warned(
+            &out,
+            &[
+                "camera.near",
+                "nearest surface",
+                "farthest",
+                "raise camera.near",
+            ],
+        );
+    }
+    // The scene as shipped has no such warning.
+    assert_no_warning_naming(&render("anaglyph.toml", "hard-near-ok", &[]), "camera.near");
+}
+
+#[test]
+fn per_vertex_sirds_depths_outside_the_clip_range_are_refused_by_name() {
+    // sirds_sphere: near = 1, far = 20, back = 7.
+    for (set, field) in [
+        ("sirds.back=0.5", "sirds.back"),
+        ("sirds.back=25", "sirds.back"),
+        ("sirds.front=0.5", "sirds.front"),
+    ] {
+        let out = info("sirds_sphere.toml", &[set]);
+        assert_refused(&out, &[field, "clip range", "camera.near"]);
+    }
+    // Inside the range it loads; the per-pixel algorithm draws no background plane and keeps
+    // accepting a back beyond far.
+    assert!(
+        info("sirds_sphere.toml", &["sirds.back=19"])
+            .status
+            .success()
+    );
+    assert!(
+        info(
+            "sirds_sphere.toml",
+            &["sirds.algorithm=\"per-pixel\"", "sirds.back=25"]
+        )
+        .status
+        .success()
+    );
+}
+
+#[test]
+fn chromadepth_d1_d2_behind_the_eye_are_refused_and_a_scene_outside_them_is_warned_about() {
+    for set in ["chromadepth.d1=-1", "chromadepth.d1=0"] {
+        let out = info("chromadepth_molecule.toml", &[set, "chromadepth.d2=20"]);
+        assert_refused(&out, &["chromadepth.d1", "> 0"]);
+    }
+    // The molecule sits around eye depth 10: a ramp from 100 to 200 paints it all red.
+    let out = render(
+        "chromadepth_molecule.toml",
+        "hard-chroma-red",
+        &["chromadepth.d1=100", "chromadepth.d2=200"],
+    );
+    assert_warned(&out, &["chromadepth.d1", "all red"]);
+    // A ramp ending at 0.5 paints it all blue.
+    let out = render(
+        "chromadepth_molecule.toml",
+        "hard-chroma-blue",
+        &["chromadepth.d1=0.25", "chromadepth.d2=0.5"],
+    );
+    assert_warned(&out, &["chromadepth.d2", "all blue"]);
+    assert_no_warning_naming(
+        &render("chromadepth_molecule.toml", "hard-chroma-ok", &[]),
+        "ChromaDepth",
+    );
+}
+
+#[test]
+fn a_model_far_from_the_origin_is_warned_about_with_the_precision_lost() {
+    let out = info("anaglyph.toml", &["mesh.0.translate=[1e7,0,0]"]);
+    assert_warned(
+        &out,
+        &["mesh[0]", "from the origin", "apart", "nearer the origin"],
+    );
+    // A thousand units away a unit-sized model keeps 1/10 000 of its size: no warning.
+    assert_no_warning_naming(
+        &info("anaglyph.toml", &["mesh.0.translate=[100,0,0]"]),
+        "origin",
+    );
+}
+
+#[test]
+fn a_render_that_draws_nothing_says_so() {
+    // The model moved far out of the view: every pass draws 0 fragments.
+    let out = render(
+        "anaglyph.toml",
+        "hard-nothing",
+        &["mesh.0.translate=[1000,0,0]"],
+    );
+    assert_warned(&out, &["no pass drew a fragment", "camera.eye"]);
+    assert_no_warning_naming(&render("anaglyph.toml", "hard-something", &[]), "fragment");
+}
