@@ -29,3 +29,4 @@ mod sirds;
 mod sirds_interop;
 mod stability;
 mod stereo_photo;
+mod zero_parallax;
