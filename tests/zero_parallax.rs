@@ -33,7 +33,10 @@ fn auto_is_the_camera_target_distance_and_fits_the_budget() {
     let want = (Vec3::from(s.camera.target) - Vec3::from(s.camera.eye)).length();
     assert!((z0(&s) - want).abs() < 1e-5, "z0 {} vs {want}", z0(&s));
     let (worst, lo, hi) = range(&s);
-    assert!(lo < 0.0 && hi > 0.0, "the subject straddles the screen: {lo}..{hi}");
+    assert!(
+        lo < 0.0 && hi > 0.0,
+        "the subject straddles the screen: {lo}..{hi}"
+    );
     assert!(worst <= PARALLAX_BUDGET_PERCENT as f64, "{lo}..{hi}");
 }
 
@@ -53,7 +56,11 @@ fn fit_is_the_harmonic_mean_of_the_visible_depths_and_balances_the_range() {
         }
     }
     let harmonic = 2.0 / (1.0 / near + 1.0 / far);
-    assert!((z0(&s) - harmonic).abs() < 1e-4, "z0 {} vs {harmonic}", z0(&s));
+    assert!(
+        (z0(&s) - harmonic).abs() < 1e-4,
+        "z0 {} vs {harmonic}",
+        z0(&s)
+    );
     let (worst, lo, hi) = range(&s);
     assert!(lo < 0.0 && hi > 0.0, "{lo}..{hi}");
     assert!(worst <= PARALLAX_BUDGET_PERCENT as f64, "{lo}..{hi}");
@@ -67,10 +74,15 @@ fn fit_is_the_harmonic_mean_of_the_visible_depths_and_balances_the_range() {
 fn over_budget_report_names_both_remedies_and_each_works() {
     let s = load("wuson_no_zero_parallax", &[]);
     let (worst, lo, _) = range(&s);
-    assert!(lo < -9.0 && worst > 9.0, "the unfixed scene is far over budget: {lo}");
+    assert!(
+        lo < -9.0 && worst > 9.0,
+        "the unfixed scene is far over budget: {lo}"
+    );
     let text = describe(&s).expect("info");
     let number_after = |key: &str| -> String {
-        let at = text.find(key).unwrap_or_else(|| panic!("{key:?} missing in:\n{text}"));
+        let at = text
+            .find(key)
+            .unwrap_or_else(|| panic!("{key:?} missing in:\n{text}"));
         text[at + key.len()..]
             .split_whitespace()
             .next()
@@ -86,7 +98,10 @@ fn over_budget_report_names_both_remedies_and_each_works() {
         let fixed = load("wuson_no_zero_parallax", std::slice::from_ref(&set));
         let (w, lo, hi) = range(&fixed);
         // Printed to 3–4 decimals: allow that rounding.
-        assert!(w <= PARALLAX_BUDGET_PERCENT as f64 + 0.01, "{set}: {lo}..{hi}");
+        assert!(
+            w <= PARALLAX_BUDGET_PERCENT as f64 + 0.01,
+            "{set}: {lo}..{hi}"
+        );
     }
 }
 
@@ -98,6 +113,12 @@ fn info_prints_the_horizontal_fov_and_warns_under_50_degrees() {
     assert!(wide.contains("horizontal field of view 51.8°"), "{wide}");
     assert!(!wide.contains("is under 50°"), "{wide}");
     let narrow = describe(&load("wuson_narrow_fov", &[])).expect("info");
-    assert!(narrow.contains("horizontal field of view 32.9°"), "{narrow}");
-    assert!(narrow.contains("warning: horizontal field of view 32.9° is under 50°"), "{narrow}");
+    assert!(
+        narrow.contains("horizontal field of view 32.9°"),
+        "{narrow}"
+    );
+    assert!(
+        narrow.contains("warning: horizontal field of view 32.9° is under 50°"),
+        "{narrow}"
+    );
 }

@@ -267,7 +267,9 @@ impl Scene {
             ));
             rig.zero_parallax = ZeroParallax::Distance(z0);
             rig.resolve(&f.camera, aspect)?;
-        } else if let (Some(_), ZeroParallax::Distance(z0)) = (&zero_parallax_word, rig.zero_parallax) {
+        } else if let (Some(_), ZeroParallax::Distance(z0)) =
+            (&zero_parallax_word, rig.zero_parallax)
+        {
             notes.push(format!(
                 "stereo.zero_parallax = \"auto\": z0 = {z0:.4} (the camera target's distance)"
             ));
