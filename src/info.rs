@@ -95,7 +95,25 @@ pub fn describe(scene: &Scene) -> Result<String> {
             m.eye_world.x, m.eye_world.y, m.eye_world.z, f[0], f[1], f[2], f[3], f[4], f[5]
         );
     }
-    s.push_str(&scene_budget(scene)?.report());
+    let fov_x = horizontal_fov_degrees(scene.camera.fov_y, scene.aspect());
+    let _ = writeln!(
+        s,
+        "  horizontal field of view {fov_x:.1}° (vertical {:.1}°)",
+        scene.camera.fov_y
+    );
+    if fov_x < MIN_HORIZONTAL_FOV_DEGREES {
+        let _ = writeln!(
+            s,
+            "warning: horizontal field of view {fov_x:.1}° is under {MIN_HORIZONTAL_FOV_DEGREES}°: \
+             the StereoGraphics guide (Akka) §8 advises a wide angle (≥ {MIN_HORIZONTAL_FOV_DEGREES}°) \
+             for strong depth cues; raise camera.fov_y"
+        );
+    }
+    let budget = scene_budget(scene)?;
+    s.push_str(&budget.report());
+    if let Some(r) = budget_remedies(scene, &budget, resolved.eye_separation)? {
+        s.push_str(&r);
+    }
     let p = parallax_range(scene)?;
     if p.vertices == 0 {
         let _ = writeln!(s, "parallax: no vertex lies inside both frusta");
@@ -114,7 +132,7 @@ pub fn describe(scene: &Scene) -> Result<String> {
     if p.min_percent < -PARALLAX_BUDGET_PERCENT || p.max_percent > PARALLAX_BUDGET_PERCENT {
         let _ = writeln!(
             s,
-            "warning: parallax exceeds the StereoGraphics guide's ~{PARALLAX_BUDGET_PERCENT}% budget; reduce eye_separation or user_offset"
+            "warning: parallax exceeds the StereoGraphics guide's ~{PARALLAX_BUDGET_PERCENT}% budget; see the remedies above"
         );
     }
     if p.max_vertical_percent > 0.01 {
@@ -125,6 +143,54 @@ pub fn describe(scene: &Scene) -> Result<String> {
         );
     }
     Ok(s)
+}
+
+/// The StereoGraphics guide (Akka) §8: stereo works best with a wide horizontal field of view.
+pub const MIN_HORIZONTAL_FOV_DEGREES: f32 = 50.0;
+
+/// Horizontal field of view from the vertical one: `2 atan(tan(fov_y/2) · aspect)`.
+pub fn horizontal_fov_degrees(fov_y_degrees: f32, aspect: f32) -> f32 {
+    2.0 * ((fov_y_degrees.to_radians() * 0.5).tan() * aspect)
+        .atan()
+        .to_degrees()
+}
+
+/// When the measured budget is exceeded, both remedies with numbers: the zero-parallax distance
+/// `"fit"` would choose, and the eye separation that scales the present range into ±3%
+/// (parallax is proportional to d at a fixed z0). `None` within budget.
+///
+/// # Errors
+/// Invalid camera or rig.
+pub fn budget_remedies(
+    scene: &Scene,
+    budget: &ParallaxBudget,
+    eye_separation: f32,
+) -> Result<Option<String>> {
+    if budget.drawn == 0 {
+        return Ok(None);
+    }
+    let worst = budget
+        .percent(budget.min_pixels)
+        .abs()
+        .max(budget.percent(budget.max_pixels).abs());
+    if worst <= PARALLAX_BUDGET_PERCENT as f64 {
+        return Ok(None);
+    }
+    let mut s = format!(
+        "  remedies (parallax reaches {worst:.2}% of width, budget ±{PARALLAX_BUDGET_PERCENT}%):\n"
+    );
+    if let Ok(z0) = scene.fitted_zero_parallax() {
+        let _ = writeln!(
+            s,
+            "    move the zero-parallax plane: stereo.zero_parallax = {z0:.3} (or \"fit\")"
+        );
+    }
+    let d = eye_separation as f64 * PARALLAX_BUDGET_PERCENT as f64 / worst;
+    let _ = writeln!(
+        s,
+        "    or reduce the eye separation: stereo.eye_separation = {d:.4} (now {eye_separation:.4})"
+    );
+    Ok(Some(s))
 }
 
 /// The budget of a scene: renders the left eye depth-only (all `p(z)` needs) and measures it.

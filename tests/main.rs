@@ -32,3 +32,4 @@ mod stability;
 mod stereo_photo;
 #[cfg(feature = "viewer")]
 mod viewer;
+mod zero_parallax;

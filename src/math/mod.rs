@@ -8,6 +8,7 @@ mod rig;
 
 pub use rig::{
     Camera, CameraMode, EyeMatrices, Lighting, ResolvedRig, Separation, StereoRig, ZeroParallax,
+    fit_zero_parallax,
 };
 
 use glam::{Mat4, Vec3, Vec4};

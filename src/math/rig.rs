@@ -162,6 +162,18 @@ pub enum ZeroParallax {
     Fraction(f32),
 }
 
+/// The zero-parallax distance that best fits a depth range `[z_near, z_far]` (eye distances of
+/// the nearest and farthest visible point) into the StereoGraphics guide's symmetric parallax
+/// budget (§7–8: keep negative and positive parallax each within a few percent of the width).
+///
+/// The parallax `p(z) = d·(b − z0/z)` (the exercise slides, balance b) in pixels is, for a fixed
+/// separation, `∝ b/z0 − 1/z`, and for the automatic separation (d ∝ z0) `∝ b − z0/z`: either
+/// way the largest |p| over the range is smallest when `p(z_near) = −p(z_far)`, i.e.
+/// `b/z0 = (1/z_near + 1/z_far)/2`: z0 is b times the harmonic mean of the two depths.
+pub fn fit_zero_parallax(z_near: f32, z_far: f32, balance: f32) -> f32 {
+    balance * 2.0 / (1.0 / z_near + 1.0 / z_far)
+}
+
 /// The stereo rig: separation, fusion distance, camera mode, and the StereoGraphics guide's user factors.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StereoRig {

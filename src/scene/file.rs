@@ -78,9 +78,10 @@ pub(crate) struct StereoSpec {
     /// Number or `"auto"` (default).
     #[serde(default)]
     pub eye_separation: Option<SeparationSpec>,
-    /// Absolute zero-parallax distance.
+    /// Absolute zero-parallax distance, `"auto"` (the camera target's distance) or `"fit"`
+    /// (the distance that centres the scene's depth range in the parallax budget).
     #[serde(default)]
-    pub zero_parallax: Option<f32>,
+    pub zero_parallax: Option<SeparationSpec>,
     /// Zero-parallax position between near (0) and far (1); default 0.5 if neither is given.
     #[serde(default)]
     pub zero_parallax_fraction: Option<f32>,

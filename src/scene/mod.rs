@@ -23,7 +23,7 @@ use crate::effects::parallax::ParallaxRig;
 use crate::error::{Error, Result};
 use crate::files::InputRoot;
 use crate::framebuffer::check_size;
-use crate::math::{Camera, Separation, StereoRig, ZeroParallax};
+use crate::math::{Camera, Separation, StereoRig, ZeroParallax, fit_zero_parallax};
 use crate::plan::Output;
 use crate::raster::RasterOptions;
 use crate::shade::{Light, to_rgba8};
@@ -179,7 +179,8 @@ impl Scene {
                 ));
             }
         };
-        let zero_parallax = match (f.stereo.zero_parallax, f.stereo.zero_parallax_fraction) {
+        let mut zero_parallax_word = None;
+        let zero_parallax = match (&f.stereo.zero_parallax, f.stereo.zero_parallax_fraction) {
             (Some(_), Some(_)) => {
                 return Err(Error::invalid(
                     "stereo.zero_parallax",
@@ -187,11 +188,26 @@ impl Scene {
                     "give zero_parallax or zero_parallax_fraction, not both",
                 ));
             }
-            (Some(d), None) => ZeroParallax::Distance(d),
+            (Some(file::SeparationSpec::Value(d)), None) => ZeroParallax::Distance(*d),
+            // "auto": the camera target's distance along the view direction (seed 003 §7's
+            // centre of interest); "fit" is resolved below, once the meshes are loaded.
+            (Some(file::SeparationSpec::Word(w)), None) if w == "auto" || w == "fit" => {
+                zero_parallax_word = Some(w.clone());
+                let dir = Vec3::from(f.camera.target) - Vec3::from(f.camera.eye);
+                ZeroParallax::Distance(dir.length())
+            }
+            (Some(file::SeparationSpec::Word(w)), None) => {
+                return Err(Error::invalid(
+                    "stereo.zero_parallax",
+                    format!("\"{w}\""),
+                    "must be a distance, \"auto\" (the camera target's distance) or \"fit\" \
+                     (centre the scene's depth range in the parallax budget)",
+                ));
+            }
             (None, Some(t)) => ZeroParallax::Fraction(t),
             (None, None) => ZeroParallax::Fraction(0.5),
         };
-        let rig = StereoRig {
+        let mut rig = StereoRig {
             mode: f.stereo.mode,
             separation,
             zero_parallax,
@@ -245,6 +261,21 @@ impl Scene {
         let triangles: u64 = objects.iter().map(|o| o.mesh.triangles.len() as u64).sum();
         if triangles > max_triangles {
             return Err(over_budget("mesh", triangles, max_triangles));
+        }
+        if zero_parallax_word.as_deref() == Some("fit") {
+            let z0 = fit_scene_zero_parallax(&rig, &f.camera, &objects)?;
+            notes.push(format!(
+                "stereo.zero_parallax = \"fit\": z0 = {z0:.4} (balance × harmonic mean of the \
+                 nearest and farthest visible vertex depths)"
+            ));
+            rig.zero_parallax = ZeroParallax::Distance(z0);
+            rig.resolve(&f.camera, aspect)?;
+        } else if let (Some(_), ZeroParallax::Distance(z0)) =
+            (&zero_parallax_word, rig.zero_parallax)
+        {
+            notes.push(format!(
+                "stereo.zero_parallax = \"auto\": z0 = {z0:.4} (the camera target's distance)"
+            ));
         }
         let sirds = crate::effects::sirds::Settings::from_spec(&f.sirds, root)?;
         checks::check_sirds_clip(&sirds, &f.camera)?;
@@ -308,6 +339,15 @@ impl Scene {
         Ok(())
     }
 
+    /// The zero-parallax distance `"fit"` would choose for this scene's camera and rig
+    /// ([`fit_zero_parallax`] over the visible vertex depths).
+    ///
+    /// # Errors
+    /// Parallel mode (z0 moves nothing), or no vertex inside the view.
+    pub fn fitted_zero_parallax(&self) -> Result<f32> {
+        fit_scene_zero_parallax(&self.rig, &self.camera, &self.objects)
+    }
+
     /// Every object's vertices in world space.
     pub fn world_points(&self) -> impl Iterator<Item = Vec3> + '_ {
         self.objects.iter().flat_map(|o| {
@@ -317,6 +357,51 @@ impl Scene {
                 .map(move |p| o.model.transform_point3(*p))
         })
     }
+}
+
+/// `zero_parallax = "fit"`: the eye distances of the nearest and farthest vertex inside the
+/// cyclopean view (strictly between near and far) give [`fit_zero_parallax`].
+fn fit_scene_zero_parallax(rig: &StereoRig, camera: &Camera, objects: &[Object]) -> Result<f32> {
+    use crate::math::CameraMode;
+    let balance = match rig.mode {
+        CameraMode::OffAxis => rig.user_balance,
+        CameraMode::ToeIn => 1.0,
+        CameraMode::Parallel => {
+            return Err(Error::invalid(
+                "stereo.zero_parallax",
+                "\"fit\"",
+                "parallel cameras put zero parallax at infinity whatever z0 is; use mode \
+                 \"off-axis\" or give a distance",
+            ));
+        }
+    };
+    let view = camera.view();
+    let ty = (camera.fov_y.to_radians() * 0.5).tan();
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for o in objects {
+        for p in &o.mesh.positions {
+            let e = view.transform_point3(o.model.transform_point3(*p));
+            let z = -e.z;
+            // Inside the view: depth between the clip planes, |y| within the vertical fov
+            // (x is not tested: the fit is meant for the subject the camera looks at).
+            if z > camera.near && z < camera.far && e.y.abs() <= ty * z {
+                lo = lo.min(z);
+                hi = hi.max(z);
+            }
+        }
+    }
+    if !lo.is_finite() {
+        return Err(Error::invalid(
+            "stereo.zero_parallax",
+            "\"fit\"",
+            "no vertex lies inside the view to measure; give a distance",
+        ));
+    }
+    let z0 = fit_zero_parallax(lo, hi, balance);
+    Ok(z0.clamp(
+        camera.near + 1e-3 * (camera.far - camera.near),
+        camera.far - 1e-3 * (camera.far - camera.near),
+    ))
 }
 
 fn check_finite(field: &str, v: &[f32]) -> Result<()> {
