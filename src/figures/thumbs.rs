@@ -1,11 +1,11 @@
 //! Small renders of the course scene for the figures: the real passes and outputs at a small
 //! size, and a captioned grid to lay them out.
 
-use image::{Rgba, RgbaImage};
+use image::RgbaImage;
 
 use super::canvas::{Canvas, INK, LABEL};
 use crate::error::Result;
-use crate::output::{Image, produce};
+use crate::output::produce;
 use crate::plan::{Output, Plan};
 use crate::render::{Frame, render};
 use crate::scene::Scene;
@@ -35,21 +35,7 @@ pub fn rendered(
 /// # Errors
 /// As [`produce`].
 pub fn image_of(output: Output, frame: &Frame, scene: &Scene) -> Result<RgbaImage> {
-    Ok(match produce(output, frame, scene)? {
-        Image::Rgba(i) => i,
-        Image::Gray16(g) => RgbaImage::from_fn(g.width(), g.height(), |x, y| {
-            let v = (g.get_pixel(x, y)[0] >> 8) as u8;
-            Rgba([v, v, v, 255])
-        }),
-        // A stereo photo shows as its files hold it: cross-eyed, the right eye on the left.
-        Image::Stereo(p) => {
-            let (w, h) = (p.left.width(), p.left.height());
-            let mut out = RgbaImage::new(2 * w, h);
-            image::imageops::replace(&mut out, &p.right, 0, 0);
-            image::imageops::replace(&mut out, &p.left, i64::from(w), 0);
-            out
-        }
-    })
+    Ok(produce(output, frame, scene)?.to_display_rgba())
 }
 
 /// Images in a grid of `cols` columns, each with its caption above, on a white page.

@@ -41,6 +41,34 @@ impl Image {
             Image::Stereo(photo) => files::write_bytes(path, &photo.encode()?),
         }
     }
+
+    /// The image as 8-bit RGBA for a screen or a page: 16-bit depth by its high byte, a stereo
+    /// photo as its file shows it (cross-eyed: the right eye on the left).
+    pub fn to_display_rgba(&self) -> image::RgbaImage {
+        match self {
+            Image::Rgba(i) => i.clone(),
+            Image::Gray16(g) => image::RgbaImage::from_fn(g.width(), g.height(), |x, y| {
+                let v = (g.get_pixel(x, y).0[0] >> 8) as u8;
+                image::Rgba([v, v, v, 255])
+            }),
+            Image::Stereo(p) => {
+                let w = p.left.width();
+                let mut out = image::RgbaImage::new(2 * w, p.left.height());
+                image::imageops::replace(&mut out, &p.right, 0, 0);
+                image::imageops::replace(&mut out, &p.left, i64::from(w), 0);
+                out
+            }
+        }
+    }
+
+    /// Width and height of [`Image::to_display_rgba`].
+    pub fn display_size(&self) -> (u32, u32) {
+        match self {
+            Image::Rgba(i) => i.dimensions(),
+            Image::Gray16(i) => i.dimensions(),
+            Image::Stereo(p) => (2 * p.left.width(), p.left.height()),
+        }
+    }
 }
 
 fn need(frame: &Frame, view: View, output: Output) -> Result<&Framebuffer> {

@@ -105,29 +105,17 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
 impl Shown {
     /// The image as 8-bit RGBA for the screen (16-bit depth shown by its high byte).
     pub fn display_rgba(&self) -> image::RgbaImage {
-        match &self.image {
-            Image::Rgba(i) => i.clone(),
-            Image::Gray16(g) => image::RgbaImage::from_fn(g.width(), g.height(), |x, y| {
-                let v = (g.get_pixel(x, y).0[0] >> 8) as u8;
-                image::Rgba([v, v, v, 255])
-            }),
-        }
+        self.image.to_display_rgba()
     }
 
     /// Width of the output image (side by side is twice the scene's width).
     pub fn image_width(&self) -> u32 {
-        match &self.image {
-            Image::Rgba(i) => i.width(),
-            Image::Gray16(i) => i.width(),
-        }
+        self.image.display_size().0
     }
 
     /// Height of the output image.
     pub fn image_height(&self) -> u32 {
-        match &self.image {
-            Image::Rgba(i) => i.height(),
-            Image::Gray16(i) => i.height(),
-        }
+        self.image.display_size().1
     }
 
     /// The scene's width / height.
