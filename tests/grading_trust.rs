@@ -137,12 +137,18 @@ fn a_process_left_behind_by_a_task_cannot_change_the_results() {
     let results = dir.join("results.json");
     // Two ways to outlive the task: a plain child in its process group, and one in a new
     // session of its own (`setsid`), both rewriting results.json a second later.
-    // Each leaves a marker first, to prove it ran (a forger that never started proves nothing).
+    // Each leaves a marker first, to prove it ran (a forger that never started proves nothing),
+    // and the task waits (at most 10 s) for that marker before it returns, so that on a busy
+    // machine the grader's end of task cannot come before the forger has started.
     let forge = |how: &str| {
-        format!(
-            "std::process::Command::new(\"sh\").args([\"-c\", \"{how} sh -c 'touch {}/started-{}; sleep 1; echo forged > {}'\"]).spawn().ok();",
+        let marker = format!(
+            "{}/started-{}",
             dir.display(),
-            if how.is_empty() { "plain" } else { how },
+            if how.is_empty() { "plain" } else { how }
+        );
+        format!(
+            "std::process::Command::new(\"sh\").args([\"-c\", \"{how} sh -c 'touch {marker}; sleep 1; echo forged > {}'\"]).spawn().ok(); \
+             for _ in 0..1000 {{ if std::path::Path::new(\"{marker}\").exists() {{ break; }} std::thread::sleep(std::time::Duration::from_millis(10)); }}",
             results.display()
         )
     };

@@ -62,10 +62,11 @@ impl WindowVertex {
         // no sample point inside the viewport and keeps the fixed-point math from overflowing.
         // The depth plane's positions are not clamped (llvmpipe does not): they only enter
         // float arithmetic, whose overflow setup turns into an empty triangle.
-        let ndc = |c: f32| (c / p.w).clamp(-1.0, 1.0);
+        // Positions as llvmpipe's viewport computes them: `fma(x·(1/w), W/2, W/2)`.
+        let ndc = |c: f32| (c * inv_w).clamp(-1.0, 1.0);
         Some(WindowVertex {
-            x: ndc(p.x) * hw + hw,
-            y: ndc(p.y) * -hh + hh,
+            x: ndc(p.x).mul_add(hw, hw),
+            y: ndc(p.y).mul_add(-hh, hh),
             z: (0.5 * (p.z + p.w)) * inv_w,
             inv_w,
             depth_x: (p.x * inv_w).mul_add(hw, hw),
