@@ -29,7 +29,7 @@ pub struct WindowVertex {
 }
 
 impl WindowVertex {
-    /// Perspective divide and viewport transform: `x_win = (x/w)·W/2 + W/2`,
+    /// Perspective divide and viewport transform: mathematically `x_win = (x/w)·W/2 + W/2`,
     /// `y_win = (y/w)·(−H/2) + H/2` (NDC y = +1 is the top row), `z_win = (z/w)/2 + 1/2`.
     /// `None` when w ≤ 0 (only possible for unclipped input).
     ///
@@ -44,9 +44,11 @@ impl WindowVertex {
     ///   viewport code computes `(c·(1/w))·scale + translate` with `lp_build_fmuladd`, which
     ///   LLVM fuses into one FMA instruction on a CPU that has it.
     ///
-    /// `x` and `y` (coverage and varyings) keep the division `(x/w)` of OpenGL's formula: they
-    /// are snapped to 1/256 pixel for coverage, where the last bit almost never matters, and
-    /// changing them would shift colours of the golden images by a rounding step here and there.
+    /// `x` and `y` (coverage and varyings) are computed the same way, then clamped to the
+    /// viewport. They used to keep the division `(x/w)` of OpenGL's formula; snapped to 1/256
+    /// pixel the last bit almost never matters, but on one shipped view (`wuson_zero_parallax_fit`)
+    /// it did: a snapped vertex landed on the other side of a pixel centre, and a different
+    /// triangle won that pixel on the GPU.
     pub(crate) fn from_clip(v: &ClipVertex, width: u32, height: u32) -> Option<Self> {
         let p = v.pos;
         if p.w <= 0.0 {
