@@ -38,16 +38,7 @@ impl Metrics {
 /// # Errors
 /// Different sizes.
 pub fn compare(expected: &Framebuffer, actual: &Framebuffer) -> Result<Metrics> {
-    if (expected.width, expected.height) != (actual.width, actual.height) {
-        return Err(Error::invalid(
-            "compare",
-            format!(
-                "{}x{} vs {}x{}",
-                expected.width, expected.height, actual.width, actual.height
-            ),
-            "images must have the same size",
-        ));
-    }
+    same_size(expected, actual)?;
     let mut m = Metrics {
         pixels: expected.color.len(),
         coverage_mismatch: 0,
@@ -93,16 +84,7 @@ pub fn depth_bits_identical(
     expected: &Framebuffer,
     actual: &Framebuffer,
 ) -> Result<(usize, usize)> {
-    if (expected.width, expected.height) != (actual.width, actual.height) {
-        return Err(Error::invalid(
-            "compare",
-            format!(
-                "{}x{} vs {}x{}",
-                expected.width, expected.height, actual.width, actual.height
-            ),
-            "images must have the same size",
-        ));
-    }
+    same_size(expected, actual)?;
     let (mut same, mut both) = (0, 0);
     for (e, a) in expected.depth.iter().zip(&actual.depth) {
         if *e < 1.0 && *a < 1.0 {
@@ -542,6 +524,21 @@ fn compare_16(
         max_depth_diff: 0.0,
     };
     (metrics, max)
+}
+
+/// Refuses two framebuffers of different sizes, naming both.
+fn same_size(expected: &Framebuffer, actual: &Framebuffer) -> Result<()> {
+    if (expected.width, expected.height) != (actual.width, actual.height) {
+        return Err(Error::invalid(
+            "compare",
+            format!(
+                "{}x{} vs {}x{}",
+                expected.width, expected.height, actual.width, actual.height
+            ),
+            "images must have the same size",
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -102,14 +102,7 @@ impl Canvas {
 
     /// A polyline through `points`.
     pub fn polyline(&mut self, points: &[(f32, f32)], rgb: Rgb, width: f32) {
-        let mut pb = PathBuilder::new();
-        for (i, &(x, y)) in points.iter().enumerate() {
-            if i == 0 {
-                pb.move_to(x, y);
-            } else {
-                pb.line_to(x, y);
-            }
-        }
+        let pb = path_through(points);
         self.stroke(pb, rgb, width, false);
     }
 
@@ -163,14 +156,7 @@ impl Canvas {
 
     /// A filled polygon, `alpha` 0..255.
     pub fn fill_polygon(&mut self, points: &[(f32, f32)], rgb: Rgb, alpha: u8) {
-        let mut pb = PathBuilder::new();
-        for (i, &(x, y)) in points.iter().enumerate() {
-            if i == 0 {
-                pb.move_to(x, y);
-            } else {
-                pb.line_to(x, y);
-            }
-        }
+        let mut pb = path_through(points);
         pb.close();
         if let Some(path) = pb.finish() {
             self.pm.fill_path(
@@ -438,6 +424,19 @@ impl Axes {
             c.text(x0 + 34.0, y, SMALL, s, INK, Align::Left);
         }
     }
+}
+
+/// A path from the first point through the others in order (open; close it to fill).
+fn path_through(points: &[(f32, f32)]) -> PathBuilder {
+    let mut pb = PathBuilder::new();
+    for (i, &(x, y)) in points.iter().enumerate() {
+        if i == 0 {
+            pb.move_to(x, y);
+        } else {
+            pb.line_to(x, y);
+        }
+    }
+    pb
 }
 
 #[cfg(test)]
