@@ -64,15 +64,18 @@ impl WindowVertex {
         // no sample point inside the viewport and keeps the fixed-point math from overflowing.
         // The depth plane's positions are not clamped (llvmpipe does not): they only enter
         // float arithmetic, whose overflow setup turns into an empty triangle.
-        // Positions as llvmpipe's viewport computes them: `fma(x·(1/w), W/2, W/2)`.
-        let ndc = |c: f32| (c * inv_w).clamp(-1.0, 1.0);
+        // Positions as llvmpipe's viewport computes them: `fma(x·(1/w), W/2, W/2)`. Clamping
+        // the window position to [0, W] is clamping NDC to [−1, 1] (the map is monotonic and
+        // sends ±1 exactly to the edges), so one evaluation serves both.
+        let depth_x = (p.x * inv_w).mul_add(hw, hw);
+        let depth_y = (p.y * inv_w).mul_add(-hh, hh);
         Some(WindowVertex {
-            x: ndc(p.x).mul_add(hw, hw),
-            y: ndc(p.y).mul_add(-hh, hh),
+            x: depth_x.clamp(0.0, width as f32),
+            y: depth_y.clamp(0.0, height as f32),
             z: (0.5 * (p.z + p.w)) * inv_w,
             inv_w,
-            depth_x: (p.x * inv_w).mul_add(hw, hw),
-            depth_y: (p.y * inv_w).mul_add(-hh, hh),
+            depth_x,
+            depth_y,
         })
     }
 }
