@@ -94,6 +94,13 @@ struct Viewer<'a> {
     state: PathBuf,
 }
 
+impl Viewer<'_> {
+    /// The test's output folder (the state file's).
+    fn out(&self) -> &Path {
+        self.state.parent().unwrap_or(Path::new("."))
+    }
+}
+
 fn json(path: &Path) -> Option<serde_json::Value> {
     serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
 }
@@ -498,7 +505,117 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
         "toe-in's vertical parallax: {vertical}% of the height"
     );
     v.key("l");
-    v.wait("cyclopic lighting", |s| s["lighting"] == "cyclopic");
+    let s10 = v.wait("cyclopic lighting", |s| s["lighting"] == "cyclopic");
+
+    // 7. Balance by keypad (]): × 1.1 a press up to 1.1⁷ = 1.95; the eighth press would pass
+    // the StereoGraphics guide's upper limit 2.0, so it changes nothing and the readout says so.
+    for _ in 0..8 {
+        v.key("bracketright");
+    }
+    let s11 = v.wait("balance at its limit", |s| s["limit"].is_string());
+    let balance = s11["user_balance"].as_f64().unwrap();
+    assert!(
+        (balance - 1.1f64.powi(7)).abs() < 1e-4,
+        "balance after eight presses: {balance}"
+    );
+    let limit = s11["limit"].as_str().unwrap();
+    assert!(
+        limit.contains("UserBalanceAdjustment") && limit.contains("2.0"),
+        "{limit}"
+    );
+    v.key("bracketleft");
+    v.wait("balance moving again", |s| {
+        s["limit"].is_null() && s["user_balance"].as_f64().unwrap() < balance - 0.1
+    });
+
+    // 8. The GPU path (G), built with --features gpu; without it G says how to get it.
+    gpu_path(&v, &s10);
+}
+
+/// G shows the wgpu frame beside the CPU's with `compare`'s numbers for the current frame.
+#[cfg(feature = "gpu")]
+fn gpu_path(v: &Viewer, before: &serde_json::Value) {
+    v.key("g");
+    let s = v.wait("the GPU frame beside", |s| {
+        s["gpu_view"] == "beside"
+            && (s["gpu"].is_object() || s["gpu_error"].is_string())
+            && s["gpu_rect"].is_array()
+    });
+    if let Some(e) = s["gpu_error"].as_str() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI is set but the viewer's GPU path failed: {e}"
+        );
+        // Straight to the process's stderr: libtest would swallow eprintln! of a passing test.
+        let _ = std::io::Write::write_all(
+            &mut std::io::stderr(),
+            format!("skipping the viewer's GPU path: {e}\n").as_bytes(),
+        );
+        return;
+    }
+    let g = &s["gpu"];
+    assert_eq!(s["output"], "side_by_side", "{s}");
+    let names: Vec<&str> = g["passes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["Left Color", "Right Color"], "{g}");
+    // Parity on the viewer's frame (toe-in, cyclopic lighting, zero parallax from the click):
+    // the same pixels covered, colors within a step or so, depth bit for bit almost everywhere.
+    for p in g["passes"].as_array().unwrap() {
+        assert_eq!(p["coverage_mismatch"], 0, "{p}");
+        assert!(p["max_channel_diff"].as_u64().unwrap() <= 8, "{p}");
+        let psnr = &p["psnr"];
+        assert!(
+            psnr == "inf" || psnr.as_f64().is_some_and(|d| d > 40.0),
+            "{p}"
+        );
+        let same = p["depth_identical"][0].as_f64().unwrap();
+        let both = p["depth_identical"][1].as_f64().unwrap();
+        assert!(both > 1000.0 && same >= 0.95 * both, "{p}");
+    }
+    assert_eq!(g["output"]["coverage_mismatch"], 0, "{g}");
+    // The GPU image lies right of the CPU image and shows the same picture.
+    let (cpu_rect, gpu_rect) = (&s["image_rect"], &s["gpu_rect"]);
+    assert!(
+        gpu_rect[0].as_f64() >= cpu_rect[2].as_f64(),
+        "{cpu_rect} {gpu_rect}"
+    );
+    let cpu = v.picture(&s);
+    let mut at_gpu = s.clone();
+    at_gpu["image_rect"] = gpu_rect.clone();
+    let gpu = v.picture(&at_gpu);
+    gpu.save(v.out().join("gpu_beside.png")).unwrap();
+    assert_eq!(cpu.dimensions(), gpu.dimensions());
+    let diff: u64 = cpu
+        .as_raw()
+        .iter()
+        .zip(gpu.as_raw())
+        .map(|(a, b)| u64::from(a.abs_diff(*b)))
+        .sum();
+    let mean = diff as f64 / cpu.as_raw().len() as f64;
+    assert!(mean < 2.0, "the GPU image differs by {mean:.2} per channel");
+    // G again: the GPU image alone, in the CPU image's place; then off.
+    v.key("g");
+    v.wait("the GPU frame alone", |s| {
+        s["gpu_view"] == "only" && s["gpu_rect"].is_null() && s["gpu"].is_object()
+    });
+    v.key("g");
+    let off = v.wait("the GPU path off", |s| s["gpu_view"] == "off");
+    assert!(off["frames"].as_u64() > before["frames"].as_u64());
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_path(v: &Viewer, _: &serde_json::Value) {
+    v.key("g");
+    let s = v.wait("the note on the GPU path", |s| {
+        s["status"]
+            .as_str()
+            .is_some_and(|t| t.contains("--features gpu"))
+    });
+    assert_eq!(s["gpu_view"], "off", "{s}");
 }
 
 #[test]

@@ -9,13 +9,16 @@ use eframe::egui;
 use glam::Vec3;
 
 use super::ViewOptions;
-use super::frame::{Shown, render_shown};
-use super::session::{KEYPAD_FACTOR, Params, Session, lighting_name, mode_name};
+use super::frame::{Shown, display_image, render_shown};
+use super::session::{
+    KEYPAD_FACTOR, MODES, Params, Session, Step, USER_FACTOR_MAX, UserFactor, lighting_name,
+    mode_name, next_mode,
+};
 use crate::effects::parallax::PARALLAX_BUDGET_PERCENT;
 use crate::effects::sirds::Algorithm;
 use crate::effects::sirds::settings::{Filter, Start};
 use crate::error::{Error, Result};
-use crate::math::{CameraMode, Lighting, Separation, ZeroParallax};
+use crate::math::{Lighting, Separation, ZeroParallax};
 use crate::plan::Output;
 use crate::scene::Scene;
 
@@ -31,8 +34,11 @@ const KEYS: &[(&str, &str)] = &[
         "separation × 1.1 (UserOffsetAdjustment, guide §7)",
     ),
     ("keypad − / -", "separation ÷ 1.1"),
-    ("] / [", "balance × 1.1 / ÷ 1.1 (UserBalanceAdjustment)"),
-    ("M", "rig mode: off-axis, toe-in, parallel in turn"),
+    (
+        "] / [",
+        "balance × 1.1 / ÷ 1.1 (UserBalanceAdjustment); both factors stop below the guide's 2.0",
+    ),
+    ("M", "rig mode: the next of off-axis, toe-in, parallel"),
     ("L", "lighting: per-eye or cyclopic"),
     ("PageDown / PageUp", "next / previous output"),
     (
@@ -43,6 +49,10 @@ const KEYS: &[(&str, &str)] = &[
     ("T", "turn the model (SIRDS demonstration)"),
     ("N", "SIRDS: a new dot pattern every frame, or a fixed one"),
     ("S", "screenshot: PNG + scene TOML"),
+    (
+        "G",
+        "GPU path (built with --features gpu): beside the CPU image, alone, off; compare's numbers",
+    ),
     ("H / F1", "this help"),
     ("Q / Esc", "quit"),
 ];
@@ -61,16 +71,70 @@ const FAVORITES: [&str; 10] = [
     "left",
 ];
 
+/// The GPU frame beside the CPU's (cargo feature `gpu`).
+#[cfg(feature = "gpu")]
+use super::gpu::GpuShown;
+
+/// Without the `gpu` feature there is never a GPU frame.
+#[cfg(not(feature = "gpu"))]
+enum GpuShown {}
+
+#[cfg(not(feature = "gpu"))]
+impl GpuShown {
+    fn lines(&self) -> Vec<String> {
+        match *self {}
+    }
+}
+
+/// Where the GPU path's image goes (the G key steps through them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum GpuView {
+    /// Not rendered.
+    Off,
+    /// The GPU image to the right of the CPU image.
+    Beside,
+    /// The GPU image in place of the CPU image (clicks still pick in the CPU frame, which has
+    /// the same geometry).
+    Only,
+}
+
+impl GpuView {
+    fn name(self) -> &'static str {
+        match self {
+            GpuView::Off => "off",
+            GpuView::Beside => "beside",
+            GpuView::Only => "only",
+        }
+    }
+}
+
+/// What the worker is asked to render: the parameters, the point last clicked, and whether
+/// the GPU path renders too.
+type Request = (Params, Option<Vec3>, bool);
+
+/// A GPU frame and its texture pixels, or why there is none.
+type GpuDelivered = std::result::Result<(Arc<GpuShown>, egui::ColorImage), String>;
+
+/// What the worker hands back: the frame, its texture pixels (made on the worker, so the
+/// window only moves them into its texture), and the GPU frame if one was asked for.
+struct Delivered {
+    shown: Arc<Shown>,
+    pixels: egui::ColorImage,
+    /// Time spent making `pixels`.
+    pixels_time: std::time::Duration,
+    gpu: Option<GpuDelivered>,
+}
+
 /// What the UI hands the worker, and what it gets back.
 struct Shared {
     job: Mutex<Job>,
     wake: Condvar,
-    done: Mutex<Option<std::result::Result<Arc<Shown>, String>>>,
+    done: Mutex<Option<std::result::Result<Delivered, String>>>,
 }
 
 #[derive(Default)]
 struct Job {
-    next: Option<(Params, Option<Vec3>)>,
+    next: Option<Request>,
     quit: bool,
 }
 
@@ -138,8 +202,12 @@ fn spawn_worker(
     ctx: egui::Context,
 ) -> std::thread::JoinHandle<()> {
     std::thread::spawn(move || {
+        #[cfg(feature = "gpu")]
+        let mut gpu: Option<std::result::Result<super::gpu::GpuPath, String>> = None;
+        #[cfg(not(feature = "gpu"))]
+        let mut gpu: Option<()> = None;
         loop {
-            let (params, picked) = {
+            let (params, picked, want_gpu) = {
                 let mut job = lock(&shared.job);
                 loop {
                     if job.quit {
@@ -153,12 +221,51 @@ fn spawn_worker(
             };
             session.apply(&params, &mut scene);
             let result = render_shown(&scene, &params, picked)
-                .map(Arc::new)
+                .map(|shown| {
+                    let start = Instant::now();
+                    let pixels = display_image(&shown.image);
+                    let pixels_time = start.elapsed();
+                    let gpu = want_gpu
+                        .then(|| gpu_frame(&mut gpu, &scene, &shown))
+                        .flatten();
+                    Delivered {
+                        shown: Arc::new(shown),
+                        pixels,
+                        pixels_time,
+                        gpu,
+                    }
+                })
                 .map_err(|e| e.to_string());
             *lock(&shared.done) = Some(result);
             ctx.request_repaint();
         }
     })
+}
+
+/// The GPU frame of `shown`'s parameters (the device is opened at the first one).
+#[cfg(feature = "gpu")]
+fn gpu_frame(
+    path: &mut Option<std::result::Result<super::gpu::GpuPath, String>>,
+    scene: &Scene,
+    shown: &Shown,
+) -> Option<GpuDelivered> {
+    let path = path.get_or_insert_with(|| super::gpu::GpuPath::new().map_err(|e| e.to_string()));
+    Some(match path {
+        Ok(p) => p
+            .render(scene, shown)
+            .map(|g| {
+                let pixels = display_image(&g.image);
+                (Arc::new(g), pixels)
+            })
+            .map_err(|e| e.to_string()),
+        Err(e) => Err(e.clone()),
+    })
+}
+
+/// Built without the `gpu` feature: no GPU frame.
+#[cfg(not(feature = "gpu"))]
+fn gpu_frame(_: &mut Option<()>, _: &Scene, _: &Shown) -> Option<GpuDelivered> {
+    None
 }
 
 struct App {
@@ -167,10 +274,25 @@ struct App {
     shared: Arc<Shared>,
     _worker: std::thread::JoinHandle<()>,
     params: Params,
-    sent: Option<(Params, Option<Vec3>)>,
+    sent: Option<Request>,
     picked: Option<Vec3>,
     shown: Option<Arc<Shown>>,
     texture: Option<egui::TextureHandle>,
+    /// Where the GPU image goes (G).
+    gpu_view: GpuView,
+    /// The GPU frame delivered with `shown`, or why there is none.
+    gpu: Option<std::result::Result<Arc<GpuShown>, String>>,
+    gpu_texture: Option<egui::TextureHandle>,
+    /// Where the GPU image lies in the window, in physical pixels (beside the CPU image).
+    gpu_rect: Option<egui::Rect>,
+    /// The last keypad press that could not move a user factor, and why.
+    limit: Option<String>,
+    /// The window's own time for its last frame (layout, texture upload, paint).
+    window_time: Option<f32>,
+    /// When the last frames arrived (frames on screen per second).
+    arrivals: std::collections::VecDeque<Instant>,
+    /// Time the worker spent making the last frame's texture pixels.
+    pixels_time: std::time::Duration,
     image_rect: Option<egui::Rect>,
     error: Option<String>,
     status: String,
@@ -217,6 +339,14 @@ impl App {
             picked: None,
             shown: None,
             texture: None,
+            gpu_view: GpuView::Off,
+            gpu: None,
+            gpu_texture: None,
+            gpu_rect: None,
+            limit: None,
+            window_time: None,
+            arrivals: std::collections::VecDeque::new(),
+            pixels_time: std::time::Duration::ZERO,
             image_rect: None,
             error: None,
             status: "H for help".into(),
@@ -231,7 +361,11 @@ impl App {
 
     /// Hands the current parameters to the worker when they differ from the last sent.
     fn send(&mut self) {
-        let job = (self.params.clone(), self.picked);
+        let job = (
+            self.params.clone(),
+            self.picked,
+            self.gpu_view != GpuView::Off,
+        );
         if self.sent.as_ref() != Some(&job) {
             let mut j = lock(&self.shared.job);
             j.next = Some(job.clone());
@@ -250,24 +384,40 @@ impl App {
         let pressed = |k: Key| ctx.input(|i| i.key_pressed(k));
         // Every press counts, also several within one frame.
         let presses = |k: Key| ctx.input(|i| i.num_presses(k));
-        for _ in 0..presses(Key::Plus) + presses(Key::Equals) {
-            self.params.scale_offset(KEYPAD_FACTOR);
+        let steps = [
+            (
+                presses(Key::Plus) + presses(Key::Equals),
+                UserFactor::Offset,
+                KEYPAD_FACTOR,
+            ),
+            (presses(Key::Minus), UserFactor::Offset, 1.0 / KEYPAD_FACTOR),
+            (
+                presses(Key::CloseBracket),
+                UserFactor::Balance,
+                KEYPAD_FACTOR,
+            ),
+            (
+                presses(Key::OpenBracket),
+                UserFactor::Balance,
+                1.0 / KEYPAD_FACTOR,
+            ),
+        ];
+        let limit_before = self.limit.clone();
+        for (n, which, by) in steps {
+            for _ in 0..n {
+                let step = self.params.step_user_factor(which, by);
+                self.keypad_step(which, step);
+            }
         }
-        for _ in 0..presses(Key::Minus) {
-            self.params.scale_offset(1.0 / KEYPAD_FACTOR);
-        }
-        for _ in 0..presses(Key::CloseBracket) {
-            self.params.scale_balance(KEYPAD_FACTOR);
-        }
-        for _ in 0..presses(Key::OpenBracket) {
-            self.params.scale_balance(1.0 / KEYPAD_FACTOR);
+        if self.limit != limit_before {
+            // A press at the limit renders no new frame: the readout changes all the same.
+            self.write_state();
         }
         if pressed(Key::M) {
-            self.params.rig.mode = match self.params.rig.mode {
-                CameraMode::OffAxis => CameraMode::ToeIn,
-                CameraMode::ToeIn => CameraMode::Parallel,
-                CameraMode::Parallel => CameraMode::OffAxis,
-            };
+            self.params.rig.mode = next_mode(self.params.rig.mode);
+        }
+        if pressed(Key::G) {
+            self.toggle_gpu();
         }
         if pressed(Key::L) {
             self.params.rig.lighting = match self.params.rig.lighting {
@@ -337,6 +487,47 @@ impl App {
         }
     }
 
+    /// Says what a keypad press did: a press that stopped at a limit is shown until the next
+    /// press that moves a factor.
+    fn keypad_step(&mut self, which: UserFactor, step: Step) {
+        let (guide, field) = which.names();
+        match step {
+            Step::Moved(_) => self.limit = None,
+            Step::AtLimit(at, would) => {
+                self.limit = Some(format!(
+                    "{guide} stays at {at:.3}: ×1.1 would make it {would:.3}, past the guide's \
+                     upper limit {USER_FACTOR_MAX:.1} ({field} must lie in 0..2)"
+                ));
+            }
+            Step::AtZero => {
+                self.limit = Some(format!(
+                    "{guide} is 0: the keypad multiplies, so it cannot leave 0; move the slider"
+                ));
+            }
+        }
+        if let Some(l) = &self.limit {
+            self.status.clone_from(l);
+        }
+    }
+
+    /// G: the GPU image beside the CPU image, alone, or off. Built without the `gpu`
+    /// feature, says how to get it.
+    fn toggle_gpu(&mut self) {
+        if cfg!(feature = "gpu") {
+            self.gpu_view = match self.gpu_view {
+                GpuView::Off => GpuView::Beside,
+                GpuView::Beside => GpuView::Only,
+                GpuView::Only => GpuView::Off,
+            };
+            self.status = format!("GPU path: {}", self.gpu_view.name());
+        } else {
+            self.status = "the GPU path needs a build with it: cargo run --release \
+                           --features gpu -- view SCENE"
+                .into();
+        }
+        self.write_state();
+    }
+
     /// Writes the frame on screen as `NAME-NNN.png` and its scene as `NAME-NNN.toml`.
     fn screenshot(&mut self) -> Result<String> {
         let shown = self
@@ -387,16 +578,28 @@ impl App {
             return;
         };
         match done {
-            Ok(shown) => {
-                let rgba = shown.display_rgba();
-                let size = [rgba.width() as usize, rgba.height() as usize];
-                let image = egui::ColorImage::from_rgba_unmultiplied(size, rgba.as_raw());
-                match &mut self.texture {
-                    Some(t) => t.set(image, egui::TextureOptions::LINEAR),
-                    None => {
-                        self.texture =
-                            Some(ctx.load_texture("frame", image, egui::TextureOptions::LINEAR));
-                    }
+            Ok(Delivered {
+                shown,
+                pixels,
+                pixels_time,
+                gpu,
+            }) => {
+                set_texture(ctx, &mut self.texture, "frame", pixels);
+                self.gpu = gpu.map(|g| {
+                    g.map(|(g, pixels)| {
+                        set_texture(ctx, &mut self.gpu_texture, "gpu frame", pixels);
+                        g
+                    })
+                });
+                self.pixels_time = pixels_time;
+                let now = Instant::now();
+                self.arrivals.push_back(now);
+                while self
+                    .arrivals
+                    .front()
+                    .is_some_and(|t| now.duration_since(*t).as_secs_f32() > 1.0)
+                {
+                    self.arrivals.pop_front();
                 }
                 self.shown = Some(shown);
                 self.error = None;
@@ -408,6 +611,14 @@ impl App {
             Err(e) => self.error = Some(e),
         }
         self.write_state();
+    }
+
+    /// Frames that reached the window in the last second.
+    fn frames_per_second(&self) -> usize {
+        self.arrivals
+            .iter()
+            .filter(|t| t.elapsed().as_secs_f32() <= 1.0)
+            .count()
     }
 
     /// The readouts as one JSON object (the `--state-file`).
@@ -428,7 +639,19 @@ impl App {
             "status": self.status,
             "shots": self.shots.iter().map(|s| s.display().to_string()).collect::<Vec<_>>(),
             "pixels_per_point": self.pixels_per_point,
+            "limit": self.limit,
+            "gpu_view": self.gpu_view.name(),
+            "window_ms": self.window_time.map(|t| f64::from(t) * 1e3),
+            "frames_per_second": self.frames_per_second(),
         });
+        if let Some(r) = self.gpu_rect {
+            v["gpu_rect"] = serde_json::json!([r.min.x, r.min.y, r.max.x, r.max.y]);
+        }
+        match &self.gpu {
+            Some(Err(e)) => v["gpu_error"] = e.clone().into(),
+            Some(Ok(g)) => v["gpu"] = gpu_json(g),
+            None => {}
+        }
         if let Some(r) = self.image_rect {
             v["image_rect"] = serde_json::json!([r.min.x, r.min.y, r.max.x, r.max.y]);
         }
@@ -437,12 +660,15 @@ impl App {
             v["shown_output"] = s.params.output.name().into();
             v["passes"] = s.passes.iter().map(|(n, _)| n.clone()).collect();
             v["frame_ms"] = (s.total.as_secs_f64() * 1e3).into();
+            v["readouts_ms"] = (s.readouts.as_secs_f64() * 1e3).into();
+            v["pixels_ms"] = (self.pixels_time.as_secs_f64() * 1e3).into();
             v["parallax_min_px"] = (s.range.min_percent * w / 100.0).into();
             v["parallax_max_px"] = (s.range.max_percent * w / 100.0).into();
             v["parallax_min_percent"] = s.range.min_percent.into();
             v["parallax_max_percent"] = s.range.max_percent.into();
             v["vertical_percent"] = s.range.max_vertical_percent.into();
             v["beyond_budget"] = beyond(s).into();
+            v["window_violations"] = serde_json::json!(s.window_violations);
             v["picked_parallax_px"] = s.picked_parallax.into();
             v["zero_parallax"] = match s.params.rig.zero_parallax {
                 ZeroParallax::Distance(z) => z.into(),
@@ -476,7 +702,7 @@ impl App {
         ui.heading("Rig");
         let rig = &mut self.params.rig;
         ui.horizontal(|ui| {
-            for m in [CameraMode::OffAxis, CameraMode::ToeIn, CameraMode::Parallel] {
+            for &m in MODES {
                 ui.radio_value(&mut rig.mode, m, mode_name(m));
             }
         });
@@ -610,9 +836,12 @@ impl App {
             lighting_name(s.params.rig.lighting)
         ));
         ui.label(format!(
-            "user offset {:.3}, balance {:.3}",
+            "user offset {:.3}, balance {:.3} (keypad ×/÷ 1.1, range 0..{USER_FACTOR_MAX})",
             s.params.rig.user_offset, s.params.rig.user_balance
         ));
+        if let Some(l) = &self.limit {
+            ui.colored_label(egui::Color32::from_rgb(255, 170, 60), l);
+        }
         if let Ok(rig) = s.params.rig.resolve(&s.params.camera, s.aspect()) {
             ui.label(format!(
                 "d = {:.4}, z0 = {:.3}",
@@ -650,9 +879,17 @@ impl App {
                 );
             }
         }
-        if let Some(b) = &s.budget {
-            let v = b.window_violations.iter().sum::<usize>();
-            ui.label(format!("window violations: {v} border px"));
+        if let Some(sides) = s.window_violations {
+            let v = sides.iter().sum::<usize>();
+            let text = format!(
+                "window violations: {v} border px (left {}, right {}, top {}, bottom {})",
+                sides[0], sides[1], sides[2], sides[3]
+            );
+            if v > 0 {
+                ui.colored_label(egui::Color32::from_rgb(255, 170, 60), text);
+            } else {
+                ui.label(text);
+            }
         }
         if let Some(p) = s.picked_parallax {
             ui.label(format!("clicked point: parallax {p:+.2} px"));
@@ -665,9 +902,73 @@ impl App {
         for line in s.timing_lines() {
             ui.monospace(line);
         }
+        ui.monospace(format!(
+            "texture pixels: {:.1} ms",
+            self.pixels_time.as_secs_f64() * 1e3
+        ));
+        if let Some(t) = self.window_time {
+            ui.monospace(format!("window (layout, upload, paint): {:.1} ms", t * 1e3));
+        }
+        ui.monospace(format!("frames on screen: {}/s", self.frames_per_second()));
+
         ui.separator();
         ui.label(&self.status);
     }
+}
+
+/// Hands `pixels` to the texture in `slot` (made on first use); the window uploads it when it
+/// paints.
+fn set_texture(
+    ctx: &egui::Context,
+    slot: &mut Option<egui::TextureHandle>,
+    name: &str,
+    pixels: egui::ColorImage,
+) {
+    match slot {
+        Some(t) => t.set(pixels, egui::TextureOptions::LINEAR),
+        None => *slot = Some(ctx.load_texture(name, pixels, egui::TextureOptions::LINEAR)),
+    }
+}
+
+/// The GPU readouts for the state file.
+#[cfg(feature = "gpu")]
+fn gpu_json(g: &GpuShown) -> serde_json::Value {
+    use serde_json::json;
+    // JSON has no infinity: identical images have PSNR "inf".
+    let psnr = |x: f64| {
+        if x.is_finite() {
+            json!(x)
+        } else {
+            json!("inf")
+        }
+    };
+    let metrics = |m: &crate::compare::Metrics| {
+        json!({
+            "coverage_mismatch": m.coverage_mismatch,
+            "max_channel_diff": m.max_channel_diff,
+            "psnr": psnr(m.psnr),
+            "pixels": m.pixels,
+        })
+    };
+    let (same, both) = g.depth_identical();
+    json!({
+        "adapter": g.adapter,
+        "frame_ms": g.time.as_secs_f64() * 1e3,
+        "coverage_mismatch": g.coverage_mismatch(),
+        "depth_identical": [same, both],
+        "passes": g.passes.iter().map(|p| {
+            let mut v = metrics(&p.metrics);
+            v["name"] = json!(p.name);
+            v["depth_identical"] = json!([p.depth_identical.0, p.depth_identical.1]);
+            v
+        }).collect::<Vec<_>>(),
+        "output": metrics(&g.output),
+    })
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_json(g: &GpuShown) -> serde_json::Value {
+    match *g {}
 }
 
 /// Whether the frame's parallax leaves the StereoGraphics guide's ±3% budget.
@@ -678,8 +979,9 @@ fn beyond(s: &Shown) -> bool {
 }
 
 impl eframe::App for App {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        self.window_time = frame.info().cpu_usage;
         self.receive(&ctx);
         self.keys(&ctx);
         if self.turning {
@@ -718,23 +1020,86 @@ impl eframe::App for App {
 }
 
 impl App {
-    /// The frame, scaled to fit (never up), with the mouse: orbit, pan, zoom, click.
+    /// The frame, scaled to fit (never up), with the mouse: orbit, pan, zoom, click. With the
+    /// GPU path beside, both images share the width; alone, the GPU image takes the CPU
+    /// image's place.
     fn picture(&mut self, ui: &mut egui::Ui) {
         let (Some(tex), Some(shown)) = (&self.texture, self.shown.clone()) else {
             ui.label("rendering …");
             return;
         };
+        let gpu_tex = match (&self.gpu, &self.gpu_texture) {
+            (Some(Ok(_)), Some(t)) => Some(t.id()),
+            _ => None,
+        };
+        let beside = self.gpu_view == GpuView::Beside;
         let size = tex.size_vec2();
+        let gap = 8.0;
         let avail = ui.available_size();
-        let scale = (avail.x / size.x).min(avail.y / size.y).min(1.0);
-        let (rect, response) = ui.allocate_exact_size(size * scale, egui::Sense::click_and_drag());
-        ui.painter().image(
-            tex.id(),
-            rect,
-            egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
-            egui::Color32::WHITE,
-        );
+        let across = if beside { 2.0 * size.x + gap } else { size.x };
+        let scale = (avail.x / across).min(avail.y / size.y).min(1.0);
+        let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+        let (rect, response, gpu_rect) = ui
+            .horizontal_top(|ui| {
+                ui.spacing_mut().item_spacing.x = gap;
+                let (rect, response) =
+                    ui.allocate_exact_size(size * scale, egui::Sense::click_and_drag());
+                let shown_tex = match (self.gpu_view, gpu_tex) {
+                    (GpuView::Only, Some(g)) => g,
+                    _ => tex.id(),
+                };
+                ui.painter()
+                    .image(shown_tex, rect, uv, egui::Color32::WHITE);
+                let gpu_rect = beside.then(|| {
+                    let (r, _) = ui.allocate_exact_size(size * scale, egui::Sense::hover());
+                    match gpu_tex {
+                        Some(g) => {
+                            ui.painter().image(g, r, uv, egui::Color32::WHITE);
+                        }
+                        None => {
+                            ui.painter()
+                                .rect_filled(r, 0.0, egui::Color32::from_gray(40));
+                        }
+                    }
+                    r
+                });
+                (rect, response, gpu_rect)
+            })
+            .inner;
+        if self.gpu_view != GpuView::Off {
+            // Which image is which, under the pictures (never over them: the test compares
+            // the pictures' pixels).
+            ui.label(match (self.gpu_view, gpu_tex) {
+                (GpuView::Beside, _) => "left: CPU, right: GPU (wgpu)",
+                (GpuView::Only, Some(_)) => "GPU (wgpu); clicks pick in the CPU frame",
+                _ => "CPU (the GPU frame is not ready)",
+            });
+            ui.label("GPU path against the CPU, this frame (stereolab compare's numbers):");
+            match &self.gpu {
+                Some(Ok(g)) => {
+                    for line in g.lines() {
+                        ui.monospace(line);
+                    }
+                }
+                Some(Err(e)) => {
+                    ui.colored_label(egui::Color32::from_rgb(255, 90, 90), e);
+                }
+                None => {
+                    ui.label("rendering on the GPU …");
+                }
+            }
+        }
         let ppp = ui.ctx().pixels_per_point();
+        let gpu_physical = gpu_rect.map(|r| {
+            egui::Rect::from_min_max(
+                (r.min.to_vec2() * ppp).to_pos2(),
+                (r.max.to_vec2() * ppp).to_pos2(),
+            )
+        });
+        if self.gpu_rect != gpu_physical {
+            self.gpu_rect = gpu_physical;
+            self.write_state();
+        }
         self.pixels_per_point = ppp;
         let physical = egui::Rect::from_min_max(
             (rect.min.to_vec2() * ppp).to_pos2(),

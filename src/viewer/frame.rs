@@ -7,8 +7,9 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
-use crate::effects::parallax::{ParallaxBudget, budget_of};
+use crate::effects::parallax::ParallaxRig;
 use crate::error::Result;
+use crate::framebuffer::Framebuffer;
 use crate::info::{ParallaxRange, parallax_range};
 use crate::output::{self, Image};
 use crate::plan::{Output, Plan, Shading, View};
@@ -31,13 +32,17 @@ pub struct Shown {
     /// Making the output from the passes (finalize, layouts, ChromaDepth glasses, SIRDS
     /// strips or TIW).
     pub effect: Duration,
-    /// Passes and effect together, the frame time.
+    /// Passes and effect together: the library's render, what `stereolab render` spends.
     pub total: Duration,
+    /// What the viewer adds to each frame: the readouts below (parallax range of every vertex,
+    /// the per-pixel budget, the ChromaDepth range, the clicked point).
+    pub readouts: Duration,
     /// Parallax of every vertex seen by both eyes (`stereolab info`'s range); also the
     /// vertical parallax toe-in makes.
     pub range: ParallaxRange,
-    /// The per-pixel budget of an eye the plan rendered (window violations), if any did.
-    pub budget: Option<ParallaxBudget>,
+    /// Window violations (border pixels with negative parallax: left, right, top, bottom) of
+    /// an eye the plan rendered, if any did.
+    pub window_violations: Option<[usize; 4]>,
     /// Screen parallax in pixels of the point last clicked, under this frame's rig.
     pub picked_parallax: Option<f32>,
     /// Image width (the parallax readouts' pixels are of this width).
@@ -62,6 +67,7 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
     let image = output::produce(params.output, &frame, scene)?;
     let effect = passes_done.elapsed();
     let total = start.elapsed();
+    let readouts_start = Instant::now();
     let passes = frame
         .passes
         .iter()
@@ -69,11 +75,10 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
         .collect();
     let range = parallax_range(scene)?;
     let rig = scene.parallax_rig()?;
-    let budget = [View::Left, View::Right]
+    let window_violations = [View::Left, View::Right]
         .into_iter()
         .find_map(|v| frame.view(v))
-        .map(|fb| budget_of(fb, &rig))
-        .transpose()?;
+        .map(|fb| window_violations(fb, &rig));
     // The D1/D2 a ChromaDepth pass uses (set, or fitted to the bounding sphere), also for the
     // other outputs, so the sliders start where the ramp would be; `None` where no range fits.
     let chromadepth = match frame.plan.pass(View::Center) {
@@ -86,6 +91,7 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
             .map(|t| [t.d1, t.d2]),
     };
     let picked_parallax = picked.and_then(|p| point_parallax_pixels(&frame.eyes, p, scene.width));
+    let readouts = readouts_start.elapsed();
     Ok(Shown {
         params: params.clone(),
         image,
@@ -93,8 +99,9 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
         passes,
         effect,
         total,
+        readouts,
         range,
-        budget,
+        window_violations,
         picked_parallax,
         width: scene.width,
         height: scene.height,
@@ -102,12 +109,50 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
     })
 }
 
-impl Shown {
-    /// The image as 8-bit RGBA for the screen (16-bit depth shown by its high byte).
-    pub fn display_rgba(&self) -> image::RgbaImage {
-        self.image.to_display_rgba()
+/// The StereoGraphics guide's window violations of one eye's framebuffer: border pixels with
+/// negative parallax (in front of the screen, cut by the window's edge), per side (left, right,
+/// top, bottom). The same count as
+/// [`budget_of`](crate::effects::parallax::budget_of)`(fb, rig).window_violations`, which maps
+/// every pixel's parallax; this looks at the border pixels only, as only they can violate
+/// (a unit test holds the two equal).
+pub fn window_violations(fb: &Framebuffer, rig: &ParallaxRig) -> [usize; 4] {
+    let (w, h) = (fb.width as usize, fb.height as usize);
+    let negative = |x: usize, y: usize| {
+        fb.depth
+            .get(y * w + x)
+            .and_then(|&d| rig.parallax_pixels(d))
+            .is_some_and(|p| p < 0.0)
+    };
+    let column = |x: usize| (0..h).filter(|&y| negative(x, y)).count();
+    let row = |y: usize| (0..w).filter(|&x| negative(x, y)).count();
+    if w == 0 || h == 0 {
+        return [0; 4];
     }
+    [column(0), column(w - 1), row(0), row(h - 1)]
+}
 
+/// `image` as egui's texture pixels, made on the worker thread so the window only moves it
+/// into its texture. An RGBA output is converted in one pass over its bytes (no intermediate
+/// copy); depth (16 bits, shown by the high byte) and stereo photos go through
+/// [`Image::to_display_rgba`] first.
+pub fn display_image(image: &Image) -> eframe::egui::ColorImage {
+    use eframe::egui::ColorImage;
+    match image {
+        Image::Rgba(i) => ColorImage::from_rgba_unmultiplied(
+            [i.width() as usize, i.height() as usize],
+            i.as_raw(),
+        ),
+        other => {
+            let rgba = other.to_display_rgba();
+            ColorImage::from_rgba_unmultiplied(
+                [rgba.width() as usize, rgba.height() as usize],
+                rgba.as_raw(),
+            )
+        }
+    }
+}
+
+impl Shown {
     /// Width of the output image (side by side is twice the scene's width).
     pub fn image_width(&self) -> u32 {
         self.image.display_size().0
@@ -176,7 +221,64 @@ impl Shown {
             self.params.output.name(),
             ms(self.effect)
         ));
-        lines.push(format!("frame: {:.1} ms", ms(self.total)));
+        lines.push(format!("library frame: {:.1} ms", ms(self.total)));
+        lines.push(format!("readouts: {:.1} ms", ms(self.readouts)));
         lines
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::parallax::budget_of;
+    use crate::math::{Camera, StereoRig, ZeroParallax};
+
+    /// The border-only count is the per-pixel budget's count, on framebuffers whose depths are
+    /// scattered over the whole range (background included), for several zero-parallax planes.
+    #[test]
+    fn window_violations_count_as_the_budget_does() {
+        let camera = Camera {
+            eye: [0.0, 0.0, 5.0],
+            target: [0.0; 3],
+            up: [0.0, 1.0, 0.0],
+            fov_y: 50.0,
+            near: 1.0,
+            far: 20.0,
+        };
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for (w, h, z0) in [(7, 5, 2.0), (16, 9, 6.0), (1, 1, 10.0), (33, 2, 19.0)] {
+            let depth: Vec<f32> = (0..w * h)
+                .map(|_| {
+                    let d = next();
+                    if d > 0.8 { 1.0 } else { d * 1.2 }
+                })
+                .map(|d: f32| d.min(1.0))
+                .collect();
+            let fb = Framebuffer {
+                width: w,
+                height: h,
+                color: vec![[0; 4]; (w * h) as usize],
+                depth,
+            };
+            let rig = StereoRig {
+                zero_parallax: ZeroParallax::Distance(z0),
+                ..StereoRig::default()
+            };
+            let prig = ParallaxRig::new(&rig, &camera, w, h).unwrap();
+            let expected = budget_of(&fb, &prig).unwrap().window_violations;
+            assert_eq!(window_violations(&fb, &prig), expected, "{w}x{h} z0 {z0}");
+            if z0 > 5.0 && w > 2 {
+                assert!(
+                    expected.iter().sum::<usize>() > 0,
+                    "{w}x{h}: nothing to count"
+                );
+            }
+        }
     }
 }

@@ -10,18 +10,22 @@
 //! - [`session`]: the parameters, how they reach the scene, and the scene file a screenshot
 //!   writes (which `stereolab render` turns into the same bytes);
 //! - [`frame`]: one frame and its readouts (passes and times, parallax against the ±3% budget);
+//! - `gpu` (cargo feature `gpu`): the wgpu path's frame beside the CPU's, with `compare`'s
+//!   numbers;
 //! - `app` (private): the window, keys and mouse.
 //!
 //! [`benchmark`] renders an orbit without a window (`--benchmark-frames N`).
 
 mod app;
 pub mod frame;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod session;
 
 use std::path::PathBuf;
 use std::time::Duration;
 
-pub use frame::{Shown, render_shown};
+pub use frame::{Shown, display_image, render_shown};
 pub use session::{Params, Session};
 
 use crate::error::{Error, Result};
@@ -69,12 +73,20 @@ pub fn check_display(display: Option<std::ffi::OsString>) -> Result<()> {
 pub struct BenchmarkReport {
     /// Frames rendered.
     pub frames: usize,
-    /// Median time of a whole frame (passes, output, readouts).
+    /// Median time of a whole viewer frame on the worker thread: the library's render, the
+    /// readouts, and the texture pixels for the window.
     pub median_frame: Duration,
     /// Median of each pass, by name, in plan order.
     pub median_passes: Vec<(String, Duration)>,
     /// Median time of making the output from the passes.
     pub median_effect: Duration,
+    /// Median of the library's render alone (passes and output: what `stereolab render`
+    /// spends on the frame).
+    pub median_library: Duration,
+    /// Median of the readouts (parallax range, budget, ChromaDepth range).
+    pub median_readouts: Duration,
+    /// Median of turning the output into the window's texture pixels ([`display_image`]).
+    pub median_display: Duration,
 }
 
 impl BenchmarkReport {
@@ -91,7 +103,9 @@ fn median(mut v: Vec<Duration>) -> Duration {
 
 /// Renders `frames` frames of a full orbit of the camera about its target (360°/`frames`
 /// per frame) with the worker's own frame function ([`render_shown`]: passes, output,
-/// readouts), and returns the medians. Nothing else changes between frames.
+/// readouts, then [`display_image`]: the texture pixels), and returns the medians. Nothing else
+/// changes between frames. The window's own share (moving the pixels into its OpenGL texture
+/// and painting) is not in it: the viewer shows that as "window" in its readouts.
 ///
 /// # Errors
 /// `frames` is 0 or above 100 000, or a frame fails.
@@ -109,14 +123,22 @@ pub fn benchmark(
         ));
     }
     let step = 360.0 / frames as f32;
-    let (mut totals, mut effects) = (Vec::new(), Vec::new());
+    let (mut totals, mut effects, mut library, mut readouts, mut display) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut passes: Vec<(String, Vec<Duration>)> = Vec::new();
     for _ in 0..frames {
         params.orbit(step, 0.0);
         session.apply(&params, &mut scene);
         let start = std::time::Instant::now();
         let shown = render_shown(&scene, &params, None)?;
-        totals.push(start.elapsed());
+        let shown_at = std::time::Instant::now();
+        let pixels = display_image(&shown.image);
+        let done = std::time::Instant::now();
+        std::hint::black_box(&pixels);
+        totals.push(done - start);
+        display.push(done - shown_at);
+        library.push(shown.total);
+        readouts.push(shown.readouts);
         effects.push(shown.effect);
         for (name, t) in shown.passes {
             match passes.iter_mut().find(|(n, _)| *n == name) {
@@ -130,5 +152,8 @@ pub fn benchmark(
         median_frame: median(totals),
         median_passes: passes.into_iter().map(|(n, v)| (n, median(v))).collect(),
         median_effect: median(effects),
+        median_library: median(library),
+        median_readouts: median(readouts),
+        median_display: median(display),
     })
 }

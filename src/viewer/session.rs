@@ -24,7 +24,10 @@ use crate::scene::{Scene, model_matrix};
 /// multiplication rather than addition"), the same for the balance.
 pub const KEYPAD_FACTOR: f32 = 1.1;
 
-/// The guide's range for both user factors: 1.0 default, "2.0 is usually OK as an upper limit".
+/// The guide's range for both user factors (§7): 1.0 default, adjustable "downward towards
+/// 0.0" and "upward (2.0 is usually OK as an upper limit)" for the offset, "2.0 is once again a
+/// good upper limit" for the balance. The rig refuses factors outside `0..=2`
+/// ([`StereoRig::resolve`]), so a keypad press that would pass 2 changes nothing and says so.
 pub const USER_FACTOR_MAX: f32 = 2.0;
 
 /// Everything the viewer can change; a frame is a pure function of the scene and these.
@@ -190,7 +193,7 @@ impl Session {
         set("camera", "near", Some(num(c.near)));
         set("camera", "far", Some(num(c.far)));
         let r = &p.rig;
-        set("stereo", "mode", Some(word(mode_name(r.mode))));
+        set("stereo", "mode", Some(word(&mode_name(r.mode))));
         set(
             "stereo",
             "eye_separation",
@@ -326,12 +329,31 @@ fn absolute_path(t: &mut toml::Table, key: &str, base: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The scene-file word for a camera mode.
-pub fn mode_name(m: CameraMode) -> &'static str {
+/// The rig modes the viewer offers, in the order the M key steps through them.
+///
+/// To offer a new [`CameraMode`], add it here (and to `_every_mode_listed` below, which stops
+/// compiling until a new variant is handled); the radio buttons, the M key and the scene file's
+/// word ([`mode_name`], from the scene file's own serde name) follow from this list.
+pub const MODES: &[CameraMode] = &[CameraMode::OffAxis, CameraMode::ToeIn, CameraMode::Parallel];
+
+/// Fails to compile when `CameraMode` gains a variant: add the new mode to [`MODES`] too.
+const fn _every_mode_listed(m: CameraMode) {
     match m {
-        CameraMode::OffAxis => "off-axis",
-        CameraMode::ToeIn => "toe-in",
-        CameraMode::Parallel => "parallel",
+        CameraMode::OffAxis | CameraMode::ToeIn | CameraMode::Parallel => {}
+    }
+}
+
+/// The mode after `m` in [`MODES`] (the M key).
+pub fn next_mode(m: CameraMode) -> CameraMode {
+    let at = MODES.iter().position(|&x| x == m).unwrap_or(0);
+    MODES[(at + 1) % MODES.len()]
+}
+
+/// The scene-file word for a camera mode (`stereo.mode`), as the scene file's reader spells it.
+pub fn mode_name(m: CameraMode) -> String {
+    match serde_json::to_value(m) {
+        Ok(serde_json::Value::String(s)) => s,
+        _ => format!("{m:?}"),
     }
 }
 
@@ -343,15 +365,70 @@ pub fn lighting_name(l: Lighting) -> &'static str {
     }
 }
 
+/// Which of the StereoGraphics guide's two user factors a keypad press changes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UserFactor {
+    /// `UserOffsetAdjustment` (the separation).
+    Offset,
+    /// `UserBalanceAdjustment` (the frustum asymmetry).
+    Balance,
+}
+
+impl UserFactor {
+    /// The name the guide gives it, and the scene file's field.
+    pub fn names(self) -> (&'static str, &'static str) {
+        match self {
+            UserFactor::Offset => ("UserOffsetAdjustment", "stereo.user_offset"),
+            UserFactor::Balance => ("UserBalanceAdjustment", "stereo.user_balance"),
+        }
+    }
+}
+
+/// What one keypad press did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Step {
+    /// The factor is now this value.
+    Moved(f32),
+    /// The press would have taken the factor from the first value to the second, past the
+    /// guide's upper limit [`USER_FACTOR_MAX`]; the factor stays where it was.
+    AtLimit(f32, f32),
+    /// The factor is 0, which multiplying cannot leave (the guide's "no stereo effect at all"
+    /// for the offset, "no frustum asymmetry" for the balance): the slider moves it.
+    AtZero,
+}
+
 impl Params {
-    /// Multiplies the user offset (separation) by `factor`, kept in `0..=2` (the guide's range).
-    pub fn scale_offset(&mut self, factor: f32) {
-        self.rig.user_offset = (self.rig.user_offset * factor).clamp(0.0, USER_FACTOR_MAX);
+    /// One keypad press on a user factor: `factor` × `by` (the guide's §7: "adjusted based on
+    /// multiplication (i.e.: UserOffsetAdjustment *= 1.1) rather than addition"), unless that
+    /// passes the guide's upper limit 2.0 ("2.0 is usually OK as an upper limit"; for the
+    /// balance "2.0 is once again a good upper limit"), which the rig refuses
+    /// ([`StereoRig::resolve`]). Such a press changes nothing and says so ([`Step::AtLimit`]),
+    /// so presses stay on the 1.1ⁿ ladder and as many ÷ presses as × presses return to the
+    /// start. Downward the guide's range is "towards 0.0", which multiplying never reaches.
+    pub fn step_user_factor(&mut self, which: UserFactor, by: f32) -> Step {
+        let v = match which {
+            UserFactor::Offset => &mut self.rig.user_offset,
+            UserFactor::Balance => &mut self.rig.user_balance,
+        };
+        let next = *v * by;
+        if *v == 0.0 {
+            Step::AtZero
+        } else if next > USER_FACTOR_MAX {
+            Step::AtLimit(*v, next)
+        } else {
+            *v = next;
+            Step::Moved(next)
+        }
     }
 
-    /// Multiplies the user balance by `factor`, kept in `0..=2`.
-    pub fn scale_balance(&mut self, factor: f32) {
-        self.rig.user_balance = (self.rig.user_balance * factor).clamp(0.0, USER_FACTOR_MAX);
+    /// Multiplies the user offset (separation) by `factor` ([`Params::step_user_factor`]).
+    pub fn scale_offset(&mut self, factor: f32) -> Step {
+        self.step_user_factor(UserFactor::Offset, factor)
+    }
+
+    /// Multiplies the user balance by `factor` ([`Params::step_user_factor`]).
+    pub fn scale_balance(&mut self, factor: f32) -> Step {
+        self.step_user_factor(UserFactor::Balance, factor)
     }
 
     /// The camera's unit view direction, right and up vectors.
@@ -521,6 +598,21 @@ mod tests {
     }
 
     #[test]
+    fn every_mode_is_listed_once_and_named_as_the_scene_file_reads_it() {
+        for (i, &m) in MODES.iter().enumerate() {
+            assert!(!MODES[..i].contains(&m), "{m:?} twice");
+            let text = format!("mode = \"{}\"", mode_name(m));
+            #[derive(serde::Deserialize)]
+            struct S {
+                mode: CameraMode,
+            }
+            let back: S = toml::from_str(&text).unwrap();
+            assert_eq!(back.mode, m, "{text}");
+            assert_eq!(next_mode(MODES[(i + MODES.len() - 1) % MODES.len()]), m);
+        }
+    }
+
+    #[test]
     fn keypad_steps_multiply_and_stay_in_the_guides_range() {
         let mut p = Params {
             output: Output::SideBySide,
@@ -545,12 +637,48 @@ mod tests {
         p.scale_offset(KEYPAD_FACTOR);
         p.scale_offset(KEYPAD_FACTOR);
         assert!((p.rig.user_offset - 1.21).abs() < 1e-6);
+        // Up to 1.1⁷ = 1.95 for both factors; the eighth press (2.14) would pass the guide's
+        // upper limit 2.0: it changes nothing and says so, for the balance as for the offset.
+        p.rig.user_offset = 1.0;
+        for which in [UserFactor::Offset, UserFactor::Balance] {
+            let steps: Vec<Step> = (0..9)
+                .map(|_| p.step_user_factor(which, KEYPAD_FACTOR))
+                .collect();
+            assert!(
+                steps[..7].iter().all(|s| matches!(s, Step::Moved(_))),
+                "{steps:?}"
+            );
+            let top = 1.1f32.powi(7);
+            match steps[7] {
+                Step::AtLimit(at, would) => {
+                    assert!(
+                        (at - top).abs() < 1e-5 && would > USER_FACTOR_MAX,
+                        "{at} {would}"
+                    );
+                }
+                other => panic!("{which:?}: {other:?}"),
+            }
+            assert!(matches!(steps[8], Step::AtLimit(..)));
+            // Seven presses down return to 1.0 (the ladder was kept).
+            for _ in 0..7 {
+                p.step_user_factor(which, 1.0 / KEYPAD_FACTOR);
+            }
+            let v = match which {
+                UserFactor::Offset => p.rig.user_offset,
+                UserFactor::Balance => p.rig.user_balance,
+            };
+            assert!((v - 1.0).abs() < 1e-5, "{which:?}: {v}");
+            // The rig accepts every value the keypad reaches.
+            assert!(p.rig.resolve(&p.camera, 4.0 / 3.0).is_ok());
+        }
+        // Down towards 0, never reaching it; at 0 (the slider) a press says why it cannot move.
         for _ in 0..20 {
-            p.scale_offset(KEYPAD_FACTOR);
             p.scale_balance(1.0 / KEYPAD_FACTOR);
         }
-        assert_eq!(p.rig.user_offset, USER_FACTOR_MAX);
         assert!(p.rig.user_balance > 0.0 && p.rig.user_balance < 0.2);
+        p.rig.user_offset = 0.0;
+        assert_eq!(p.scale_offset(KEYPAD_FACTOR), Step::AtZero);
+        p.rig.user_offset = 1.0;
         // Zero parallax at a clicked point: its distance along the view direction.
         let z = p.set_zero_parallax_at(Vec3::new(0.3, -0.2, 1.0)).unwrap();
         assert!((z - 4.0).abs() < 1e-5, "{z}");
