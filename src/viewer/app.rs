@@ -266,7 +266,8 @@ impl App {
             self.params.rig.mode = match self.params.rig.mode {
                 CameraMode::OffAxis => CameraMode::ToeIn,
                 CameraMode::ToeIn => CameraMode::Parallel,
-                CameraMode::Parallel => CameraMode::OffAxis,
+                CameraMode::Parallel => CameraMode::ImageShift,
+                CameraMode::ImageShift => CameraMode::OffAxis,
             };
         }
         if pressed(Key::L) {
@@ -476,7 +477,12 @@ impl App {
         ui.heading("Rig");
         let rig = &mut self.params.rig;
         ui.horizontal(|ui| {
-            for m in [CameraMode::OffAxis, CameraMode::ToeIn, CameraMode::Parallel] {
+            for m in [
+                CameraMode::OffAxis,
+                CameraMode::ToeIn,
+                CameraMode::Parallel,
+                CameraMode::ImageShift,
+            ] {
                 ui.radio_value(&mut rig.mode, m, mode_name(m));
             }
         });

@@ -332,6 +332,7 @@ pub fn mode_name(m: CameraMode) -> &'static str {
         CameraMode::OffAxis => "off-axis",
         CameraMode::ToeIn => "toe-in",
         CameraMode::Parallel => "parallel",
+        CameraMode::ImageShift => "image-shift",
     }
 }
 
