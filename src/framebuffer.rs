@@ -65,6 +65,20 @@ impl Framebuffer {
         self.color[self.index(x, y)]
     }
 
+    /// Clears every column outside `keep` to `clear_color` and depth 1.0, as a scissor
+    /// rectangle `keep × all rows` would have left them: the columns an image-shift eye's
+    /// shifted viewport does not cover.
+    pub fn clear_outside_columns(&mut self, keep: std::ops::Range<u32>, clear_color: [u8; 4]) {
+        let w = self.width as usize;
+        let (x0, x1) = (keep.start.min(self.width) as usize, keep.end.min(self.width) as usize);
+        for (color, depth) in self.color.chunks_mut(w).zip(self.depth.chunks_mut(w)) {
+            for x in (0..x0).chain(x1.max(x0)..w) {
+                color[x] = clear_color;
+                depth[x] = 1.0;
+            }
+        }
+    }
+
     /// The color buffer as an `image` RGBA image.
     pub fn to_rgba_image(&self) -> image::RgbaImage {
         let bytes: Vec<u8> = self.color.iter().flatten().copied().collect();

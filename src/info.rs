@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 
 use crate::effects::parallax::{ParallaxBudget, budget_of};
 use crate::error::Result;
-use crate::math::{StereoRig, project_ndc};
+use crate::math::{CameraMode, StereoRig, Viewer, project_ndc};
 use crate::plan::{Shading, View};
 use crate::render::{Frame, render_view};
 use crate::scene::Scene;
@@ -30,7 +30,7 @@ pub struct ParallaxRange {
 /// # Errors
 /// Invalid camera or rig.
 pub fn parallax_range(scene: &Scene) -> Result<ParallaxRange> {
-    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let mut r = ParallaxRange {
         min_percent: f32::INFINITY,
         max_percent: f32::NEG_INFINITY,
@@ -62,7 +62,7 @@ pub fn parallax_range(scene: &Scene) -> Result<ParallaxRange> {
 pub fn describe(scene: &Scene) -> Result<String> {
     let mut s = String::new();
     let resolved = scene.rig.resolve(&scene.camera, scene.aspect())?;
-    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let center = StereoRig::center(&scene.camera, scene.aspect())?;
     let _ = writeln!(
         s,
@@ -73,8 +73,13 @@ pub fn describe(scene: &Scene) -> Result<String> {
     );
     let _ = writeln!(
         s,
-        "rig: {:?}, lighting {:?}",
-        scene.rig.mode, scene.rig.lighting
+        "rig: {:?}, lighting {:?}{}",
+        scene.rig.mode,
+        scene.rig.lighting,
+        match scene.rig.viewer {
+            Viewer::Midpoint => "",
+            Viewer::LeftEye => ", viewer at the left eye (camera.eye), right eye at +d",
+        }
     );
     let _ = writeln!(
         s,
@@ -87,13 +92,20 @@ pub fn describe(scene: &Scene) -> Result<String> {
         resolved.zero_parallax_distance, scene.rig.zero_parallax, scene.rig.user_balance
     );
     let _ = writeln!(s, "  view width at z0 (Xrange) = {:.6}", resolved.xrange);
+    if let Some(line) = image_shift_line(scene)? {
+        s.push_str(&line);
+    }
     for (name, m) in [("center", center), ("left", eyes[0]), ("right", eyes[1])] {
         let f = m.frustum;
-        let _ = writeln!(
+        let _ = write!(
             s,
             "  {name:6} eye at ({:.4}, {:.4}, {:.4})  frustum l={:.6} r={:.6} b={:.6} t={:.6} n={} f={}",
             m.eye_world.x, m.eye_world.y, m.eye_world.z, f[0], f[1], f[2], f[3], f[4], f[5]
         );
+        if m.viewport_shift != 0 {
+            let _ = write!(s, "  viewport moved {:+} px", m.viewport_shift);
+        }
+        s.push('\n');
     }
     let fov_x = horizontal_fov_degrees(scene.camera.fov_y, scene.aspect());
     let _ = writeln!(
@@ -143,6 +155,21 @@ pub fn describe(scene: &Scene) -> Result<String> {
         );
     }
     Ok(s)
+}
+
+/// For [`CameraMode::ImageShift`], the line saying how far each eye's image moved, how the
+/// shift was rounded, and how many columns on each side hold one eye only; `None` otherwise.
+///
+/// # Errors
+/// As [`StereoRig::image_shift`].
+pub fn image_shift_line(scene: &Scene) -> Result<Option<String>> {
+    if scene.rig.mode != CameraMode::ImageShift {
+        return Ok(None);
+    }
+    let shift = scene
+        .rig
+        .image_shift(&scene.camera, scene.width, scene.height)?;
+    Ok(Some(format!("  {}", shift.describe())))
 }
 
 /// The StereoGraphics guide (Akka) §8: stereo works best with a wide horizontal field of view.
@@ -199,7 +226,7 @@ pub fn budget_remedies(
 /// # Errors
 /// Invalid camera or rig, or an image size refused by [`crate::Framebuffer::new`].
 pub fn scene_budget(scene: &Scene) -> Result<ParallaxBudget> {
-    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let (fb, _) = render_view(scene, &eyes[0], Shading::DepthOnly)?;
     budget_of(&fb, &scene.parallax_rig()?)
 }
@@ -214,7 +241,8 @@ pub fn frame_budget_report(frame: &Frame, scene: &Scene) -> Result<Option<String
     for (view, name) in [(View::Left, "left"), (View::Right, "right")] {
         if let Some(fb) = frame.view(view) {
             let b = budget_of(fb, &rig)?;
-            return Ok(Some(format!("  {name} eye {}", b.report())));
+            let shift = image_shift_line(scene)?.unwrap_or_default();
+            return Ok(Some(format!("  {name} eye {}{shift}", b.report())));
         }
     }
     Ok(None)

@@ -61,6 +61,10 @@ pub enum Output {
     Jps,
     /// Right | left side by side in one PNG (`pns.pns`).
     Pns,
+    /// The SGI course notes' §4.1.3 "Rotate vs. Shear" side by side: the same frame from the
+    /// off-axis (shear) and toe-in (rotate) rigs, toe-in's vertical parallax per pixel, and the
+    /// difference of the two rigs' left images.
+    ShearVsRotate,
 }
 
 /// Which camera a pass renders from.
@@ -72,6 +76,14 @@ pub enum View {
     Right,
     /// The cyclopean eye: the camera itself.
     Center,
+    /// The scene's rig as off-axis (shear), left eye: one side of [`Output::ShearVsRotate`].
+    ShearLeft,
+    /// The scene's rig as off-axis (shear), right eye.
+    ShearRight,
+    /// The scene's rig as toe-in (rotate), left eye: the other side of [`Output::ShearVsRotate`].
+    RotateLeft,
+    /// The scene's rig as toe-in (rotate), right eye.
+    RotateRight,
 }
 
 /// What a pass computes per fragment.
@@ -130,6 +142,7 @@ impl Output {
         Output::Mpo,
         Output::Jps,
         Output::Pns,
+        Output::ShearVsRotate,
     ];
 
     /// The name used in scene files and for the PNG written.
@@ -160,6 +173,7 @@ impl Output {
             Output::Mpo => "mpo",
             Output::Jps => "jps",
             Output::Pns => "pns",
+            Output::ShearVsRotate => "shear_vs_rotate",
         }
     }
 
@@ -226,6 +240,13 @@ impl Output {
             Output::Parallax => vec![depth(View::Left)],
             // One depth pass of the cyclopean view; no color shading at all (the SIRDS paper (Petz et al.)).
             Output::Sirds | Output::SirdsDepth => vec![depth(View::Center)],
+            // Both rigs' eye passes, whatever the scene's own mode: the comparison is the point.
+            Output::ShearVsRotate => vec![
+                color(View::ShearLeft),
+                color(View::ShearRight),
+                color(View::RotateLeft),
+                color(View::RotateRight),
+            ],
             _ => vec![color(View::Left), color(View::Right)],
         }
     }

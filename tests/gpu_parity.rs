@@ -93,6 +93,7 @@ fn identity_matrices() -> EyeMatrices {
         mvp: Mat4::IDENTITY,
         eye_world: Vec3::ZERO,
         frustum: [-1.0, 1.0, -1.0, 1.0, 1.0, 10.0],
+        viewport_shift: 0,
     }
 }
 

@@ -11,4 +11,5 @@ pub mod legend;
 pub mod occlusion;
 pub mod parallax;
 pub mod remap;
+pub mod shear_rotate;
 pub mod sirds;

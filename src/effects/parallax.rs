@@ -24,7 +24,9 @@ pub struct ParallaxRig {
     pub eye_separation: f64,
     /// Zero-parallax distance z0.
     pub zero_parallax_distance: f64,
-    /// The StereoGraphics guide's `UserBalanceAdjustment` b (off-axis), 1 for toe-in, 0 for parallel axes.
+    /// The StereoGraphics guide's `UserBalanceAdjustment` b (off-axis), 1 for toe-in, 0 for
+    /// parallel axes; for image-shift the balance its whole-pixel shift applies
+    /// ([`crate::math::ImageShift::balance`]).
     pub balance: f64,
     /// Near plane distance n.
     pub near: f64,
@@ -53,6 +55,7 @@ impl ParallaxRig {
                 CameraMode::OffAxis => rig.user_balance as f64,
                 CameraMode::ToeIn => 1.0,
                 CameraMode::Parallel => 0.0,
+                CameraMode::ImageShift => rig.image_shift(camera, width, height)?.balance,
             },
             near: camera.near as f64,
             far: camera.far as f64,

@@ -11,10 +11,10 @@ use crate::effects::chromadepth::texgen::Texgen;
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 use crate::math::{EyeMatrices, StereoRig};
-use crate::plan::{Pass, Plan, Shading, View};
+use crate::plan::{Pass, Plan, Shading};
 use crate::raster::{RasterOptions, RasterStats};
 use crate::render::chromadepth::resolve_texgen;
-use crate::render::{Frame, PassResult};
+use crate::render::{Frame, PassResult, planned_shear_rotate_eyes};
 use crate::scene::{Object, Scene};
 use crate::shade::BlinnPhong;
 
@@ -109,19 +109,15 @@ impl GpuRenderer {
     /// Invalid camera or rig, or a GPU failure.
     pub fn render(&self, scene: &GpuScene, plan: &Plan) -> Result<Frame> {
         let s = scene.scene;
-        let eyes = s.rig.eyes(&s.camera, s.aspect())?;
+        let eyes = s.rig.eyes_for_image(&s.camera, s.width, s.height)?;
         let center = StereoRig::center(&s.camera, s.aspect())?;
-        let matrices = |v: View| match v {
-            View::Left => eyes[0],
-            View::Right => eyes[1],
-            View::Center => center,
-        };
+        let shear_rotate = planned_shear_rotate_eyes(s, plan)?;
         let start = Instant::now();
         let passes: Vec<(EyeMatrices, Shading)> = plan
             .passes
             .iter()
-            .map(|p| (matrices(p.view), p.shading))
-            .collect();
+            .map(|p| Ok((Frame::lookup(&eyes, &center, &shear_rotate, p.view)?, p.shading)))
+            .collect::<Result<_>>()?;
         let framebuffers = self.render_views(scene, &passes)?;
         let time = start.elapsed();
         let triangles: usize = s.objects.iter().map(|o| o.mesh.triangles.len()).sum();
@@ -144,6 +140,7 @@ impl GpuRenderer {
             passes,
             eyes,
             center,
+            shear_rotate,
         })
     }
 
@@ -245,7 +242,7 @@ impl GpuRenderer {
             b: bg[2],
             a: bg[3],
         };
-        for (v, ((_, shading), target)) in views.iter().zip(&targets).enumerate() {
+        for (v, ((m, shading), target)) in views.iter().zip(&targets).enumerate() {
             let key = PipelineKey {
                 shaded: *shading != Shading::DepthOnly,
                 chromadepth: *shading == Shading::ChromaDepth,
@@ -287,6 +284,11 @@ impl GpuRenderer {
                 ..Default::default()
             });
             pass.set_pipeline(&pipeline);
+            // Image-shift: the shifted viewport covers only these columns.
+            let drawn = m.drawn_columns(s.width);
+            if drawn != (0..s.width) {
+                pass.set_scissor_rect(drawn.start, 0, drawn.end - drawn.start, s.height);
+            }
             if let (true, Some(ramp)) = (key.chromadepth, &ramp_group) {
                 pass.set_bind_group(1, ramp, &[]);
             }

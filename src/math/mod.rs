@@ -7,8 +7,8 @@
 mod rig;
 
 pub use rig::{
-    Camera, CameraMode, EyeMatrices, Lighting, ResolvedRig, Separation, StereoRig, ZeroParallax,
-    fit_zero_parallax,
+    Camera, CameraMode, EyeMatrices, ImageShift, Lighting, ResolvedRig, Separation, StereoRig,
+    Viewer, ZeroParallax, fit_zero_parallax,
 };
 
 use glam::{Mat4, Vec3, Vec4};

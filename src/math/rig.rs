@@ -135,6 +135,30 @@ pub enum CameraMode {
     ToeIn,
     /// Parallel axes, symmetric frusta: zero parallax at infinity, everything in front of the screen.
     Parallel,
+    /// The StereoGraphics guide's §6 "imperfect approach": parallel axes and the same symmetric
+    /// frustum in both eyes (as [`CameraMode::Parallel`]), then each eye's image shifted when
+    /// viewported, the left one leftward and the right one rightward, by whole pixels, so that
+    /// the zero-parallax plane has zero parallax. Geometrically the off-axis result, but the
+    /// left and right edges of the two images no longer line up: the columns a shift uncovers
+    /// are blank (the clear colour) in that eye. See [`ImageShift`].
+    ImageShift,
+}
+
+/// Where the viewer (the camera position) sits in the rig: the SGI course notes §4.1.1, "the
+/// position of the viewer can be defined to be at one of the eye points, or halfway between
+/// them. In either case, the left and right eye locations are positioned relative to it."
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Viewer {
+    /// Halfway between the eyes: left eye at `−d/2`, right eye at `+d/2` along the camera's x
+    /// axis (the exercise slides' `T±`). Default.
+    #[default]
+    Midpoint,
+    /// At the left eye: the left eye at the camera position, the right eye displaced by the
+    /// full separation `d` along the camera's x axis. The whole rig (both eyes, the toe-in
+    /// fusion point on the centre line between them) moves by `d/2`; the center pass
+    /// (ChromaDepth, SIRDS) stays the camera, the viewer's own view.
+    LeftEye,
 }
 
 /// Which modelview the shading sees (the exercise slides' "Effect on lighting"): per-eye
@@ -189,6 +213,8 @@ pub struct StereoRig {
     pub user_balance: f32,
     /// Per-eye or cyclopic modelview for shading.
     pub lighting: Lighting,
+    /// Where the camera position sits in the rig: between the eyes or at the left eye.
+    pub viewer: Viewer,
 }
 
 impl Default for StereoRig {
@@ -200,6 +226,7 @@ impl Default for StereoRig {
             user_offset: 1.0,
             user_balance: 1.0,
             lighting: Lighting::PerEye,
+            viewer: Viewer::Midpoint,
         }
     }
 }
@@ -217,6 +244,77 @@ pub struct EyeMatrices {
     pub eye_world: Vec3,
     /// The frustum arguments `(l, r, b, t, n, f)` of `P_frustum±`.
     pub frustum: [f32; 6],
+    /// Pixels this eye's image is moved to the right when viewported ([`CameraMode::ImageShift`]:
+    /// `−k_left` for the left eye, `+k_right` for the right; 0 in every other mode). The
+    /// translation is part of `projection` (an NDC translation `2·shift/W` after `P_frustum`),
+    /// so `mvp` maps to the image as shown; a pass leaves the `|shift|` columns the image moved
+    /// away from blank ([`EyeMatrices::drawn_columns`]).
+    pub viewport_shift: i32,
+}
+
+impl EyeMatrices {
+    /// The columns `x0..x1` of a `width`-pixel image that this eye draws: all of them, but for
+    /// [`CameraMode::ImageShift`], whose shifted viewport leaves `|viewport_shift|` columns on
+    /// one side blank (the right side of the left eye, the left side of the right eye).
+    pub fn drawn_columns(&self, width: u32) -> std::ops::Range<u32> {
+        let k = self.viewport_shift.unsigned_abs().min(width);
+        if self.viewport_shift >= 0 {
+            k..width
+        } else {
+            0..width - k
+        }
+    }
+}
+
+/// The whole-pixel shifts of [`CameraMode::ImageShift`] for one image width.
+///
+/// The off-axis rig shifts each eye's image by `b·(d/2)·W/Xrange` pixels (the StereoGraphics
+/// guide §5–7: the frustum asymmetry, measured on the zero-parallax plane, equals the camera
+/// offset times `UserBalanceAdjustment` b). Shifting when viewporting moves whole pixels only,
+/// so the total relative shift `b·d·W/Xrange` is rounded to `K` pixels and split between the
+/// eyes (`k_left = ⌊K/2⌋`, `k_right = K − k_left`): the zero-parallax plane then has parallax
+/// `K − b·d·W/Xrange`, within half a pixel of zero. The balance the images really have is
+/// `b' = b·K / (b·d·W/Xrange)`, and the parallax of the pair is `p(z) = d·(b' − z0/z)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageShift {
+    /// Pixels the left eye's image moves left (its rightmost `left` columns are blank).
+    pub left: u32,
+    /// Pixels the right eye's image moves right (its leftmost `right` columns are blank).
+    pub right: u32,
+    /// The exact total shift `b·d·W/Xrange` in pixels, before rounding.
+    pub exact_total: f64,
+    /// The balance the rounded shift applies, `b' = b·K/exact_total` (b itself when d = 0).
+    pub balance: f64,
+}
+
+impl ImageShift {
+    /// The whole-pixel total `K = k_left + k_right`.
+    pub fn total(&self) -> u32 {
+        self.left + self.right
+    }
+
+    /// Parallax at the zero-parallax plane left by the rounding, in pixels: `K − exact`.
+    pub fn zero_plane_error_pixels(&self) -> f64 {
+        self.total() as f64 - self.exact_total
+    }
+
+    /// The line `stereolab info` and the render report print: the shifts, the rounding, and
+    /// how many columns on each side hold one eye only.
+    pub fn describe(&self) -> String {
+        format!(
+            "image shift: left eye moved {} px left, right eye {} px right (exact total {:.3} px, \
+             rounded to {}: parallax at z0 {:+.3} px, balance applied {:.4}); one eye only: {} \
+             columns at the left edge (left eye), {} at the right edge (right eye)\n",
+            self.left,
+            self.right,
+            self.exact_total,
+            self.total(),
+            self.zero_plane_error_pixels(),
+            self.balance,
+            self.right,
+            self.left
+        )
+    }
 }
 
 /// The rig's numbers once resolved against a camera and an aspect ratio.
@@ -294,16 +392,93 @@ impl StereoRig {
         })
     }
 
-    /// The two eyes' matrices, index 0 left, 1 right.
+    /// The two eyes' matrices, index 0 left, 1 right, for an image of aspect `width/height`.
     ///
     /// # Errors
-    /// As [`Camera::validate`] and [`StereoRig::resolve`].
+    /// As [`Camera::validate`] and [`StereoRig::resolve`]; and [`CameraMode::ImageShift`],
+    /// whose shift is a whole number of pixels and so needs the image size: use
+    /// [`StereoRig::eyes_for_image`].
     pub fn eyes(&self, camera: &Camera, aspect: f32) -> Result<[EyeMatrices; 2]> {
+        if self.mode == CameraMode::ImageShift {
+            return Err(Error::invalid(
+                "stereo.mode",
+                "\"image-shift\"",
+                "shifts each eye by whole pixels, so its matrices need the image size \
+                 (StereoRig::eyes_for_image, which every render uses)",
+            ));
+        }
+        self.eyes_with(camera, aspect, None)
+    }
+
+    /// The two eyes' matrices for a `width`×`height` image, index 0 left, 1 right: what the
+    /// passes render with. The same as [`StereoRig::eyes`] but for
+    /// [`CameraMode::ImageShift`], whose whole-pixel shifts ([`StereoRig::image_shift`]) this
+    /// puts into the projections.
+    ///
+    /// # Errors
+    /// As [`StereoRig::eyes`] and [`StereoRig::image_shift`].
+    pub fn eyes_for_image(
+        &self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+    ) -> Result<[EyeMatrices; 2]> {
+        let aspect = width as f32 / height as f32;
+        let shift = match self.mode {
+            CameraMode::ImageShift => Some((self.image_shift(camera, width, height)?, width)),
+            _ => None,
+        };
+        self.eyes_with(camera, aspect, shift)
+    }
+
+    /// The whole-pixel shifts [`CameraMode::ImageShift`] applies to a `width`×`height` image
+    /// (for any mode: what image-shift would do with this rig).
+    ///
+    /// # Errors
+    /// As [`StereoRig::resolve`]; a shift that leaves no column to both eyes (total ≥ width).
+    pub fn image_shift(&self, camera: &Camera, width: u32, height: u32) -> Result<ImageShift> {
+        camera.validate()?;
+        let r = self.resolve(camera, width as f32 / height as f32)?;
+        // b·d·W/Xrange: both eyes' shifts on the zero-parallax plane, in pixels.
+        let exact = self.user_balance as f64 * r.eye_separation as f64 * width as f64
+            / r.xrange as f64;
+        let total = exact.round();
+        if !(total.is_finite() && total < width as f64) {
+            return Err(Error::invalid(
+                "stereo.eye_separation",
+                r.eye_separation,
+                format!(
+                    "shifts the two image-shift eyes {exact:.1} px apart, which leaves no column \
+                     of the {width}-pixel image to both eyes; use a smaller separation, a \
+                     smaller stereo.user_balance, or \"auto\""
+                ),
+            ));
+        }
+        let total = total as u32;
+        let left = total / 2;
+        Ok(ImageShift {
+            left,
+            right: total - left,
+            exact_total: exact,
+            balance: if exact > 0.0 {
+                self.user_balance as f64 * total as f64 / exact
+            } else {
+                self.user_balance as f64
+            },
+        })
+    }
+
+    fn eyes_with(
+        &self,
+        camera: &Camera,
+        aspect: f32,
+        shift: Option<(ImageShift, u32)>,
+    ) -> Result<[EyeMatrices; 2]> {
         camera.validate()?;
         let r = self.resolve(camera, aspect)?;
         let eyes = [
-            self.eye(camera, aspect, &r, -1.0),
-            self.eye(camera, aspect, &r, 1.0),
+            self.eye(camera, aspect, &r, -1.0, shift),
+            self.eye(camera, aspect, &r, 1.0, shift),
         ];
         // Every range check can pass and the matrices still overflow (toe-in's look-at squares
         // the eye offset): refuse them here, before anything renders with NaN cameras.
@@ -325,12 +500,26 @@ impl StereoRig {
         Ok(eyes)
     }
 
-    /// One eye; `side` is −1 for left, +1 for right.
-    fn eye(&self, camera: &Camera, aspect: f32, r: &ResolvedRig, side: f32) -> EyeMatrices {
-        let mv = camera.view();
+    /// One eye; `side` is −1 for left, +1 for right; `shift` the image-shift pixels and the
+    /// image width (image-shift only).
+    fn eye(
+        &self,
+        camera: &Camera,
+        aspect: f32,
+        r: &ResolvedRig,
+        side: f32,
+        shift: Option<(ImageShift, u32)>,
+    ) -> EyeMatrices {
+        let half = 0.5 * r.eye_separation;
+        // The viewer's modelview (the camera's), and the rig's: centred between the eyes. With
+        // the viewer at the left eye the rig's midpoint is d/2 to the camera's right.
+        let viewer_mv = camera.view();
+        let mv = match self.viewer {
+            Viewer::Midpoint => viewer_mv,
+            Viewer::LeftEye => Mat4::from_translation(Vec3::new(-half, 0.0, 0.0)) * viewer_mv,
+        };
         let (w, h) = camera.near_half_extents(aspect);
         let (n, f) = (camera.near, camera.far);
-        let half = 0.5 * r.eye_separation;
         // Eye offset along the camera's x axis, in eye space.
         let t = Mat4::from_translation(Vec3::new(-side * half, 0.0, 0.0));
         let (eye_view, fr) = match self.mode {
@@ -339,7 +528,8 @@ impl StereoRig {
                 let shift = -side * half * self.user_balance * n / r.zero_parallax_distance;
                 (t * mv, [-w + shift, w + shift, -h, h, n, f])
             }
-            CameraMode::Parallel => (t * mv, [-w, w, -h, h, n, f]),
+            // Image-shift renders the parallel eyes; the shift comes after the projection.
+            CameraMode::Parallel | CameraMode::ImageShift => (t * mv, [-w, w, -h, h, n, f]),
             CameraMode::ToeIn => {
                 // The SGI course notes, per-eye look-at: both eyes aim at the fusion point on the center line.
                 let inv = mv.inverse();
@@ -349,10 +539,24 @@ impl StereoRig {
                 (look_at(eye, fusion, up), [-w, w, -h, h, n, f])
             }
         };
-        let p = frustum(fr[0], fr[1], fr[2], fr[3], fr[4], fr[5]);
+        let mut p = frustum(fr[0], fr[1], fr[2], fr[3], fr[4], fr[5]);
+        // The StereoGraphics guide §6: "apply an offset (towards the left for the left-camera
+        // rendering, towards the right for the right-camera rendering) when viewporting": a
+        // move of k whole pixels is the NDC translation 2k/W after the projection.
+        let mut viewport_shift = 0i32;
+        if let (CameraMode::ImageShift, Some((s, width))) = (self.mode, shift) {
+            viewport_shift = if side < 0.0 {
+                -(s.left as i32)
+            } else {
+                s.right as i32
+            };
+            let ndc = 2.0 * viewport_shift as f32 / width as f32;
+            p = Mat4::from_translation(Vec3::new(ndc, 0.0, 0.0)) * p;
+        }
         let (view, projection) = match self.lighting {
             Lighting::PerEye => (eye_view, p),
-            Lighting::Cyclopic => (mv, p * eye_view * mv.inverse()),
+            // Cyclopic: both eyes shade in the viewer's eye space.
+            Lighting::Cyclopic => (viewer_mv, p * eye_view * viewer_mv.inverse()),
         };
         EyeMatrices {
             view,
@@ -360,6 +564,7 @@ impl StereoRig {
             mvp: p * eye_view,
             eye_world: eye_view.inverse().transform_point3(Vec3::ZERO),
             frustum: fr,
+            viewport_shift,
         }
     }
 
@@ -379,6 +584,7 @@ impl StereoRig {
             mvp: projection * view,
             eye_world: camera.eye.into(),
             frustum: fr,
+            viewport_shift: 0,
         })
     }
 }

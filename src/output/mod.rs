@@ -2,6 +2,7 @@
 
 pub mod animate;
 pub mod chromadepth;
+pub mod shear_rotate;
 pub mod sirds;
 pub mod stereo_photo;
 
@@ -155,6 +156,7 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
         Output::Parallax => Image::Rgba(parallax_image(eye(View::Left)?, &scene.parallax_rig()?)?),
         Output::Sirds => Image::Rgba(sirds::from_frame(frame, scene)?.to_rgba_image()),
         Output::SirdsDepth => Image::Gray16(sirds::scene_depth(frame, scene)?.0.to_image()),
+        Output::ShearVsRotate => Image::Rgba(shear_rotate::shear_vs_rotate(frame)?.0),
         Output::Mpo | Output::Jps | Output::Pns => {
             let format = match output {
                 Output::Mpo => PhotoFormat::Mpo,
@@ -173,7 +175,8 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
 
 /// The MPO's baseline and convergence from the scene's rig: the resolved eye separation, and
 /// the angle between the optical axes — `2 atan((d/2)/z0)` for toe-in (the SGI course notes'
-/// rotation of each eye towards the fusion point), 0 for off-axis and parallel (parallel axes).
+/// rotation of each eye towards the fusion point), 0 for off-axis, parallel and image-shift
+/// (parallel axes).
 ///
 /// # Errors
 /// As [`StereoRig::resolve`](crate::math::StereoRig::resolve).
@@ -186,7 +189,7 @@ pub fn rig_metadata(scene: &Scene) -> Result<RigMetadata> {
                 .atan()
                 .to_degrees()
         }
-        CameraMode::OffAxis | CameraMode::Parallel => 0.0,
+        CameraMode::OffAxis | CameraMode::Parallel | CameraMode::ImageShift => 0.0,
     };
     Ok(RigMetadata {
         baseline: r.eye_separation,

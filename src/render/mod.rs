@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
-use crate::math::{EyeMatrices, StereoRig};
+use crate::math::{CameraMode, EyeMatrices, StereoRig};
 use crate::plan::{Pass, Plan, Shading, View};
 use crate::raster::{RasterStats, rasterize};
 use crate::scene::Scene;
@@ -43,6 +43,10 @@ pub struct Frame {
     pub eyes: [EyeMatrices; 2],
     /// The cyclopean eye.
     pub center: EyeMatrices,
+    /// The scene's rig as off-axis (`[0]`, shear) and as toe-in (`[1]`, rotate), each left and
+    /// right: the matrices of the [`View::ShearLeft`] … [`View::RotateRight`] passes, present
+    /// when the plan runs them ([`shear_rotate_eyes`]).
+    pub shear_rotate: Option<[[EyeMatrices; 2]; 2]>,
 }
 
 impl Frame {
@@ -54,13 +58,79 @@ impl Frame {
             .map(|p| &p.framebuffer)
     }
 
-    /// The matrices of `view`.
-    pub fn matrices(&self, view: View) -> &EyeMatrices {
+    /// The matrices of `view`; `None` for a shear/rotate view the plan did not run.
+    pub fn try_matrices(&self, view: View) -> Option<&EyeMatrices> {
+        let compare = |rig: usize, eye: usize| self.shear_rotate.as_ref().map(|m| &m[rig][eye]);
         match view {
-            View::Left => &self.eyes[0],
-            View::Right => &self.eyes[1],
-            View::Center => &self.center,
+            View::Left => Some(&self.eyes[0]),
+            View::Right => Some(&self.eyes[1]),
+            View::Center => Some(&self.center),
+            View::ShearLeft => compare(0, 0),
+            View::ShearRight => compare(0, 1),
+            View::RotateLeft => compare(1, 0),
+            View::RotateRight => compare(1, 1),
         }
+    }
+
+    /// The matrices of `view`.
+    ///
+    /// # Panics
+    /// For a shear/rotate view the frame's plan did not run (no matrices were made for it);
+    /// [`Frame::try_matrices`] returns `None` instead.
+    pub fn matrices(&self, view: View) -> &EyeMatrices {
+        self.try_matrices(view)
+            .expect("a shear/rotate view is asked for only when the plan ran it")
+    }
+}
+
+/// The scene's rig as off-axis (`[0]`, the SGI course notes' shear) and as toe-in (`[1]`,
+/// rotate), index 0 left and 1 right within each: everything else (separation, zero parallax,
+/// balance, lighting, viewer) as the scene sets it.
+///
+/// # Errors
+/// As [`StereoRig::eyes_for_image`].
+pub fn shear_rotate_eyes(scene: &Scene) -> Result<[[EyeMatrices; 2]; 2]> {
+    let rig = |mode| StereoRig { mode, ..scene.rig };
+    let (w, h) = (scene.width, scene.height);
+    Ok([
+        rig(CameraMode::OffAxis).eyes_for_image(&scene.camera, w, h)?,
+        rig(CameraMode::ToeIn).eyes_for_image(&scene.camera, w, h)?,
+    ])
+}
+
+/// [`shear_rotate_eyes`] when `plan` runs a shear or rotate pass, `None` otherwise (so a rig
+/// that only toe-in cannot represent never fails a plan that does not ask for it).
+///
+/// # Errors
+/// As [`shear_rotate_eyes`].
+pub fn planned_shear_rotate_eyes(scene: &Scene, plan: &Plan) -> Result<Option<[[EyeMatrices; 2]; 2]>> {
+    let needed = plan.passes.iter().any(|p| {
+        matches!(
+            p.view,
+            View::ShearLeft | View::ShearRight | View::RotateLeft | View::RotateRight
+        )
+    });
+    needed.then(|| shear_rotate_eyes(scene)).transpose()
+}
+
+impl Frame {
+    /// The matrices of every view, for a frame that is still being rendered.
+    pub(crate) fn lookup(
+        eyes: &[EyeMatrices; 2],
+        center: &EyeMatrices,
+        compare: &Option<[[EyeMatrices; 2]; 2]>,
+        view: View,
+    ) -> Result<EyeMatrices> {
+        let m = match view {
+            View::Left => Some(eyes[0]),
+            View::Right => Some(eyes[1]),
+            View::Center => Some(*center),
+            View::ShearLeft => compare.map(|m| m[0][0]),
+            View::ShearRight => compare.map(|m| m[0][1]),
+            View::RotateLeft => compare.map(|m| m[1][0]),
+            View::RotateRight => compare.map(|m| m[1][1]),
+        };
+        m.ok_or_else(|| crate::Error::internal("plan", format!("no matrices for the {view:?} pass")))
     }
 }
 
@@ -70,19 +140,16 @@ impl Frame {
 /// # Errors
 /// Invalid camera or rig, or an image size refused by [`Framebuffer::new`].
 pub fn render(scene: &Scene, plan: &Plan) -> Result<Frame> {
-    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let center = StereoRig::center(&scene.camera, scene.aspect())?;
-    let matrices = |v: View| match v {
-        View::Left => eyes[0],
-        View::Right => eyes[1],
-        View::Center => center,
-    };
+    let shear_rotate = planned_shear_rotate_eyes(scene, plan)?;
     let passes = plan
         .passes
         .par_iter()
         .map(|p| {
             let start = Instant::now();
-            let (framebuffer, stats) = render_view(scene, &matrices(p.view), p.shading)?;
+            let m = Frame::lookup(&eyes, &center, &shear_rotate, p.view)?;
+            let (framebuffer, stats) = render_view(scene, &m, p.shading)?;
             Ok(PassResult {
                 pass: *p,
                 framebuffer,
@@ -96,6 +163,7 @@ pub fn render(scene: &Scene, plan: &Plan) -> Result<Frame> {
         passes,
         eyes,
         center,
+        shear_rotate,
     })
 }
 
@@ -153,6 +221,11 @@ pub fn render_view(
         total.clipped += s.clipped;
         total.culled += s.culled;
         total.fragments += s.fragments;
+    }
+    // Image-shift: the shifted viewport covers only these columns (a scissor, on the GPU).
+    let drawn = m.drawn_columns(scene.width);
+    if drawn != (0..scene.width) {
+        fb.clear_outside_columns(drawn, scene.background);
     }
     Ok((fb, total))
 }

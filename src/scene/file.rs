@@ -3,7 +3,7 @@
 use serde::Deserialize;
 
 use crate::effects::chromadepth::ChromaDepthSettings;
-use crate::math::{Camera, CameraMode, Lighting};
+use crate::math::{Camera, CameraMode, Lighting, Viewer};
 
 /// A scene file as written.
 #[derive(Debug, Deserialize)]
@@ -72,7 +72,7 @@ pub(crate) enum SeparationSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct StereoSpec {
-    /// `off-axis` (default), `toe-in`, `parallel`.
+    /// `off-axis` (default), `toe-in`, `parallel`, `image-shift`.
     #[serde(default)]
     pub mode: CameraMode,
     /// Number or `"auto"` (default).
@@ -94,6 +94,9 @@ pub(crate) struct StereoSpec {
     /// `per-eye` (default) or `cyclopic`.
     #[serde(default)]
     pub lighting: Lighting,
+    /// Where the camera position sits: `midpoint` (default, between the eyes) or `left-eye`.
+    #[serde(default)]
+    pub viewer: Viewer,
 }
 
 impl Default for StereoSpec {
@@ -106,6 +109,7 @@ impl Default for StereoSpec {
             user_offset: 1.0,
             user_balance: 1.0,
             lighting: Lighting::PerEye,
+            viewer: Viewer::Midpoint,
         }
     }
 }

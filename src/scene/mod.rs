@@ -214,11 +214,12 @@ impl Scene {
             user_offset: f.stereo.user_offset,
             user_balance: f.stereo.user_balance,
             lighting: f.stereo.lighting,
+            viewer: f.stereo.viewer,
         };
-        let aspect = f.image.width as f32 / f.image.height as f32;
         // The eyes themselves: a separation can pass every range check and still overflow the
-        // matrices (toe-in at 1e20 units gives NaN cameras).
-        rig.eyes(&f.camera, aspect)?;
+        // matrices (toe-in at 1e20 units gives NaN cameras), or shift image-shift's eyes apart
+        // by the whole width.
+        rig.eyes_for_image(&f.camera, f.image.width, f.image.height)?;
         check_finite("light.position", &f.light.position)?;
         checks::check_light(&f.light)?;
         check_finite("image.background", &f.image.background)?;
@@ -269,7 +270,7 @@ impl Scene {
                  nearest and farthest visible vertex depths)"
             ));
             rig.zero_parallax = ZeroParallax::Distance(z0);
-            rig.resolve(&f.camera, aspect)?;
+            rig.eyes_for_image(&f.camera, f.image.width, f.image.height)?;
         } else if let (Some(_), ZeroParallax::Distance(z0)) =
             (&zero_parallax_word, rig.zero_parallax)
         {
@@ -335,7 +336,7 @@ impl Scene {
         check_size(width, height)?;
         self.width = width;
         self.height = height;
-        self.rig.eyes(&self.camera, self.aspect())?;
+        self.rig.eyes_for_image(&self.camera, width, height)?;
         Ok(())
     }
 
@@ -364,7 +365,8 @@ impl Scene {
 fn fit_scene_zero_parallax(rig: &StereoRig, camera: &Camera, objects: &[Object]) -> Result<f32> {
     use crate::math::CameraMode;
     let balance = match rig.mode {
-        CameraMode::OffAxis => rig.user_balance,
+        // Image-shift: the balance before its whole-pixel rounding (z0 fixes that rounding).
+        CameraMode::OffAxis | CameraMode::ImageShift => rig.user_balance,
         CameraMode::ToeIn => 1.0,
         CameraMode::Parallel => {
             return Err(Error::invalid(

@@ -334,12 +334,17 @@ fn absolute_path(t: &mut toml::Table, key: &str, base: &Path) -> Result<()> {
 /// To offer a new [`CameraMode`], add it here (and to `_every_mode_listed` below, which stops
 /// compiling until a new variant is handled); the radio buttons, the M key and the scene file's
 /// word ([`mode_name`], from the scene file's own serde name) follow from this list.
-pub const MODES: &[CameraMode] = &[CameraMode::OffAxis, CameraMode::ToeIn, CameraMode::Parallel];
+pub const MODES: &[CameraMode] = &[
+    CameraMode::OffAxis,
+    CameraMode::ToeIn,
+    CameraMode::Parallel,
+    CameraMode::ImageShift,
+];
 
 /// Fails to compile when `CameraMode` gains a variant: add the new mode to [`MODES`] too.
 const fn _every_mode_listed(m: CameraMode) {
     match m {
-        CameraMode::OffAxis | CameraMode::ToeIn | CameraMode::Parallel => {}
+        CameraMode::OffAxis | CameraMode::ToeIn | CameraMode::Parallel | CameraMode::ImageShift => {}
     }
 }
 

@@ -144,6 +144,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(report) = info::frame_budget_report(&frame, &s)? {
         out!("{report}");
     }
+    if let Some(report) = stereolab::output::shear_rotate::report(&frame)? {
+        out!("{report}");
+    }
     for p in paths {
         outln!("  wrote {}", p.display());
     }

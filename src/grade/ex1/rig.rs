@@ -33,6 +33,7 @@ pub(crate) fn eye_matrices_from_answer(a: &[f64]) -> Option<EyeMatrices> {
         mvp: projection * view,
         eye_world: Vec3::ZERO,
         frustum: [0.0; 6],
+        viewport_shift: 0,
     })
 }
 
