@@ -10,6 +10,7 @@ mod determinism;
 mod figures;
 mod finalize;
 mod fuzz;
+mod gallery;
 mod golden;
 #[cfg(feature = "gpu")]
 mod gpu_finalize;
@@ -28,6 +29,7 @@ mod rig;
 mod scene_hashes;
 mod sirds;
 mod sirds_interop;
+mod sirds_told;
 mod stability;
 mod stereo_photo;
 #[cfg(feature = "viewer")]
