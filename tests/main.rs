@@ -28,6 +28,7 @@ mod reliability;
 mod rig;
 mod scene_hashes;
 mod sirds;
+mod sirds_experiments;
 mod sirds_interop;
 mod sirds_told;
 mod stability;
