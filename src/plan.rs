@@ -54,6 +54,9 @@ pub enum Output {
     Sirds,
     /// The depth map the SIRDS encodes (16-bit, white = near).
     SirdsDepth,
+    /// The SIRDS paper's Fig. 5: the scene's SIRDS in three horizontal bands, eq. 3 bilinear
+    /// (top), eq. 1 bilinear (middle), eq. 3 nearest (bottom: discrete depth layers).
+    SirdsFig5,
     /// Left and right as a CIPA DC-007 multi-picture JPEG (`mpo.mpo`), what stereo cameras
     /// write and 3D viewers open.
     Mpo,
@@ -139,6 +142,7 @@ impl Output {
         Output::Parallax,
         Output::Sirds,
         Output::SirdsDepth,
+        Output::SirdsFig5,
         Output::Mpo,
         Output::Jps,
         Output::Pns,
@@ -170,6 +174,7 @@ impl Output {
             Output::Parallax => "parallax",
             Output::Sirds => "sirds",
             Output::SirdsDepth => "sirds_depth",
+            Output::SirdsFig5 => "sirds_fig5",
             Output::Mpo => "mpo",
             Output::Jps => "jps",
             Output::Pns => "pns",
@@ -239,7 +244,7 @@ impl Output {
             // p(z) needs the left eye's depth and the rig, nothing else.
             Output::Parallax => vec![depth(View::Left)],
             // One depth pass of the cyclopean view; no color shading at all (the SIRDS paper (Petz et al.)).
-            Output::Sirds | Output::SirdsDepth => vec![depth(View::Center)],
+            Output::Sirds | Output::SirdsDepth | Output::SirdsFig5 => vec![depth(View::Center)],
             // Both rigs' eye passes, whatever the scene's own mode: the comparison is the point.
             Output::ShearVsRotate => vec![
                 color(View::ShearLeft),

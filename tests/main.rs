@@ -10,6 +10,7 @@ mod determinism;
 mod figures;
 mod finalize;
 mod fuzz;
+mod gallery;
 mod golden;
 #[cfg(feature = "gpu")]
 mod gpu_finalize;
@@ -29,7 +30,9 @@ mod rig;
 mod scene_hashes;
 mod shear_rotate;
 mod sirds;
+mod sirds_experiments;
 mod sirds_interop;
+mod sirds_told;
 mod stability;
 mod stereo_photo;
 #[cfg(feature = "viewer")]

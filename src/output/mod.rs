@@ -157,6 +157,7 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
         Output::Sirds => Image::Rgba(sirds::from_frame(frame, scene)?.to_rgba_image()),
         Output::SirdsDepth => Image::Gray16(sirds::scene_depth(frame, scene)?.0.to_image()),
         Output::ShearVsRotate => Image::Rgba(shear_rotate::shear_vs_rotate(frame)?.0),
+        Output::SirdsFig5 => Image::Rgba(sirds::fig5_bands(frame, scene)?.to_rgba_image()),
         Output::Mpo | Output::Jps | Output::Pns => {
             let format = match output {
                 Output::Mpo => PhotoFormat::Mpo,

@@ -6,7 +6,8 @@ use std::path::Path;
 
 use crate::effects::sirds::depthfile::{DepthMapping, DepthSamples, Near};
 use crate::effects::sirds::{
-    Algorithm, DepthMap, DepthRange, Disparity, Settings, Sirds, depth_range, pattern, per_pixel,
+    Algorithm, DepthMap, DepthRange, Disparity, DisparityModel, Filter, Settings, Sirds,
+    depth_range, pattern, per_pixel,
 };
 use crate::error::{Error, Result};
 use crate::files;
@@ -55,6 +56,42 @@ pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
             false,
         )
     })
+}
+
+/// The three variants of the SIRDS paper's Fig. 5, top to bottom: eq. 3 (constant eye
+/// distance) with bilinear filtering, eq. 1 (constant viewing direction) bilinear, eq. 3 with
+/// nearest filtering ("without texture interpolation, discrete depth layers are visible").
+pub const FIG5_BANDS: [(DisparityModel, Filter); 3] = [
+    (DisparityModel::EyeDistance, Filter::Bilinear),
+    (DisparityModel::ViewAngle, Filter::Bilinear),
+    (DisparityModel::EyeDistance, Filter::Nearest),
+];
+
+/// Output `sirds_fig5`: the scene's per-vertex SIRDS made three times from the one depth pass,
+/// once per [`FIG5_BANDS`] variant (the scene's other `[sirds]` settings kept), each
+/// contributing a third of the rows (band `k`: rows `k·H/3 .. (k+1)·H/3`). On the ramp scene
+/// (`sirds_fig5.toml`) it is the paper's figure. `disparity` is the top band's.
+///
+/// # Errors
+/// As [`from_frame`].
+pub fn fig5_bands(frame: &Frame, scene: &Scene) -> Result<Sirds> {
+    let (w, h) = (scene.width as usize, scene.height as usize);
+    let mut bands = Vec::with_capacity(3);
+    for (model, filter) in FIG5_BANDS {
+        let mut s = scene.clone();
+        s.sirds.algorithm = Algorithm::PerVertex;
+        s.sirds.geometry.model = model;
+        s.sirds.per_vertex.filter = filter;
+        bands.push(from_frame(frame, &s)?);
+    }
+    let mut out = bands[0].clone();
+    for (k, band) in bands.iter().enumerate() {
+        let rows = k * h / 3..(k + 1) * h / 3;
+        out.pixels[rows.start * w..rows.end * w]
+            .copy_from_slice(&band.pixels[rows.start * w..rows.end * w]);
+    }
+    out.iterations = None;
+    Ok(out)
 }
 
 /// [`from_frame`] with the per-vertex strips made by `strips` from the strip geometry and the

@@ -190,9 +190,9 @@ pub(crate) struct FinalizeSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct MeshSpec {
-    /// `obj`, `sphere`, `cube`, `torus`, `plane`, `triangles`, `terrain`.
+    /// `obj`, `sphere`, `cube`, `torus`, `plane`, `triangles`, `terrain`, `dem`, `pdb`.
     pub kind: String,
-    /// OBJ path (or terrain CSV path), relative to the scene file.
+    /// OBJ path (or terrain CSV, DEM image, PDB file), relative to the scene file.
     #[serde(default)]
     pub path: Option<String>,
     /// Radius (sphere), edge (cube, plane), major radius (torus).
@@ -204,9 +204,18 @@ pub(crate) struct MeshSpec {
     /// Tessellation (segments / divisions).
     #[serde(default)]
     pub detail: Option<u32>,
-    /// Triangle count for `triangles`.
+    /// Triangle count for `triangles`; scattered points for `dem`.
     #[serde(default)]
     pub count: Option<u32>,
+    /// `dem`: the grid's size on the map, `[east, north]`, scene units.
+    #[serde(default)]
+    pub extent: Option<[f64; 2]>,
+    /// `dem`: the heights of gray 0 and full-scale white, scene units.
+    #[serde(default)]
+    pub heights: Option<[f64; 2]>,
+    /// `dem`: seed of the point scatter.
+    #[serde(default)]
+    pub seed: Option<u64>,
     /// Translation (world).
     #[serde(default)]
     pub translate: [f32; 3],

@@ -1,9 +1,11 @@
 //! Scenes: the TOML file, OBJ models, procedural shapes.
 
 mod checks;
+pub mod dem;
 mod file;
 mod mesh;
 mod obj;
+pub mod pdb;
 mod polygon;
 pub mod terrain;
 pub mod terrain_data;
@@ -460,11 +462,12 @@ fn load_object(
         "sphere" | "torus" => 2 * u64::from(detail) * u64::from(detail / 2),
         "plane" => 2 * u64::from(detail.min(512)).pow(2),
         "triangles" => u64::from(m.count.unwrap_or(1000)),
+        "dem" => 2 * u64::from(m.count.unwrap_or(DEFAULT_DEM_POINTS)),
         _ => 0,
     };
     if planned > max_triangles {
         return Err(over_budget(
-            &field(if m.kind == "triangles" {
+            &field(if m.kind == "triangles" || m.kind == "dem" {
                 "count"
             } else {
                 "detail"
@@ -496,6 +499,19 @@ fn load_object(
             })?;
             terrain::load_terrain_csv_within(&root.resolve(&field("path"), p)?, max_triangles)?.mesh
         }
+        "dem" => load_dem_mesh(&field, m, root, max_triangles)?,
+        "pdb" => {
+            let p = m.path.as_ref().ok_or_else(|| {
+                Error::invalid(field("path"), "missing", "a pdb mesh needs a PDB file path")
+            })?;
+            let detail = m.detail.unwrap_or(12);
+            let atoms = pdb::load_pdb(&root.resolve(&field("path"), p)?)?;
+            let planned = pdb::planned_triangles(atoms.len(), detail);
+            if planned > max_triangles {
+                return Err(over_budget(&field("detail"), planned, max_triangles));
+            }
+            pdb::atoms_mesh(&atoms, detail, positive("size", m.size, 1.0)?)
+        }
         "plane" => Mesh::plane(positive("size", m.size, 1.0)?, detail.min(512)),
         "triangles" => {
             let n = m.count.unwrap_or(1000);
@@ -512,7 +528,7 @@ fn load_object(
             return Err(Error::invalid(
                 field("kind"),
                 format!("\"{other}\""),
-                "known kinds: obj, sphere, cube, torus, plane, triangles, terrain",
+                "known kinds: obj, sphere, cube, torus, plane, triangles, terrain, dem, pdb",
             ));
         }
     };
@@ -532,6 +548,49 @@ fn load_object(
         model: model_matrix(m.translate, m.rotate, m.scale),
         color: m.color.into(),
     })
+}
+
+/// Scattered points a `dem` mesh is sampled at unless `count` says otherwise.
+pub const DEFAULT_DEM_POINTS: u32 = 20_000;
+
+/// A `kind = "dem"` mesh: the elevation image at `path`, its `extent` and `heights` (both
+/// required: an image does not say how large its ground is), `count` scattered points
+/// ([`DEFAULT_DEM_POINTS`]), `seed`.
+fn load_dem_mesh(
+    field: &dyn Fn(&str) -> String,
+    m: &file::MeshSpec,
+    root: &InputRoot,
+    max_triangles: u64,
+) -> Result<Mesh> {
+    let p = m.path.as_ref().ok_or_else(|| {
+        Error::invalid(
+            field("path"),
+            "missing",
+            "a dem mesh needs the path of a grayscale elevation image",
+        )
+    })?;
+    let extent = m.extent.ok_or_else(|| {
+        Error::invalid(
+            field("extent"),
+            "missing",
+            "a dem mesh needs extent = [east, north], the ground the image covers, in scene units",
+        )
+    })?;
+    let heights = m.heights.ok_or_else(|| {
+        Error::invalid(
+            field("heights"),
+            "missing",
+            "a dem mesh needs heights = [at gray 0, at full-scale white], in scene units",
+        )
+    })?;
+    let opts = dem::DemOptions {
+        extent,
+        heights,
+        points: m.count.unwrap_or(DEFAULT_DEM_POINTS),
+        seed: m.seed.unwrap_or(0),
+    };
+    dem::check_options(field("").trim_end_matches('.'), &opts)?;
+    Ok(dem::load_dem(&root.resolve(&field("path"), p)?, &opts, max_triangles)?.mesh)
 }
 
 /// A `[[mesh]]`'s object → world matrix from its `translate`, `rotate` (degrees about X, then

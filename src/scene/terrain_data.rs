@@ -4,7 +4,7 @@
 //! math libraries), so the same CSV bytes come out on every machine.
 
 /// splitmix64 (Steele, Lea, Flood 2014): the whole random state is one `u64`.
-struct SplitMix64(u64);
+pub(crate) struct SplitMix64(pub(crate) u64);
 
 impl SplitMix64 {
     fn next_u64(&mut self) -> u64 {
@@ -12,7 +12,7 @@ impl SplitMix64 {
         mix(self.0)
     }
     /// Uniform in [0, 1) with 53 random bits.
-    fn next_f64(&mut self) -> f64 {
+    pub(crate) fn next_f64(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
 }

@@ -26,8 +26,10 @@ pub struct SirdsArgs {
     #[arg(long, default_value = "white", value_parser = ["white", "black"], requires = "depth")]
     pub near: String,
     /// Decode this autostereogram: write the depth it encodes to --out and say whether it is
-    /// one at all.
-    #[arg(long, conflicts_with_all = ["scene", "depth"])]
+    /// one at all. With a scene (its `[sirds]` table) or `--set sirds.*` flags the decoder is
+    /// told the viewing set-up: it decodes over that model's separations (eq. 1 or eq. 3,
+    /// wall- or cross-eyed) instead of searching for them.
+    #[arg(long, conflicts_with_all = ["depth", "frames"])]
     pub decode: Option<PathBuf>,
     /// Output file: .png, or .ppm (uncompressed); with --frames a .gif. Default sirds.png, or
     /// sirds.gif with --frames.
@@ -182,15 +184,21 @@ fn report(args: &SirdsArgs) -> Result<String> {
 /// `stereolab sirds --decode`: searches the full plausible separation range, decodes, writes
 /// the depth (and with `--pair` the two views and their anaglyph); returns the report.
 fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
-    use stereolab::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
     use stereolab::effects::sirds::decode::{decode_auto, nearness_linear};
-    use stereolab::effects::sirds::pair::views;
     use stereolab::effects::sirds::search::SearchOptions;
 
-    let settings = settings_from_sets(&args.sets)?;
+    // Told the set-up: by the scene's [sirds] table (with --set applied), or by --set alone.
+    let told = args.scene.is_some() || !args.sets.is_empty();
+    let settings = match &args.scene {
+        Some(scene) => super::load_scene(scene, &args.sets, None)?.sirds,
+        None => settings_from_sets(&args.sets)?,
+    };
     let img = stereolab::framebuffer::open_image(path, "image")?.to_rgba8();
     let (w, h) = img.dimensions();
     let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    if told {
+        return decode_told(args, path, out, &settings, &pixels, w, h);
+    }
     let auto = super::with_spinner(&format!("decoding {}", path.display()), || {
         decode_auto(&pixels, w, h, &SearchOptions::default())
     })
@@ -233,34 +241,102 @@ fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
     );
     // Depth: through the viewing model when the user named the set-up (--set), else linear
     // in the range found (near repeats sooner when wall-eyed, later when cross-eyed).
-    let z: Vec<f32> = if args.sets.is_empty() {
-        let (near, far) = if settings.cross_eyed {
-            (hi as f32, lo as f32)
-        } else {
-            (lo as f32, hi as f32)
-        };
-        report += &format!(
-            "  depth: linear in separation, {near} px = white (near) .. {far} px = black (far)\n"
-        );
-        nearness_linear(decoded, near, far)
+    // Not told the set-up: depth linear in the range found (near repeats sooner when
+    // wall-eyed, later when cross-eyed).
+    let (near, far) = if settings.cross_eyed {
+        (hi as f32, lo as f32)
     } else {
-        let d = settings.geometry.to_pixels()?;
-        report += &format!(
-            "  depth: through the {:?} model of the --set viewing set-up ({:.1}..{:.1} px){}\n",
-            d.model,
-            d.min_separation(),
-            d.max_separation(),
-            if settings.cross_eyed {
-                ", cross-eyed"
-            } else {
-                ""
-            }
-        );
-        depth_from_separation(decoded, &d)
-            .into_iter()
-            .map(|z| if settings.cross_eyed { 1.0 - z } else { z })
-            .collect()
+        (lo as f32, hi as f32)
     };
+    report += &format!(
+        "  depth: linear in separation, {near} px = white (near) .. {far} px = black (far)\n"
+    );
+    let z = nearness_linear(decoded, near, far);
+    let range = auto
+        .options
+        .map_or((lo, hi), |o| (o.min_separation, o.max_separation));
+    report += &finish_decode(args, out, &pixels, (w, h), decoded, z, range, &settings)?;
+    Ok(report)
+}
+
+/// `--decode` told the viewing set-up (a scene or `--set sirds.*`): decodes over the
+/// separations the model can produce ([`DecodeOptions::for_disparity`]), no search, and maps
+/// separation to depth through the model (eq. 1 or eq. 3; cross-eyed inverts depth).
+#[allow(clippy::too_many_arguments)]
+fn decode_told(
+    args: &SirdsArgs,
+    path: &Path,
+    out: &Path,
+    settings: &Settings,
+    pixels: &[[u8; 4]],
+    w: u32,
+    h: u32,
+) -> Result<String> {
+    use stereolab::effects::sirds::decode::{
+        DecodeOptions, Decoded, decode, matched_share_where_all_fit,
+    };
+    let d = settings.geometry.to_pixels()?;
+    let opts = DecodeOptions::for_disparity(&d);
+    let decoded = super::with_spinner(&format!("decoding {}", path.display()), || {
+        decode(pixels, w, h, &opts)
+    })
+    .map_err(|e| e.in_file(path))?;
+    let mut report = format!(
+        "{}: told the viewing set-up ({}): the {} model, {}, separations {:.1}..{:.1} px\n  \
+         depth: through that model\n",
+        path.display(),
+        if args.scene.is_some() {
+            "the scene's [sirds]"
+        } else {
+            "--set"
+        },
+        match d.model {
+            stereolab::effects::sirds::DisparityModel::ViewAngle => "eq. 1 (constant view angle)",
+            stereolab::effects::sirds::DisparityModel::EyeDistance =>
+                "eq. 3 (constant eye distance)",
+        },
+        if settings.cross_eyed {
+            "cross-eyed"
+        } else {
+            "wall-eyed"
+        },
+        d.min_separation(),
+        d.max_separation(),
+    );
+    let z = depth_from_separation(&decoded, &d)
+        .into_iter()
+        .map(|z| if settings.cross_eyed { 1.0 - z } else { z })
+        .collect();
+    let range = (opts.min_separation, opts.max_separation);
+    // Judged where every separation of the model fits (see matched_share_where_all_fit).
+    let share = matched_share_where_all_fit(&decoded, &opts);
+    report += &format!(
+        "  {:.1}% of the pixels where every separation of the model fits matched\n",
+        share * 100.0
+    );
+    let judged = Decoded {
+        matched_share: share,
+        ..decoded
+    };
+    report += &finish_decode(args, out, pixels, (w, h), &judged, z, range, settings)?;
+    Ok(report)
+}
+
+/// Writes the decoded depth (and with `--pair` the views and their anaglyph); returns the
+/// verdict and what was written.
+#[allow(clippy::too_many_arguments)]
+fn finish_decode(
+    args: &SirdsArgs,
+    out: &Path,
+    pixels: &[[u8; 4]],
+    (w, h): (u32, u32),
+    decoded: &stereolab::effects::sirds::decode::Decoded,
+    z: Vec<f32>,
+    (lo, hi): (u32, u32),
+    settings: &Settings,
+) -> Result<String> {
+    use stereolab::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
+    use stereolab::effects::sirds::pair::views;
     let z = z
         .into_iter()
         .map(|z| {
@@ -279,12 +355,10 @@ fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
         },
         out,
     )?;
-    report += &format!(
-        "  {:.1}% of pixels matched a separation in {}..={} px: {}\n  wrote {}\n",
+    let mut report = format!(
+        "  {:.1}% of pixels matched a separation in {lo}..={hi} px: {}\n  wrote {}\n",
         decoded.matched_share * 100.0,
-        auto.options.map_or(lo, |o| o.min_separation),
-        auto.options.map_or(hi, |o| o.max_separation),
-        if auto.is_autostereogram() {
+        if decoded.is_autostereogram() {
             "an autostereogram"
         } else {
             "not an autostereogram (no consistent repetition)"
@@ -292,7 +366,7 @@ fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
         out.display()
     );
     if let Some(dir) = &args.pair {
-        let v = views(&pixels, decoded, settings.cross_eyed)?;
+        let v = views(pixels, decoded, settings.cross_eyed)?;
         let fb = |color: Vec<[u8; 4]>| -> Result<stereolab::framebuffer::Framebuffer> {
             let mut fb = stereolab::framebuffer::Framebuffer::new(w, h, [0, 0, 0, 255])?;
             fb.color = color;

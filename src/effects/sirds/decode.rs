@@ -230,6 +230,28 @@ fn decode_band(
     tested
 }
 
+/// Share of pixels matched among those where a pair of every separation in `opts`' range
+/// fits the image (`x ± (max_separation / 2 + half_width)` inside it): the region where an
+/// autostereogram of a known set-up has a pair at every depth. A decoder told the set-up
+/// judges the image there; [`Decoded::matched_share`] also counts pixels near the sides,
+/// where only the smaller separations fit, which a SIRDS with separations wider than a third
+/// of the image has many of.
+pub fn matched_share_where_all_fit(decoded: &Decoded, opts: &DecodeOptions) -> f64 {
+    let w = decoded.width as usize;
+    let margin = (opts.max_separation as usize).div_ceil(2) + opts.half_width as usize;
+    if 2 * margin >= w {
+        return 0.0;
+    }
+    let (mut tested, mut matched) = (0usize, 0usize);
+    for row in decoded.separation.chunks_exact(w) {
+        for s in &row[margin..w - margin] {
+            tested += 1;
+            matched += s.is_finite() as usize;
+        }
+    }
+    matched as f64 / tested.max(1) as f64
+}
+
 /// How well decoded separations agree with the intended ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoundTrip {
