@@ -5,6 +5,9 @@ mod chromadepth;
 mod finalize;
 #[cfg(feature = "gpu")]
 mod gpu;
+#[cfg(feature = "gpu")]
+mod gpu_oneshot;
+mod scaling;
 mod sirds;
 
 use std::fmt::Write as _;
@@ -52,18 +55,20 @@ pub struct BenchOptions {
     pub width: u32,
     /// Image height.
     pub height: u32,
-    /// Run only these groups (`stereo`, `raster`, `chromadepth`, `finalize`, `sirds`, `gpu`);
+    /// Run only these groups (`stereo`, `raster`, `chromadepth`, `finalize`, `sirds`, `scaling`,
+    /// `gpu`);
     /// empty: all.
     pub only: Vec<String>,
 }
 
 /// The benchmark groups, in the order they run.
-pub(crate) const GROUPS: [&str; 6] = [
+pub(crate) const GROUPS: [&str; 7] = [
     "stereo",
     "raster",
     "chromadepth",
     "finalize",
     "sirds",
+    "scaling",
     "gpu",
 ];
 
@@ -127,8 +132,12 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     if want("sirds") {
         rows.extend(sirds::rows(iters)?);
     }
+    if want("scaling") {
+        rows.extend(scaling::rows(&scene, iters)?);
+    }
     #[cfg(feature = "gpu")]
     if want("gpu") {
+        rows.extend(gpu_oneshot::rows(&scene, iters)?);
         rows.extend(gpu::rows(&scene, iters)?);
     }
     Ok(rows)

@@ -18,7 +18,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 15)]
     pub iterations: usize,
     /// Run only these groups, comma-separated: stereo, raster, chromadepth, finalize, sirds,
-    /// gpu (default: all).
+    /// scaling, gpu (default: all).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
 }

@@ -1,0 +1,244 @@
+//! The Blinn-Phong fragment stage eight pixels at a time: [`BlinnPhong::fragment`]'s
+//! arithmetic on AVX2 lanes, with the depth test LESS and the color and depth writes of
+//! [`traverse`](super::traverse) around it.
+//!
+//! Every lane performs the scalar code's IEEE operations in the same order: the plane
+//! evaluations `(a0 + dadx·fx) + dady·fy`, one division `1 / (1/w)` for perspective, the three
+//! `normalize_or_zero` of glam (`(x·x + y·y) + z·z`, `sqrt`, `1 / length`, kept only where
+//! that reciprocal is finite and positive), the dot products in the same order, the specular
+//! power by the same repeated squaring as [`powi`](crate::shade::powi), and the rounding of
+//! [`to_rgba8`](crate::shade::to_rgba8). No fused multiply-add: `sqrt`, `+`, `−`, `×` and `÷`
+//! are correctly rounded in both, so the bytes are the scalar stage's
+//! (`avx2_blinn_phong_matches_traverse`, the golden images and the scene hashes hold them).
+//! The scalar path stays the reference: it is what runs without AVX2 or with
+//! `STEREOLAB_SCALAR=1`.
+
+use std::arch::x86_64::*;
+
+use super::avx2::{clamp01, columns, covered_vectors, depth_at, load, plane_at, store};
+use super::{Band, Plane, SetupTriangle};
+use crate::shade::BlinnPhong;
+
+/// The uniforms of one Blinn-Phong program, splatted once per band.
+#[derive(Clone, Copy)]
+pub(crate) struct Uniforms {
+    /// The light position in the lighting eye's space.
+    light: [f32; 3],
+    /// The material color.
+    color: [f32; 3],
+    ambient: f32,
+    specular: f32,
+    /// The whole-number exponent (`None`: `powf` needed, no vector form here).
+    power: u32,
+}
+
+impl Uniforms {
+    /// The uniforms of `s`, when its specular power is the repeated-squaring case of
+    /// [`specular_power`](crate::shade::specular_power) (a whole exponent up to 1024); `None`
+    /// otherwise (the scalar stage then runs, with its `powf`).
+    pub(crate) fn of(s: &BlinnPhong) -> Option<Uniforms> {
+        let light = s.light();
+        let n = light.shininess;
+        let whole = (0.0..=1024.0).contains(&n) && (n as u32) as f32 == n;
+        whole.then(|| Uniforms {
+            light: s.light_eye().to_array(),
+            color: s.color().to_array(),
+            ambient: light.ambient,
+            specular: light.specular,
+            power: n as u32,
+        })
+    }
+}
+
+/// [`traverse`](super::traverse) of one triangle over `band` with the Blinn-Phong program `u`,
+/// depth test LESS with depth writes: the same color and depth bits, the same fragment count.
+///
+/// # Safety
+/// The CPU must support AVX2, FMA and POPCNT ([`super::avx2::available`]).
+#[target_feature(enable = "avx2,fma,popcnt")]
+pub(crate) unsafe fn shade_triangle(
+    t: &SetupTriangle,
+    u: &Uniforms,
+    band: &mut Band,
+    perspective_correct: bool,
+) -> usize {
+    let rows = (band.depth.len() / band.width.max(1) as usize) as u32;
+    let (x0, y0, w) = (band.x0, band.y0, band.width as usize);
+    let mut passed = 0;
+    covered_vectors(t, (x0, y0, band.width, rows), |y, x, mask| {
+        let i = (y - y0) as usize * w + (x - x0) as usize;
+        // SAFETY: this function runs only where AVX2 is available; `i` is the vector's first
+        // pixel in the tile, and `mask` covers only pixels inside it.
+        passed += unsafe {
+            shade_vector(
+                t,
+                u,
+                (x, y),
+                mask,
+                perspective_correct,
+                &mut band.depth[i..],
+                &mut band.color[i..],
+            )
+        };
+    });
+    passed
+}
+
+/// glam's `normalize_or_zero` per lane: `v · (1 / √((x·x + y·y) + z·z))` where that
+/// reciprocal is finite and positive, else zero.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn normalize_or_zero(v: [__m256; 3]) -> [__m256; 3] {
+    let len2 = _mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(v[0], v[0]), _mm256_mul_ps(v[1], v[1])),
+        _mm256_mul_ps(v[2], v[2]),
+    );
+    let rcp = _mm256_div_ps(_mm256_set1_ps(1.0), _mm256_sqrt_ps(len2));
+    let ok = _mm256_and_ps(
+        _mm256_cmp_ps::<_CMP_GT_OQ>(rcp, _mm256_setzero_ps()),
+        _mm256_cmp_ps::<_CMP_LT_OQ>(rcp, _mm256_set1_ps(f32::INFINITY)),
+    );
+    v.map(|c| _mm256_and_ps(_mm256_mul_ps(c, rcp), ok))
+}
+
+/// `a · b` in glam's order: `(ax·bx + ay·by) + az·bz`.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn dot(a: [__m256; 3], b: [__m256; 3]) -> __m256 {
+    _mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(a[0], b[0]), _mm256_mul_ps(a[1], b[1])),
+        _mm256_mul_ps(a[2], b[2]),
+    )
+}
+
+/// [`powi`](crate::shade::powi) per lane: the same multiplications in the same order.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn powi(mut x: __m256, mut n: u32) -> __m256 {
+    let mut r = _mm256_set1_ps(1.0);
+    loop {
+        if n & 1 != 0 {
+            r = _mm256_mul_ps(r, x);
+        }
+        n >>= 1;
+        if n == 0 {
+            return r;
+        }
+        x = _mm256_mul_ps(x, x);
+    }
+}
+
+/// [`to_rgba8`](crate::shade::to_rgba8)'s rounding of one channel per lane:
+/// `(clamp(c, 0, 1)·255 + ½)` truncated; NaN gives 0, as Rust's saturating `as u8`.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn channel(c: __m256) -> __m256i {
+    let q = _mm256_add_ps(
+        _mm256_mul_ps(clamp01(c), _mm256_set1_ps(255.0)),
+        _mm256_set1_ps(0.5),
+    );
+    // In 0.5 ..= 255.5, so the truncation lies in 0 ..= 255; NaN truncates to i32::MIN,
+    // whose low byte is 0.
+    _mm256_and_si256(_mm256_cvttps_epi32(q), _mm256_set1_epi32(0xff))
+}
+
+/// One vector of the stage: pixels `x .. x + 8` of row `y` where `mask` is set. Depth test
+/// LESS; where it passes, [`BlinnPhong::fragment`] per lane, then the color and depth writes.
+/// Returns how many passed.
+///
+/// # Safety
+/// The CPU must support AVX2; `depth` and `color` start at pixel `x` and hold the `mask`
+/// lanes (all eight when they are at least eight long).
+#[target_feature(enable = "avx2,fma,popcnt")]
+#[inline]
+unsafe fn shade_vector(
+    t: &SetupTriangle,
+    u: &Uniforms,
+    (x, y): (u32, u32),
+    mask: __m256i,
+    perspective_correct: bool,
+    depth: &mut [f32],
+    color: &mut [[u8; 4]],
+) -> usize {
+    let full = depth.len() >= 8 && color.len() >= 8;
+    let (xf, fx) = columns(t, x);
+    let z = depth_at(t, xf, y);
+    let dp = depth.as_mut_ptr();
+    // SAFETY: eight lanes fit when `full`; otherwise `mask` covers only pixels inside.
+    let d = unsafe { load(dp, mask, full) };
+    let pass = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
+    let bits = _mm256_movemask_ps(pass);
+    if bits == 0 {
+        return 0;
+    }
+    let fy = t.fy(y);
+    // Perspective correction: `a = (a/w) · w`, `w = 1 / (1/w)`; affine: `· 1`, which changes
+    // no bit.
+    let wv = if perspective_correct {
+        _mm256_div_ps(_mm256_set1_ps(1.0), plane_at(&t.inv_w_plane(), fx, fy))
+    } else {
+        _mm256_set1_ps(1.0)
+    };
+    let var = |k: usize| {
+        let p: Plane = t.varying_plane(k);
+        _mm256_mul_ps(plane_at(&p, fx, fy), wv)
+    };
+    let p = [var(0), var(1), var(2)];
+    let mut n = normalize_or_zero([var(3), var(4), var(5)]);
+    if !t.front_facing {
+        // Two-sided lighting: `-n` flips every sign bit, zeros included.
+        let sign = _mm256_set1_ps(-0.0);
+        n = n.map(|c| _mm256_xor_ps(c, sign));
+    }
+    let sign = _mm256_set1_ps(-0.0);
+    let l = normalize_or_zero(std::array::from_fn(|k| {
+        _mm256_sub_ps(_mm256_set1_ps(u.light[k]), p[k])
+    }));
+    let v = normalize_or_zero(p.map(|c| _mm256_xor_ps(c, sign)));
+    let h = normalize_or_zero(std::array::from_fn(|k| _mm256_add_ps(l[k], v[k])));
+    let zero = _mm256_setzero_ps();
+    // `f32::max(x, 0)`: 0 for NaN, as `maxps` returns its second operand then.
+    let diffuse = _mm256_max_ps(dot(n, l), zero);
+    let lit = _mm256_cmp_ps::<_CMP_GT_OQ>(diffuse, zero);
+    let spec = if _mm256_movemask_ps(lit) != 0 {
+        let s = _mm256_mul_ps(
+            powi(_mm256_max_ps(dot(n, h), zero), u.power),
+            _mm256_set1_ps(u.specular),
+        );
+        _mm256_and_ps(s, lit)
+    } else {
+        zero
+    };
+    // `color · (ambient + (1 − ambient)·diffuse) + spec`, per channel.
+    let k = _mm256_add_ps(
+        _mm256_set1_ps(u.ambient),
+        _mm256_mul_ps(_mm256_set1_ps(1.0 - u.ambient), diffuse),
+    );
+    let c: [__m256i; 3] = std::array::from_fn(|i| {
+        channel(_mm256_add_ps(
+            _mm256_mul_ps(_mm256_set1_ps(u.color[i]), k),
+            spec,
+        ))
+    });
+    // RGBA8 in memory order: r | g << 8 | b << 16 | 255 << 24 in a little-endian word.
+    let rgba = _mm256_or_si256(
+        _mm256_or_si256(c[0], _mm256_slli_epi32::<8>(c[1])),
+        _mm256_or_si256(
+            _mm256_slli_epi32::<16>(c[2]),
+            _mm256_set1_epi32(0xff00_0000_u32 as i32),
+        ),
+    );
+    let cp = color.as_mut_ptr().cast::<f32>();
+    // SAFETY: as for the depth above; a color is four bytes, one f32 lane, moved as bits.
+    unsafe {
+        store(dp, mask, full, _mm256_blendv_ps(d, z, pass));
+        let old = load(cp, mask, full);
+        store(
+            cp,
+            mask,
+            full,
+            _mm256_blendv_ps(old, _mm256_castsi256_ps(rgba), pass),
+        );
+    }
+    bits.count_ones() as usize
+}
