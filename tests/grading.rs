@@ -627,6 +627,25 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
             "{ex} reaches stereolab:\n{text}"
         );
     }
+    // The grader a student compiles is the command line only: no window, GPU path, C allocator
+    // or zip code in its dependency tree (they made a first `grade` take minutes).
+    let tree = Command::new(&cargo)
+        .current_dir(&handout)
+        .args(["tree", "--offline", "-e", "normal,build", "-p", "stereolab"])
+        .output()
+        .expect("run cargo tree");
+    let text = String::from_utf8_lossy(&tree.stdout);
+    assert!(
+        tree.status.success() && text.contains("clap v"),
+        "{text}{}",
+        String::from_utf8_lossy(&tree.stderr)
+    );
+    for heavy in ["eframe v", "wgpu v", "mimalloc v", "zip v", "cc v"] {
+        assert!(
+            !text.contains(heavy),
+            "the handout's grader builds {heavy}:\n{text}"
+        );
+    }
     // Everything the stubs and the handout's README cite is in the handout.
     for f in [
         "slides/01-perception.md",
@@ -660,7 +679,7 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
     let readme = std::fs::read_to_string(handout.join("README.md")).unwrap();
     for says in [
         "Only `src/stubs.rs` is\n  graded",
-        "minutes",
+        "compiles the grader",
         "How points are given",
         "println!",
     ] {

@@ -8,11 +8,7 @@
 //! `/autograder/results/results.json`. `AUTOGRADER_ROOT` moves `/autograder` (the tests run the
 //! scripts in a temporary folder). The solutions are not in the bundle.
 
-use std::io::Write as _;
 use std::path::Path;
-
-use zip::write::SimpleFileOptions;
-use zip::{CompressionMethod, DateTime, ZipWriter};
 
 use super::Exercise;
 use crate::error::{Error, Result};
@@ -94,7 +90,9 @@ if [ -n "${STEREOLAB_BIN:-}" ]; then
     cp "$STEREOLAB_BIN" "$SRC/bin/stereolab"
 else
     export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$SRC/target}"
-    cargo build --release --manifest-path "$SRC/stereolab/Cargo.toml" --bin stereolab
+    # The command alone: no viewer, allocator or zip code (what a student's handout builds too).
+    cargo build --release --no-default-features --features cli \
+        --manifest-path "$SRC/stereolab/Cargo.toml" --bin stereolab
     cp "$CARGO_TARGET_DIR/release/stereolab" "$SRC/bin/stereolab"
 fi
 # Warm-up: grading the untouched stubs compiles glam, serde and exercise-api into the build
@@ -232,11 +230,32 @@ fn files(root: &Path, seed: Option<u64>) -> Result<Files> {
 ///
 /// # Errors
 /// Unreadable sources or an unwritable `out`.
+/// An instructor's command: without the `bundle` feature (the student handout's build) it says
+/// how to get one instead of pulling the zip crate into every build.
 pub fn bundle(root: &Path, out: &Path, seed: Option<u64>) -> Result<()> {
     let files = files(root, seed)?;
+    write_zip(&files, out)
+}
+
+#[cfg(not(feature = "bundle"))]
+fn write_zip(_files: &Files, out: &Path) -> Result<()> {
+    Err(Error::invalid(
+        "grade bundle --out",
+        out.display(),
+        "this stereolab was built without the `bundle` feature (the student handout's build): \
+         build the grader with `cargo build --release --features bundle`",
+    ))
+}
+
+#[cfg(feature = "bundle")]
+fn write_zip(files: &Files, out: &Path) -> Result<()> {
+    use std::io::Write as _;
+    use zip::write::SimpleFileOptions;
+    use zip::{CompressionMethod, DateTime, ZipWriter};
+
     let mut zip = ZipWriter::new(std::io::Cursor::new(Vec::new()));
     let zerr = |e: zip::result::ZipError| Error::io(out, std::io::Error::other(e));
-    for (name, bytes, exec) in &files {
+    for (name, bytes, exec) in files {
         let options = SimpleFileOptions::default()
             .compression_method(CompressionMethod::Deflated)
             .last_modified_time(DateTime::default())
