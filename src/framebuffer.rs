@@ -70,7 +70,10 @@ impl Framebuffer {
     /// shifted viewport does not cover.
     pub fn clear_outside_columns(&mut self, keep: std::ops::Range<u32>, clear_color: [u8; 4]) {
         let w = self.width as usize;
-        let (x0, x1) = (keep.start.min(self.width) as usize, keep.end.min(self.width) as usize);
+        let (x0, x1) = (
+            keep.start.min(self.width) as usize,
+            keep.end.min(self.width) as usize,
+        );
         for (color, depth) in self.color.chunks_mut(w).zip(self.depth.chunks_mut(w)) {
             for x in (0..x0).chain(x1.max(x0)..w) {
                 color[x] = clear_color;

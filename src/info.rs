@@ -30,7 +30,9 @@ pub struct ParallaxRange {
 /// # Errors
 /// Invalid camera or rig.
 pub fn parallax_range(scene: &Scene) -> Result<ParallaxRange> {
-    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
+    let eyes = scene
+        .rig
+        .eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let mut r = ParallaxRange {
         min_percent: f32::INFINITY,
         max_percent: f32::NEG_INFINITY,
@@ -62,7 +64,9 @@ pub fn parallax_range(scene: &Scene) -> Result<ParallaxRange> {
 pub fn describe(scene: &Scene) -> Result<String> {
     let mut s = String::new();
     let resolved = scene.rig.resolve(&scene.camera, scene.aspect())?;
-    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
+    let eyes = scene
+        .rig
+        .eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let center = StereoRig::center(&scene.camera, scene.aspect())?;
     let _ = writeln!(
         s,
@@ -226,7 +230,9 @@ pub fn budget_remedies(
 /// # Errors
 /// Invalid camera or rig, or an image size refused by [`crate::Framebuffer::new`].
 pub fn scene_budget(scene: &Scene) -> Result<ParallaxBudget> {
-    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
+    let eyes = scene
+        .rig
+        .eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let (fb, _) = render_view(scene, &eyes[0], Shading::DepthOnly)?;
     budget_of(&fb, &scene.parallax_rig()?)
 }

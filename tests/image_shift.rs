@@ -41,13 +41,13 @@ specular = 0.0
 [[mesh]]
 kind = "plane"
 size = 100.0
-detail = 2
+detail = 4
 translate = [0.0, 0.0, -10.0]
 color = [0.5, 0.5, 0.5]
 [[mesh]]
 kind = "plane"
 size = 2.5
-detail = 1
+detail = 3
 rotate = [0.0, 0.0, 30.0]
 color = [1.0, 0.0, 0.0]
 "#,
@@ -188,7 +188,10 @@ fn each_eye_is_the_parallel_eye_moved_by_its_shift() {
     let p = test_scene("parallel");
     let (fs, fp) = (eyes(&s), eyes(&p));
     let sh = shift(&s);
-    for (view, k) in [(View::Left, -(sh.left as i64)), (View::Right, sh.right as i64)] {
+    for (view, k) in [
+        (View::Left, -(sh.left as i64)),
+        (View::Right, sh.right as i64),
+    ] {
         let (a, b) = (eye(&fs, view), eye(&fp, view));
         let (mut same, mut compared) = (0usize, 0usize);
         for y in 0..a.height {

@@ -69,7 +69,10 @@ fn toe_in_has_vertical_parallax_and_off_axis_none() {
 #[test]
 fn the_comparison_passes_are_the_scene_rig_in_each_mode() {
     for (mode, same) in [("off-axis", View::ShearLeft), ("toe-in", View::RotateLeft)] {
-        let mut s = load("wuson_shear_vs_rotate", &[&format!("stereo.mode=\"{mode}\"")]);
+        let mut s = load(
+            "wuson_shear_vs_rotate",
+            &[&format!("stereo.mode=\"{mode}\"")],
+        );
         s.set_size(160, 120).expect("size");
         let f = render(&s, &Plan::new(&[Output::Left, Output::ShearVsRotate])).expect("renders");
         assert_eq!(
@@ -90,7 +93,11 @@ fn viewer_at_the_left_eye_puts_the_left_eye_at_the_camera() {
     let s = load("wuson_viewer_left_eye", &[]);
     assert_eq!(s.rig.viewer, Viewer::LeftEye);
     let cam = Vec3::from(s.camera.eye);
-    let d = s.rig.resolve(&s.camera, s.aspect()).expect("rig").eye_separation;
+    let d = s
+        .rig
+        .resolve(&s.camera, s.aspect())
+        .expect("rig")
+        .eye_separation;
     assert!(d > 0.1);
     for mode in [
         CameraMode::OffAxis,
@@ -132,7 +139,11 @@ fn viewer_at_the_left_eye_puts_the_left_eye_at_the_camera() {
     let e = toe
         .eyes_for_image(&s.camera, s.width, s.height)
         .expect("eyes");
-    let z0 = s.rig.resolve(&s.camera, s.aspect()).expect("rig").zero_parallax_distance;
+    let z0 = s
+        .rig
+        .resolve(&s.camera, s.aspect())
+        .expect("rig")
+        .zero_parallax_distance;
     let dir = (Vec3::from(s.camera.target) - cam).normalize();
     let fusion = cam + 0.5 * d * right_axis(&s) + z0 * dir;
     for m in e {

@@ -181,7 +181,9 @@ fn ramp_sampling(iters: usize) -> Vec<Row> {
 /// The ChromaDepth pass against the left + right color passes of the same scene, each pass run
 /// on one thread: the CPU work a frame costs.
 fn pass_vs_pair(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
-    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
+    let eyes = scene
+        .rig
+        .eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let center = StereoRig::center(&scene.camera, scene.aspect())?;
     let mut err: Option<Error> = None;
     let mut run = |f: &mut dyn FnMut() -> Result<()>| {

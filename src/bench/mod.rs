@@ -195,7 +195,9 @@ fn stereo_pair(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
 
 /// Coverage differences of 4 and 8 subpixel bits against 16 on the real model's left eye.
 fn subpixel_bits(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
-    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
+    let eyes = scene
+        .rig
+        .eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let coverage = |bits: u32| -> Result<Vec<bool>> {
         let mut s = scene.clone();
         s.raster.subpixel_bits = bits;

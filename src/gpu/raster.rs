@@ -116,7 +116,12 @@ impl GpuRenderer {
         let passes: Vec<(EyeMatrices, Shading)> = plan
             .passes
             .iter()
-            .map(|p| Ok((Frame::lookup(&eyes, &center, &shear_rotate, p.view)?, p.shading)))
+            .map(|p| {
+                Ok((
+                    Frame::lookup(&eyes, &center, &shear_rotate, p.view)?,
+                    p.shading,
+                ))
+            })
             .collect::<Result<_>>()?;
         let framebuffers = self.render_views(scene, &passes)?;
         let time = start.elapsed();

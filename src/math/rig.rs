@@ -440,8 +440,8 @@ impl StereoRig {
         camera.validate()?;
         let r = self.resolve(camera, width as f32 / height as f32)?;
         // b·d·W/Xrange: both eyes' shifts on the zero-parallax plane, in pixels.
-        let exact = self.user_balance as f64 * r.eye_separation as f64 * width as f64
-            / r.xrange as f64;
+        let exact =
+            self.user_balance as f64 * r.eye_separation as f64 * width as f64 / r.xrange as f64;
         let total = exact.round();
         if !(total.is_finite() && total < width as f64) {
             return Err(Error::invalid(

@@ -91,7 +91,10 @@ fn mvp(frame: &Frame, view: View) -> Result<glam::Mat4> {
 /// # Errors
 /// A missing pass (a plan bug) or a singular eye matrix.
 pub fn shear_vs_rotate(frame: &Frame) -> Result<(RgbaImage, ShearVsRotate)> {
-    let shear = [pass(frame, View::ShearLeft)?, pass(frame, View::ShearRight)?];
+    let shear = [
+        pass(frame, View::ShearLeft)?,
+        pass(frame, View::ShearRight)?,
+    ];
     let rotate = [
         pass(frame, View::RotateLeft)?,
         pass(frame, View::RotateRight)?,
@@ -119,8 +122,14 @@ pub fn shear_vs_rotate(frame: &Frame) -> Result<(RgbaImage, ShearVsRotate)> {
     let caption_h = (h / 12).clamp(14, 40);
     let size = caption_h as f32 * 0.6;
     let panels = [
-        (shear[0].to_rgba_image(), "off-axis (shear), left eye".to_string()),
-        (rotate[0].to_rgba_image(), "toe-in (rotate), left eye".to_string()),
+        (
+            shear[0].to_rgba_image(),
+            "off-axis (shear), left eye".to_string(),
+        ),
+        (
+            rotate[0].to_rgba_image(),
+            "toe-in (rotate), left eye".to_string(),
+        ),
         (
             vertical_parallax_image(&rotate_map, w, h),
             format!(

@@ -103,7 +103,10 @@ pub fn shear_rotate_eyes(scene: &Scene) -> Result<[[EyeMatrices; 2]; 2]> {
 ///
 /// # Errors
 /// As [`shear_rotate_eyes`].
-pub fn planned_shear_rotate_eyes(scene: &Scene, plan: &Plan) -> Result<Option<[[EyeMatrices; 2]; 2]>> {
+pub fn planned_shear_rotate_eyes(
+    scene: &Scene,
+    plan: &Plan,
+) -> Result<Option<[[EyeMatrices; 2]; 2]>> {
     let needed = plan.passes.iter().any(|p| {
         matches!(
             p.view,
@@ -130,7 +133,9 @@ impl Frame {
             View::RotateLeft => compare.map(|m| m[1][0]),
             View::RotateRight => compare.map(|m| m[1][1]),
         };
-        m.ok_or_else(|| crate::Error::internal("plan", format!("no matrices for the {view:?} pass")))
+        m.ok_or_else(|| {
+            crate::Error::internal("plan", format!("no matrices for the {view:?} pass"))
+        })
     }
 }
 
@@ -140,7 +145,9 @@ impl Frame {
 /// # Errors
 /// Invalid camera or rig, or an image size refused by [`Framebuffer::new`].
 pub fn render(scene: &Scene, plan: &Plan) -> Result<Frame> {
-    let eyes = scene.rig.eyes_for_image(&scene.camera, scene.width, scene.height)?;
+    let eyes = scene
+        .rig
+        .eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let center = StereoRig::center(&scene.camera, scene.aspect())?;
     let shear_rotate = planned_shear_rotate_eyes(scene, plan)?;
     let passes = plan
