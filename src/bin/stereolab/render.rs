@@ -144,6 +144,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(report) = info::frame_budget_report(&frame, &s)? {
         out!("{report}");
     }
+    for line in output::report::effect_lines(&frame, &s)? {
+        outln!("  {line}");
+    }
     for p in paths {
         outln!("  wrote {}", p.display());
     }
