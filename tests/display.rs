@@ -290,8 +290,8 @@ fn calibration_arrows_sit_on_the_middle_row_of_each_view() {
     }
     // Each arrow's rows are symmetric about its centre line, and its tip meets the centre.
     for (top, bottom, cy, tip_col, tail_col) in [
-        (0u32, 364u32, 182u32, 511u32, 300u32),
-        (404, 768, 586, 512, 700),
+        (0u32, 364u32, 182u32, 505u32, 300u32),
+        (404, 768, 586, 518, 700),
     ] {
         let rows: Vec<u32> = (top..bottom)
             .filter(|&y| (0..1024).any(|x| img.get_pixel(x, y).0 == ARROW_COLOR))
@@ -309,14 +309,13 @@ fn calibration_arrows_sit_on_the_middle_row_of_each_view() {
     assert_ne!(img.get_pixel(513, 182).0, ARROW_COLOR);
     assert_ne!(img.get_pixel(510, 586).0, ARROW_COLOR);
     // Another blank interval moves the bottom arrow by the difference.
+    // (30 rows: views of 369 rows, the bottom one from row 399, its arrow on row 583).
     let other = calibration_screen(1024, 768, 30).unwrap();
-    assert_eq!(other.get_pixel(700, 586 - 5).0, ARROW_COLOR);
-    assert_eq!(
-        CalibrationLayout::new(1024, 768, 30)
-            .unwrap()
-            .bottom_arrow_y,
-        581
-    );
+    let moved = CalibrationLayout::new(1024, 768, 30).unwrap();
+    assert_eq!(moved.bottom_arrow_y, 583);
+    assert_eq!(other.get_pixel(700, 583).0, ARROW_COLOR);
+    assert_eq!(other.get_pixel(700, 573).0, ARROW_COLOR);
+    assert_eq!(img.get_pixel(700, 573).0, VIEW_COLOR);
 }
 
 #[test]
