@@ -29,6 +29,43 @@ pub const LEFT: usize = 0;
 /// Index of the right eye in an eye pair.
 pub const RIGHT: usize = 1;
 
+/// The stereo draw buffers of a quad-buffered OpenGL context, by the names the SGI course notes
+/// (`glDrawBuffer(GL_BACK_LEFT)` … `glDrawBuffer(GL_BACK_RIGHT)`, §4.1.2) and the StereoGraphics
+/// guide (§3–4: "you can specify your drawing buffer as GL_BACK_LEFT or GL_BACK_RIGHT, which will
+/// result in subsequent OpenGL drawings and renderings appearing only in one eye's drawing
+/// buffer") use. stereolab's eye framebuffers are these two buffers: `Frame::draw_buffer` in
+/// `render` returns them by these names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DrawBuffer {
+    /// `GL_BACK_LEFT`: the left eye's back buffer (eye index [`LEFT`]).
+    BackLeft,
+    /// `GL_BACK_RIGHT`: the right eye's back buffer (eye index [`RIGHT`]).
+    BackRight,
+}
+
+/// `GL_BACK_LEFT`, the left eye's back buffer.
+pub const BACK_LEFT: DrawBuffer = DrawBuffer::BackLeft;
+/// `GL_BACK_RIGHT`, the right eye's back buffer.
+pub const BACK_RIGHT: DrawBuffer = DrawBuffer::BackRight;
+
+impl DrawBuffer {
+    /// The eye index of the buffer: [`LEFT`] (0) or [`RIGHT`] (1).
+    pub fn eye(self) -> usize {
+        match self {
+            DrawBuffer::BackLeft => LEFT,
+            DrawBuffer::BackRight => RIGHT,
+        }
+    }
+
+    /// The OpenGL name, as the documents write it.
+    pub fn gl_name(self) -> &'static str {
+        match self {
+            DrawBuffer::BackLeft => "GL_BACK_LEFT",
+            DrawBuffer::BackRight => "GL_BACK_RIGHT",
+        }
+    }
+}
+
 /// The two eye framebuffers, index 0 left and 1 right as in the exercise slides.
 pub type EyePair = [Framebuffer; 2];
 

@@ -68,6 +68,24 @@ pub enum Output {
     /// off-axis (shear) and toe-in (rotate) rigs, toe-in's vertical parallax per pixel, and the
     /// difference of the two rigs' left images.
     ShearVsRotate,
+    /// Julesz's random-dot stereo pair, left eye: a seeded random-dot texture, no shape in it.
+    RdsLeft,
+    /// The right eye's view of the left eye's dots through the remap: the scene's depth as
+    /// parallax only.
+    RdsRight,
+    /// Both random-dot images as a gray red–cyan anaglyph.
+    RdsAnaglyph,
+    /// Both eyes as an animated PNG alternating left, right, … at the scene's rate: the
+    /// quad-buffered (`BACK_LEFT` / `BACK_RIGHT`) shutter-glasses display, emulated.
+    FrameSequential,
+    /// The left eye with a share of the right eye leaking in per channel (crosstalk, the
+    /// StereoGraphics guide's ghosting).
+    GhostingLeft,
+    /// The right eye with a share of the left eye leaking in.
+    GhostingRight,
+    /// The StereoGraphics guide's above-below calibration screen: two arrows that line up when
+    /// `layout.blank_interval` matches the display's blank interval. Needs no pass.
+    AboveBelowCalibration,
 }
 
 /// Which camera a pass renders from.
@@ -147,6 +165,13 @@ impl Output {
         Output::Jps,
         Output::Pns,
         Output::ShearVsRotate,
+        Output::RdsLeft,
+        Output::RdsRight,
+        Output::RdsAnaglyph,
+        Output::FrameSequential,
+        Output::GhostingLeft,
+        Output::GhostingRight,
+        Output::AboveBelowCalibration,
     ];
 
     /// The name used in scene files and for the PNG written.
@@ -179,6 +204,13 @@ impl Output {
             Output::Jps => "jps",
             Output::Pns => "pns",
             Output::ShearVsRotate => "shear_vs_rotate",
+            Output::RdsLeft => "rds_left",
+            Output::RdsRight => "rds_right",
+            Output::RdsAnaglyph => "rds_anaglyph",
+            Output::FrameSequential => "frame_sequential",
+            Output::GhostingLeft => "ghosting_left",
+            Output::GhostingRight => "ghosting_right",
+            Output::AboveBelowCalibration => "above_below_calibration",
         }
     }
 
@@ -252,6 +284,14 @@ impl Output {
                 color(View::RotateLeft),
                 color(View::RotateRight),
             ],
+            // The left eye's dots are the texture itself, whatever the scene holds.
+            Output::RdsLeft => vec![],
+            // The dots are painted, not shaded: the remap needs both eyes' depths only.
+            Output::RdsRight | Output::RdsAnaglyph => {
+                vec![depth(View::Left), depth(View::Right)]
+            }
+            // A test pattern of the layout alone: no pass at all.
+            Output::AboveBelowCalibration => vec![],
             _ => vec![color(View::Left), color(View::Right)],
         }
     }

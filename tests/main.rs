@@ -7,6 +7,7 @@ mod common;
 mod conformance;
 mod coverage;
 mod determinism;
+mod display;
 mod figures;
 mod finalize;
 mod fuzz;

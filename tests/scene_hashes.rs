@@ -46,6 +46,22 @@ fn image_hash(img: &Image) -> (u32, u32, u64) {
                 seed,
             ),
         ),
+        // The pixels of every field in order, then each field's delay.
+        Image::Sequence(s) => (
+            s.left.width(),
+            s.left.height(),
+            fnv1a(
+                s.fields.iter().flat_map(|f| {
+                    let delay = [f.delay_num.to_le_bytes(), f.delay_den.to_le_bytes()];
+                    s.image(f)
+                        .as_raw()
+                        .iter()
+                        .copied()
+                        .chain(delay.into_iter().flatten())
+                }),
+                seed,
+            ),
+        ),
     }
 }
 

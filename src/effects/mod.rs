@@ -4,12 +4,16 @@
 //! SIRDS pieces (pattern, disparity, TIW linking, depth maps, decoding).
 
 pub mod anaglyph;
+pub mod calibration;
 pub mod chromadepth;
 pub(crate) mod eye_input;
+pub mod frame_sequential;
+pub mod ghosting;
 pub mod layout;
 pub mod legend;
 pub mod occlusion;
 pub mod parallax;
+pub mod rds;
 pub mod remap;
 pub mod shear_rotate;
 pub mod sirds;

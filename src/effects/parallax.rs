@@ -234,9 +234,52 @@ pub fn color_scale(b: &ParallaxBudget) -> f64 {
     b.min_pixels.abs().max(b.max_pixels.abs()).max(0.5)
 }
 
+/// The color that marks a window violation on the parallax image: yellow, on no point of the
+/// blue–white–red scale.
+pub const VIOLATION_COLOR: [u8; 4] = [255, 220, 0, 255];
+
+/// How far into the image a window violation's mark reaches: `max(2, W/64)` pixels.
+pub fn violation_band(width: u32) -> u32 {
+    (width / 64).max(2)
+}
+
+/// The pixels (row-major indices) that mark the StereoGraphics guide's window violations on the
+/// parallax image: where a border pixel shows negative parallax (an object in front of the
+/// screen cut by the window's edge, the count [`ParallaxBudget::window_violations`] reports),
+/// a band [`violation_band`] pixels deep runs from that border pixel into the image, across
+/// the border (along its row at the left and right edges, its column at the top and bottom).
+/// Sorted and without repeats; empty when nothing violates the window.
+pub fn window_violation_marks(map: &[Option<f64>], width: u32, height: u32) -> Vec<usize> {
+    let (w, h) = (width as usize, height as usize);
+    if w == 0 || h == 0 {
+        return Vec::new();
+    }
+    let negative = |x: usize, y: usize| map[y * w + x].is_some_and(|p| p < 0.0);
+    let band = (violation_band(width) as usize).min(w).min(h);
+    let mut marks = Vec::new();
+    for y in 0..h {
+        for (x, step) in [(0usize, 1isize), (w - 1, -1)] {
+            if negative(x, y) {
+                marks.extend((0..band).map(|k| y * w + (x as isize + step * k as isize) as usize));
+            }
+        }
+    }
+    for x in 0..w {
+        for (y, step) in [(0usize, 1isize), (h - 1, -1)] {
+            if negative(x, y) {
+                marks.extend((0..band).map(|k| (y as isize + step * k as isize) as usize * w + x));
+            }
+        }
+    }
+    marks.sort_unstable();
+    marks.dedup();
+    marks
+}
+
 /// The parallax of one eye's depth buffer as color, with a legend bar (drawn with tiny-skia)
 /// appended below the image: the color scale from −S to +S pixels, ticks at 0 and at seed
-/// 003's ±3% budget, labels in pixels and percent of the width.
+/// 003's ±3% budget, labels in pixels and percent of the width. Window violations are marked
+/// in [`VIOLATION_COLOR`] ([`window_violation_marks`]).
 ///
 /// # Errors
 /// As [`parallax_map`].
@@ -249,6 +292,9 @@ pub fn parallax_image(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> 
         .iter()
         .flat_map(|p| p.map_or(PARALLAX_BACKGROUND, |p| parallax_color(p, scale)))
         .collect();
+    for i in window_violation_marks(&map, fb.width, fb.height) {
+        bytes[4 * i..4 * i + 4].copy_from_slice(&VIOLATION_COLOR);
+    }
     bytes.extend_from_slice(legend.data());
     let h = fb.height + legend.height();
     Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))

@@ -226,6 +226,16 @@ pub fn produce_wgsl(
                 crate::effects::parallax::parallax_color(p, scale)
             })?;
             let mut bytes = area.into_raw();
+            // The window violations, marked on the host from the GPU's own values.
+            let map: Vec<Option<f64>> = values
+                .iter()
+                .map(|v| (!v.is_nan()).then_some(f64::from(*v)))
+                .collect();
+            let marks =
+                crate::effects::parallax::window_violation_marks(&map, left.width, left.height);
+            for i in marks {
+                bytes[4 * i..4 * i + 4].copy_from_slice(&crate::effects::parallax::VIOLATION_COLOR);
+            }
             bytes.extend_from_slice(legend.data());
             RgbaImage::from_raw(left.width, left.height + legend.height(), bytes)
                 .ok_or_else(|| Error::internal("parallax", "image and legend size mismatch"))?

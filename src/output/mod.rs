@@ -3,6 +3,8 @@
 pub mod animate;
 pub mod chromadepth;
 pub mod shear_rotate;
+pub mod frame_sequential;
+pub mod report;
 pub mod sirds;
 pub mod stereo_photo;
 
@@ -10,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use crate::effects::parallax::parallax_image;
 use crate::effects::remap::{Precision, remap_color};
-use crate::effects::{anaglyph, layout, occlusion};
+use crate::effects::{anaglyph, calibration, ghosting, layout, occlusion, rds};
 use crate::error::{Error, Result};
 use crate::files;
 use crate::framebuffer::Framebuffer;
@@ -27,6 +29,8 @@ pub enum Image {
     Gray16(image::ImageBuffer<image::Luma<u16>, Vec<u16>>),
     /// Both eyes in a stereo photo format (MPO, JPS, PNS), encoded when saved.
     Stereo(stereo_photo::StereoPhoto),
+    /// Both eyes alternating in time (`frame_sequential`), an animated PNG when saved.
+    Sequence(frame_sequential::FrameSequence),
 }
 
 impl Image {
@@ -40,6 +44,7 @@ impl Image {
             Image::Rgba(i) => files::write_png(path, i),
             Image::Gray16(i) => files::write_png(path, i),
             Image::Stereo(photo) => files::write_bytes(path, &photo.encode()?),
+            Image::Sequence(seq) => files::write_bytes(path, &seq.encode()?),
         }
     }
 
@@ -59,6 +64,15 @@ impl Image {
                 image::imageops::replace(&mut out, &p.left, i64::from(w), 0);
                 out
             }
+            // The fields side by side in display order (L | R | …), as a film strip.
+            Image::Sequence(s) => {
+                let w = s.left.width();
+                let mut out = image::RgbaImage::new(w * s.fields.len() as u32, s.left.height());
+                for (i, f) in s.fields.iter().enumerate() {
+                    image::imageops::replace(&mut out, s.image(f), i64::from(w) * i as i64, 0);
+                }
+                out
+            }
         }
     }
 
@@ -68,6 +82,7 @@ impl Image {
             Image::Rgba(i) => i.dimensions(),
             Image::Gray16(i) => i.dimensions(),
             Image::Stereo(p) => (2 * p.left.width(), p.left.height()),
+            Image::Sequence(s) => (s.left.width() * s.fields.len() as u32, s.left.height()),
         }
     }
 }
@@ -154,6 +169,37 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             Precision::default(),
         )?),
         Output::Parallax => Image::Rgba(parallax_image(eye(View::Left)?, &scene.parallax_rig()?)?),
+        Output::RdsLeft => Image::Rgba(rds::rds_left(scene.width, scene.height, &scene.rds)),
+        Output::RdsRight => Image::Rgba(rds_right(frame, scene, output)?),
+        Output::RdsAnaglyph => {
+            let left = rds::as_framebuffer(&rds::rds_left(scene.width, scene.height, &scene.rds));
+            let right = rds::as_framebuffer(&rds_right(frame, scene, output)?);
+            Image::Rgba(anaglyph::anaglyph(
+                &left,
+                &right,
+                anaglyph::AnaglyphKind::Gray,
+                scene.finalize,
+            )?)
+        }
+        Output::FrameSequential => Image::Sequence(frame_sequential::FrameSequence::from_frame(
+            frame,
+            &scene.frame_sequential,
+        )?),
+        Output::GhostingLeft => Image::Rgba(ghosting::ghosted(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            &scene.ghosting,
+        )?),
+        Output::GhostingRight => Image::Rgba(ghosting::ghosted(
+            eye(View::Right)?,
+            eye(View::Left)?,
+            &scene.ghosting,
+        )?),
+        Output::AboveBelowCalibration => Image::Rgba(calibration::calibration_screen(
+            scene.width,
+            scene.height,
+            scene.blank_interval,
+        )?),
         Output::Sirds => Image::Rgba(sirds::from_frame(frame, scene)?.to_rgba_image()),
         Output::SirdsDepth => Image::Gray16(sirds::scene_depth(frame, scene)?.0.to_image()),
         Output::ShearVsRotate => Image::Rgba(shear_rotate::shear_vs_rotate(frame)?.0),
@@ -172,6 +218,17 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             })
         }
     })
+}
+
+/// The right image of the random-dot pair from the frame's two depth passes.
+fn rds_right(frame: &Frame, scene: &Scene, output: Output) -> Result<image::RgbaImage> {
+    rds::rds_right(
+        need(frame, View::Left, output)?,
+        need(frame, View::Right, output)?,
+        &frame.eyes[0].mvp,
+        &frame.eyes[1].mvp,
+        &scene.rds,
+    )
 }
 
 /// The MPO's baseline and convergence from the scene's rig: the resolved eye separation, and

@@ -58,6 +58,15 @@ impl Frame {
             .map(|p| &p.framebuffer)
     }
 
+    /// The eye framebuffer behind an OpenGL stereo draw buffer (`BACK_LEFT` is the left eye's,
+    /// `BACK_RIGHT` the right eye's), if the plan rendered that eye.
+    pub fn draw_buffer(&self, buffer: crate::framebuffer::DrawBuffer) -> Option<&Framebuffer> {
+        self.view(match buffer {
+            crate::framebuffer::DrawBuffer::BackLeft => View::Left,
+            crate::framebuffer::DrawBuffer::BackRight => View::Right,
+        })
+    }
+
     /// The matrices of `view`; `None` for a shear/rotate view the plan did not run.
     pub fn try_matrices(&self, view: View) -> Option<&EyeMatrices> {
         let compare = |rig: usize, eye: usize| self.shear_rotate.as_ref().map(|m| &m[rig][eye]);

@@ -34,6 +34,15 @@ pub(crate) struct SceneFile {
     /// Autostereogram options.
     #[serde(default)]
     pub sirds: crate::effects::sirds::SirdsSpec,
+    /// Random-dot stereo pair options (`rds_left`, `rds_right`, `rds_anaglyph`).
+    #[serde(default)]
+    pub rds: crate::effects::rds::RdsSettings,
+    /// Crosstalk options (`ghosting_left`, `ghosting_right`).
+    #[serde(default)]
+    pub ghosting: crate::effects::ghosting::GhostingSettings,
+    /// Frame-sequential animation options (`frame_sequential`).
+    #[serde(default)]
+    pub frame_sequential: crate::effects::frame_sequential::FrameSequentialSettings,
     /// Objects, in `[[mesh]]` tables.
     #[serde(default, rename = "mesh")]
     pub meshes: Vec<MeshSpec>,

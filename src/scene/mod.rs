@@ -72,6 +72,12 @@ pub struct Scene {
     pub finalize: AnaglyphOptions,
     /// Autostereogram options (`[sirds]`).
     pub sirds: crate::effects::sirds::Settings,
+    /// Random-dot stereo pair options (`[rds]`).
+    pub rds: crate::effects::rds::RdsSettings,
+    /// Crosstalk options (`[ghosting]`).
+    pub ghosting: crate::effects::ghosting::GhostingSettings,
+    /// Frame-sequential options (`[frame_sequential]`).
+    pub frame_sequential: crate::effects::frame_sequential::FrameSequentialSettings,
     /// What loading read in an unusual way and accepted, each naming its file and line (an
     /// OBJ coordinate such as `3.1+e2`, read as assimp reads it); `stereolab render` prints
     /// them.
@@ -254,6 +260,9 @@ impl Scene {
             ));
         }
         f.chromadepth.validate()?;
+        f.rds.validate()?;
+        f.ghosting.validate()?;
+        f.frame_sequential.validate()?;
         let mut notes = Vec::new();
         let objects = f
             .meshes
@@ -302,6 +311,9 @@ impl Scene {
                 swap_eyes: f.finalize.swap_eyes,
             },
             sirds,
+            rds: f.rds,
+            ghosting: f.ghosting,
+            frame_sequential: f.frame_sequential,
             notes,
         };
         let warnings = checks::precision_warnings(&scene)?;

@@ -544,6 +544,7 @@ mod tests {
             Image::Rgba(i) => i.as_raw().clone(),
             Image::Gray16(i) => i.as_raw().iter().flat_map(|v| v.to_le_bytes()).collect(),
             Image::Stereo(p) => [p.left.as_raw().as_slice(), p.right.as_raw()].concat(),
+            Image::Sequence(_) => i.to_display_rgba().into_raw(),
         }
     }
 

@@ -147,6 +147,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(report) = stereolab::output::shear_rotate::report(&frame)? {
         out!("{report}");
     }
+    for line in output::report::effect_lines(&frame, &s)? {
+        outln!("  {line}");
+    }
     for p in paths {
         outln!("  wrote {}", p.display());
     }
