@@ -45,7 +45,10 @@ pub const RATIOS: [f64; 12] = [
 pub fn scene() -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
-    for (k, z) in [2.0f32, 5.0, 10.0, 20.0, 50.0, 90.0].into_iter().enumerate() {
+    for (k, z) in [2.0f32, 5.0, 10.0, 20.0, 50.0, 90.0]
+        .into_iter()
+        .enumerate()
+    {
         // Column k of six across the view (the frustum below is ±1 wide at depth 1).
         let x0 = -1.0 + k as f32 / 3.0 + 0.02;
         for (scale, gap) in [(1.0f32, 0.0f32), (0.6, 1e-4)] {

@@ -76,10 +76,7 @@ pub fn eye(
     let half = 0.5 * separation;
     let t = DMat4::from_translation(DVec3::new(-side * half, 0.0, 0.0));
     let (view, shift) = match rig.mode {
-        CameraMode::OffAxis => (
-            t * mv,
-            -side * half * f64::from(rig.user_balance) * n / z0,
-        ),
+        CameraMode::OffAxis => (t * mv, -side * half * f64::from(rig.user_balance) * n / z0),
         CameraMode::Parallel => (t * mv, 0.0),
         CameraMode::ToeIn => {
             let inv = mv.inverse();
@@ -179,7 +176,8 @@ pub fn visible(
             .collect();
         for j in 1..win.len().saturating_sub(1) {
             let t = [win[0], win[j], win[j + 1]];
-            let area = (t[1].0 - t[0].0) * (t[2].1 - t[0].1) - (t[2].0 - t[0].0) * (t[1].1 - t[0].1);
+            let area =
+                (t[1].0 - t[0].0) * (t[2].1 - t[0].1) - (t[2].0 - t[0].0) * (t[1].1 - t[0].1);
             if area == 0.0 || !area.is_finite() {
                 continue;
             }

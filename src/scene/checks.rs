@@ -16,11 +16,11 @@
 use glam::DVec3;
 
 use super::{Object, Scene, file::LightSpec, file::RasterSpec};
-use crate::raster::DepthMode;
 use crate::effects::sirds::settings::{Algorithm, Settings};
 use crate::error::{Error, Result};
 use crate::math::Camera;
 use crate::plan::Output;
+use crate::raster::DepthMode;
 
 /// Warn when two surfaces must be further apart in depth than this fraction of the smallest
 /// object's size to be told apart: a cube 1 unit wide z-fights where its faces come within
