@@ -48,6 +48,7 @@ pub mod math;
 pub mod output;
 pub mod plan;
 pub mod raster;
+pub mod reference;
 pub mod render;
 pub mod scene;
 pub mod shade;

@@ -9,7 +9,8 @@
 //! - `files`: bounded reads and all-or-nothing writes.
 //! - `math`, `framebuffer`, `shade`: matrices and the rig, the render target (and the image
 //!   sizes it accepts), the shader stages.
-//! - `raster`: fixed-point setup and traversal; knows nothing of scenes or stereo.
+//! - `raster`, `reference`: fixed-point setup and traversal (knows nothing of scenes or
+//!   stereo); the f64 reference the hard cases are measured against.
 //! - `effects`: pure functions of framebuffers, matrices and their own settings types (never a
 //!   `Scene`, `Frame`, `Plan` or `Output`).
 //! - `plan`: the outputs a scene can ask for, and the passes each needs.
@@ -31,7 +32,7 @@ const LAYERS: &[&[&str]] = &[
     &["error"],
     &["files"],
     &["math", "framebuffer", "shade", "text"],
-    &["raster"],
+    &["raster", "reference"],
     &["effects"],
     &["plan"],
     &["scene"],

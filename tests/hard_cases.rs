@@ -245,3 +245,91 @@ fn a_render_that_draws_nothing_says_so() {
     assert_warned(&out, &["no pass drew a fragment", "camera.eye"]);
     assert_no_warning_naming(&render("anaglyph.toml", "hard-something", &[]), "fragment");
 }
+
+/// Catalogue: near/far ratios from 10 to 1e12, each depth mode against the f64 reference
+/// (`stereolab::reference`), on the depth benchmark's decal scene (pairs of squares 1/10 000
+/// of their depth apart). Tolerance: zero wrong or lost pixels (of those the reference decides)
+/// wherever the mode's predicted resolution `resolution_of` at the farthest pair (eye depth 90)
+/// is under a quarter of that pair's gap; reason: a resolution finer than the gap separates
+/// the two squares everywhere, and coverage is compared only away from edges. Where it is not,
+/// the scene loader warns (`a_near_plane_that_coarsens…`, the refusal above).
+#[test]
+fn catalogue_near_far_ratios_within_the_predicted_resolution_of_each_depth_mode() {
+    use stereolab::bench::depth::{FAR, measure, modes};
+    use stereolab::scene::resolution_of;
+    let rows = measure(96, 64, 1).expect("measure");
+    let gap = 90.0 * 1e-4;
+    let mut standard_failed_somewhere = false;
+    for r in &rows {
+        let near = (f64::from(FAR) / r.ratio) as f32;
+        let mode = modes(near)
+            .into_iter()
+            .find(|m| m.name() == r.setting)
+            .expect("mode");
+        let dz = resolution_of(mode, 90.0, f64::from(near), f64::from(FAR));
+        if dz < gap / 4.0 {
+            assert_eq!(
+                r.error, 0.0,
+                "{} at near/far 1/{:e}: {}% wrong with resolution {dz:e} < gap/4",
+                r.setting, r.ratio, r.error
+            );
+        }
+        if r.setting == "standard" && r.error > 0.0 {
+            standard_failed_somewhere = true;
+        }
+        if r.setting.starts_with("reversed-z, infinite") || r.setting == "f64" {
+            assert_eq!(r.error, 0.0, "{} at 1/{:e}", r.setting, r.ratio);
+        }
+    }
+    assert!(
+        standard_failed_somewhere,
+        "the standard f32 depth must lose the decals at 1e12 (else the measurement measures nothing)"
+    );
+}
+
+/// Catalogue: `sirds.depth_far_in = 1e8` keeps the front separation at eq. 3's 72 px
+/// (a = 180 px, f = 864 px, t_near = 576 px: 180·576/1440); tolerance 1e-3 px, the f32
+/// rounding of the formula. Before: 67 px (t_far − t_near rounded in f32).
+#[test]
+fn catalogue_sirds_depth_far_in_1e8_keeps_the_front_separation() {
+    use stereolab::effects::sirds::disparity::Geometry;
+    let g = Geometry {
+        depth_far_in: 1e8,
+        ..Geometry::default()
+    };
+    let d = g.to_pixels().expect("valid");
+    assert!(
+        (d.min_separation() - 72.0).abs() < 1e-3,
+        "{}",
+        d.min_separation()
+    );
+}
+
+/// Catalogue: per-vertex SIRDS back plane at the far clip plane (its f32 window depth is 1.0,
+/// so it would lose against the cleared depth) is refused by name.
+#[test]
+fn catalogue_sirds_back_at_the_far_plane_is_refused() {
+    let out = info("sirds_sphere.toml", &["sirds.back=20"]);
+    assert_refused(&out, &["sirds.back", "window depth is 1.0"]);
+}
+
+/// `raster.depth` names and `infinite_far` without reversed-Z are checked by name.
+#[test]
+fn depth_mode_values_are_checked_by_name() {
+    assert_refused(
+        &info("anaglyph.toml", &["raster.depth=\"w-buffer\""]),
+        &["raster.depth", "reversed-z"],
+    );
+    assert_refused(
+        &info("anaglyph.toml", &["raster.infinite_far=true"]),
+        &["raster.infinite_far", "reversed-z"],
+    );
+    assert!(
+        info(
+            "anaglyph.toml",
+            &["raster.depth=\"reversed-z\"", "raster.infinite_far=true"]
+        )
+        .status
+        .success()
+    );
+}

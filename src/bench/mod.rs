@@ -2,6 +2,7 @@
 //! accurate setting, milliseconds — printed and optionally written as CSV.
 
 mod chromadepth;
+pub mod depth;
 mod finalize;
 #[cfg(feature = "gpu")]
 mod gpu;
@@ -55,8 +56,8 @@ pub struct BenchOptions {
     pub width: u32,
     /// Image height.
     pub height: u32,
-    /// Run only these groups (`stereo`, `raster`, `chromadepth`, `finalize`, `sirds`, `scaling`,
-    /// `gpu`);
+    /// Run only these groups (`stereo`, `raster`, `depth`, `chromadepth`, `finalize`, `sirds`,
+    /// `scaling`, `gpu`);
     /// empty: all.
     pub only: Vec<String>,
 }
@@ -65,6 +66,7 @@ pub struct BenchOptions {
 pub(crate) const GROUPS: [&str; 7] = [
     "stereo",
     "raster",
+    "depth",
     "chromadepth",
     "finalize",
     "sirds",
@@ -122,6 +124,9 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     if want("raster") {
         rows.extend(subpixel_bits(&scene, iters)?);
         rows.extend(perspective_correction(iters)?);
+    }
+    if want("depth") {
+        rows.extend(depth::rows(iters)?);
     }
     if want("chromadepth") {
         rows.extend(chromadepth::rows(&scene, iters)?);

@@ -69,6 +69,14 @@ impl<'a> GpuScene<'a> {
                 "the GPU snaps to its own fixed 8 subpixel bits",
             ));
         }
+        if scene.raster.depth != crate::raster::DepthMode::Standard {
+            return Err(crate::Error::invalid(
+                "raster.depth",
+                scene.raster.depth.name(),
+                "the GPU path renders lavapipe's standard f32 depth only; use --backend cpu \
+                 for reversed-z or f64 depth, or set raster.depth = \"standard\"",
+            ));
+        }
         r.check_target_size(scene.width, scene.height)?;
         let meshes = scene
             .objects

@@ -8,12 +8,14 @@
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx2;
 mod clip;
+mod depth_modes;
 mod setup;
 #[cfg(target_arch = "x86_64")]
 mod shade_avx2;
 mod traverse;
 
 pub(crate) use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
+pub use depth_modes::DepthMode;
 pub use setup::{DepthPlane, Plane, Setup, SetupTriangle, WindowVertex, setup_triangle};
 pub use traverse::{Band, SmallBox, traverse};
 
@@ -51,6 +53,10 @@ pub struct RasterOptions {
     /// Run the AVX2 loops where the CPU has them (true), or the scalar ones only (false). The
     /// same bytes either way; `STEREOLAB_SCALAR=1` sets false in the `stereolab` command.
     pub simd: bool,
+    /// Which depth the depth test compares: lavapipe's f32 window depth (the default), or
+    /// reversed-Z or f64 for scenes whose near/far ratio the standard buffer cannot resolve
+    /// (`[raster] depth`, see `depth_modes`).
+    pub depth: DepthMode,
 }
 
 impl Default for RasterOptions {
@@ -61,6 +67,7 @@ impl Default for RasterOptions {
             perspective_correct: true,
             depth_test: true,
             simd: true,
+            depth: DepthMode::Standard,
         }
     }
 }
@@ -96,6 +103,9 @@ pub fn rasterize<S: Shader>(
     fb: &mut Framebuffer,
     opts: &RasterOptions,
 ) -> RasterStats {
+    if opts.depth != DepthMode::Standard {
+        return depth_modes::rasterize(triangles, vertex_count, shader, fb, opts);
+    }
     let (setups, mut stats) =
         setup_triangles(triangles, vertex_count, shader, fb.width, fb.height, opts);
     let width = fb.width as usize;

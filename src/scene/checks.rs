@@ -15,11 +15,12 @@
 
 use glam::DVec3;
 
-use super::{Object, Scene, file::LightSpec};
+use super::{Object, Scene, file::LightSpec, file::RasterSpec};
 use crate::effects::sirds::settings::{Algorithm, Settings};
 use crate::error::{Error, Result};
 use crate::math::Camera;
 use crate::plan::Output;
+use crate::raster::DepthMode;
 
 /// Warn when two surfaces must be further apart in depth than this fraction of the smallest
 /// object's size to be told apart: a cube 1 unit wide z-fights where its faces come within
@@ -50,6 +51,40 @@ pub(super) fn check_light(l: &LightSpec) -> Result<()> {
     Ok(())
 }
 
+/// `[raster] depth` and `infinite_far` as a [`DepthMode`] (reversed-Z takes the camera's clip
+/// distances).
+pub(super) fn depth_mode(spec: &RasterSpec, camera: &Camera) -> Result<DepthMode> {
+    let mode = match spec.depth.as_deref() {
+        None | Some("standard") => DepthMode::Standard,
+        Some("reversed-z") => DepthMode::ReversedZ {
+            near: camera.near,
+            far: if spec.infinite_far {
+                f32::INFINITY
+            } else {
+                camera.far
+            },
+        },
+        Some("f64") => DepthMode::F64,
+        Some(other) => {
+            return Err(Error::invalid(
+                "raster.depth",
+                other,
+                "one of \"standard\" (lavapipe's f32 window depth), \"reversed-z\" (f32, \
+                 resolves far surfaces at any near plane), \"f64\"",
+            ));
+        }
+    };
+    if spec.infinite_far && !matches!(mode, DepthMode::ReversedZ { .. }) {
+        return Err(Error::invalid(
+            "raster.infinite_far",
+            true,
+            "needs raster.depth = \"reversed-z\" (the standard depth stays lavapipe's, and f64 \
+             depth needs no far plane to be precise)",
+        ));
+    }
+    Ok(mode)
+}
+
 /// Per-vertex SIRDS renders the background plane at `sirds.back` and maps `sirds.front` to the
 /// nearest depth: both must lie inside the camera's clip range, or the plane is clipped away
 /// and the image is no autostereogram.
@@ -58,13 +93,18 @@ pub(super) fn check_sirds_clip(s: &Settings, camera: &Camera) -> Result<()> {
         return Ok(());
     }
     for (name, v) in [("sirds.front", s.front), ("sirds.back", s.back)] {
-        if let Some(v) = v.filter(|v| !(*v >= camera.near && *v <= camera.far)) {
+        // At (or just before) the far plane the window depth rounds to 1.0 in f32 and the
+        // plane loses the LESS test against the cleared depth: as lost as if clipped.
+        let lost = |v: f32| {
+            window_depth(f64::from(v), f64::from(camera.near), f64::from(camera.far)) as f32 >= 1.0
+        };
+        if let Some(v) = v.filter(|v| !(*v >= camera.near && *v <= camera.far) || lost(*v)) {
             return Err(Error::invalid(
                 name,
                 v,
                 format!(
-                    "lies outside the clip range [camera.near, camera.far] = [{}, {}]: the \
-                     per-vertex SIRDS would clip its background plane away; move {name} \
+                    "lies outside the clip range [camera.near, camera.far] = [{}, {}] (or so \
+                     near camera.far that its f32 window depth is 1.0): the per-vertex SIRDS would clip its background plane away; move {name} \
                      inside that range or widen camera.near/camera.far",
                     camera.near, camera.far
                 ),
@@ -99,6 +139,33 @@ pub fn depth_resolution(z: f64, n: f64, f: f64) -> f64 {
     let zw = window_depth(z, n, f) as f32;
     let ulp = f64::from(f32::from_bits(zw.to_bits() + 1) - zw);
     ulp * (f - n) * z * z / (f * n)
+}
+
+/// The eye-depth distance two surfaces at eye depth `z` need to be told apart by the depth test
+/// of `mode` (near and far planes `n`, `f`):
+/// - standard: [`depth_resolution`], `≈ 2⁻²⁴ z²/n`;
+/// - reversed-Z: the key `k = a/z + b` (`a = n f/(f − n)`, `b = −n/(f − n)`; `a = n`, `b = 0`
+///   for an infinite far plane) is spaced `ulp(k)` and rounded once from `a/z` and `b`, so
+///   `Δz = max(ulp(k), ulp(a/z), ulp(b)) · z²/a`: about `2⁻²³ z` with an infinite far plane;
+/// - f64: the key `1/z` in f64, `Δz ≈ 2⁻⁵² z`.
+pub fn resolution_of(mode: DepthMode, z: f64, n: f64, f: f64) -> f64 {
+    match mode {
+        DepthMode::Standard => depth_resolution(z, n, f),
+        DepthMode::ReversedZ { far, .. } => {
+            let (a, b) = if far.is_infinite() {
+                (n, 0.0)
+            } else {
+                (n * f / (f - n), -n / (f - n))
+            };
+            let k = a / z + b;
+            let ulp = [k, a / z, b]
+                .map(|v| f64::from(ulp_f32(v as f32)))
+                .into_iter()
+                .fold(0.0, f64::max);
+            ulp * z * z / a
+        }
+        DepthMode::F64 => z * f64::EPSILON,
+    }
 }
 
 /// The bounding-box diagonal and the largest coordinate magnitude of one object, in world space.
@@ -158,27 +225,44 @@ pub(super) fn precision_warnings(scene: &Scene) -> Result<Vec<String>> {
             "raise camera.near (now {near32:e}) towards {suggest:.3e}: the perspective depth buffer \
              resolves about 2^-24 z^2/near in eye depth"
         );
+        let mode = scene.raster.depth;
         if window_depth(near_s, n, f) as f32 >= 1.0 {
-            return Err(Error::invalid(
-                "camera.near",
-                near32,
-                format!(
-                    "with camera.far = {far32:e} every surface (eye depth {near_s:.4e} to \
-                     {far_s:.4e}) gets window depth 1.0 in the f32 depth buffer and loses to \
-                     the cleared depth: nothing would be drawn; {remedy}"
-                ),
+            if mode == DepthMode::Standard {
+                return Err(Error::invalid(
+                    "camera.near",
+                    near32,
+                    format!(
+                        "with camera.far = {far32:e} every surface (eye depth {near_s:.4e} to \
+                         {far_s:.4e}) gets window depth 1.0 in the f32 depth buffer and loses to \
+                         the cleared depth: nothing would be drawn; {remedy}, or set \
+                         raster.depth = \"reversed-z\""
+                    ),
+                ));
+            }
+            warnings.push(format!(
+                "warning: camera.near = {near32:e}: raster.depth = {} keeps visibility right, \
+                 but every surface's f32 window depth is 1.0, so outputs that read depth \
+                 (*_depth, parallax, remap, occlusion, sirds) see only background; {remedy}",
+                mode.name()
             ));
+            return Ok(warnings);
         }
         let (r_near, r_far) = (
-            depth_resolution(near_s, n, f),
-            depth_resolution(far_s, n, f),
+            resolution_of(mode, near_s, n, f),
+            resolution_of(mode, far_s, n, f),
         );
         if r_far > tol {
+            let switch = if mode == DepthMode::Standard {
+                ", or set raster.depth = \"reversed-z\""
+            } else {
+                ""
+            };
             warnings.push(format!(
-                "warning: camera.near = {near32:e} is too close for the depth buffer: surfaces \
-                 closer than {r_near:.3e} in depth at the nearest surface (eye depth \
-                 {near_s:.4}) and {r_far:.3e} at the farthest ({far_s:.4}) share a depth \
-                 value and fight, or are lost; {remedy}"
+                "warning: camera.near = {near32:e} is too close for the depth buffer \
+                 (raster.depth = {}): surfaces closer than {r_near:.3e} in depth at the nearest \
+                 surface (eye depth {near_s:.4}) and {r_far:.3e} at the farthest ({far_s:.4}) \
+                 share a depth value and fight, or are lost; {remedy}{switch}",
+                mode.name()
             ));
         }
     }

@@ -181,6 +181,13 @@ pub(crate) struct RasterSpec {
     /// Back-face culling.
     #[serde(default)]
     pub cull_back: bool,
+    /// Depth test precision: `standard` (lavapipe's f32 window depth, default), `reversed-z`,
+    /// `f64`.
+    #[serde(default)]
+    pub depth: Option<String>,
+    /// Reversed-Z with the far plane at infinity (key `n/w`); needs `depth = "reversed-z"`.
+    #[serde(default)]
+    pub infinite_far: bool,
 }
 
 /// `[finalize]`.

@@ -10,7 +10,7 @@ mod polygon;
 pub mod terrain;
 pub mod terrain_data;
 
-pub use checks::{DEPTH_RESOLUTION_WARN, ORIGIN_PRECISION_WARN, depth_resolution};
+pub use checks::{DEPTH_RESOLUTION_WARN, ORIGIN_PRECISION_WARN, depth_resolution, resolution_of};
 pub(crate) use file::SceneFile;
 pub use mesh::Mesh;
 pub use obj::{load_obj, load_obj_with_notes, parse_obj, parse_obj_with_notes};
@@ -291,6 +291,7 @@ impl Scene {
         }
         let sirds = crate::effects::sirds::Settings::from_spec(&f.sirds, root)?;
         checks::check_sirds_clip(&sirds, &f.camera)?;
+        let depth = checks::depth_mode(&f.raster, &f.camera)?;
         let mut scene = Scene {
             width: f.image.width,
             height: f.image.height,
@@ -303,6 +304,7 @@ impl Scene {
             blank_interval: f.layout.blank_interval,
             raster: RasterOptions {
                 cull_back: f.raster.cull_back,
+                depth,
                 ..RasterOptions::default()
             },
             chromadepth: f.chromadepth,

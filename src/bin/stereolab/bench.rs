@@ -17,7 +17,7 @@ pub struct BenchArgs {
     /// Repetitions per timing (median reported).
     #[arg(long, default_value_t = 15)]
     pub iterations: usize,
-    /// Run only these groups, comma-separated: stereo, raster, chromadepth, finalize, sirds,
+    /// Run only these groups, comma-separated: stereo, raster, depth, chromadepth, finalize, sirds,
     /// scaling, gpu (default: all).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,

@@ -169,16 +169,22 @@ impl Geometry {
 }
 
 impl Disparity {
-    /// Depth behind the image plane (pixels) of normalized nearness `z` (0 background, 1 front).
+    /// Depth behind the image plane (pixels) of normalized nearness `z` (0 background, 1 front):
+    /// `t_far − z (t_far − t_near)`, evaluated in f64 and rounded once. In f32 the difference
+    /// `t_far − t_near` rounds to a multiple of `ulp(t_far)`, so with `sirds.depth_far_in = 1e8`
+    /// (`t_far` = 7.2e9 px, ulp 512) the front `z = 1` landed at 512 px instead of
+    /// `t_near` = 576 px: a front separation of 67 px instead of 72 (issue 18).
     #[inline]
     pub fn depth_of(&self, z: f32) -> f32 {
-        self.t_far - z * (self.t_far - self.t_near)
+        let (t_far, t_near) = (f64::from(self.t_far), f64::from(self.t_near));
+        (t_far - f64::from(z) * (t_far - t_near)) as f32
     }
 
     /// Normalized nearness of a depth `t` behind the image plane (inverse of [`Self::depth_of`]).
     #[inline]
     pub fn nearness_of(&self, t: f32) -> f32 {
-        (self.t_far - t) / (self.t_far - self.t_near)
+        let (t_far, t_near) = (f64::from(self.t_far), f64::from(self.t_near));
+        ((t_far - f64::from(t)) / (t_far - t_near)) as f32
     }
 
     /// Separation in pixels of a point at depth `t` pixels behind the image plane.
