@@ -1,10 +1,12 @@
 //! `stereolab bench`: one row per measurement — area, knob, setting, error against the most
 //! accurate setting, milliseconds — printed and optionally written as CSV.
 
+pub mod accuracy;
 mod chromadepth;
 mod finalize;
 #[cfg(feature = "gpu")]
 mod gpu;
+pub mod report;
 mod sirds;
 
 use std::fmt::Write as _;

@@ -12,6 +12,7 @@
 
 pub mod bench;
 pub mod canvas;
+pub mod plot;
 mod chromadepth;
 mod finalize;
 mod perception;
