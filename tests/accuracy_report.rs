@@ -16,7 +16,11 @@ fn check_plot(path: &std::path::Path) {
         .to_rgb8();
     assert_eq!(img.dimensions(), (960, 460), "{}", path.display());
     let ink = img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
-    assert!(ink > 500, "{}: {ink} black pixels, no axes?", path.display());
+    assert!(
+        ink > 500,
+        "{}: {ink} black pixels, no axes?",
+        path.display()
+    );
     let front = img.pixels().filter(|p| p.0 == [205, 70, 20]).count();
     assert!(front > 20, "{}: no Pareto front drawn", path.display());
 }
@@ -60,7 +64,11 @@ fn quick_report_has_a_plot_per_knob_with_axes_and_a_reading() {
         );
         check_plot(&dir.join(format!("{}.png", k.id)));
         // The plot, its axes (with units) and its reading are in both pages.
-        assert!(md.contains(&format!("]({}.png)", k.id)), "{}: no plot in md", k.id);
+        assert!(
+            md.contains(&format!("]({}.png)", k.id)),
+            "{}: no plot in md",
+            k.id
+        );
         assert!(
             md.contains(&format!(
                 "*x: median time ({}); y: {}.*",
@@ -118,7 +126,10 @@ fn committed_report_plots_exist_and_slides_copy_them() {
     assert!(plots.len() >= 12, "{} plots in report.md", plots.len());
     for p in &plots {
         check_plot(&dir.join(p));
-        assert!(html.contains(&format!("src=\"{p}\"")), "{p} not in report.html");
+        assert!(
+            html.contains(&format!("src=\"{p}\"")),
+            "{p} not in report.html"
+        );
     }
     for id in SLIDE_KNOBS {
         let name = format!("accuracy_{id}.png");
@@ -131,5 +142,8 @@ fn committed_report_plots_exist_and_slides_copy_them() {
         );
     }
     let readme = std::fs::read_to_string(root().join("README.md")).expect("README");
-    assert!(readme.contains("docs/accuracy/report.md"), "README does not link the report");
+    assert!(
+        readme.contains("docs/accuracy/report.md"),
+        "README does not link the report"
+    );
 }

@@ -267,7 +267,12 @@ pub fn off_axis_mvp_f64(scene: &Scene, side: f64) -> Result<DMat4> {
     let p = DMat4::from_cols(
         DVec4::new(2.0 * n / (r - l), 0.0, 0.0, 0.0),
         DVec4::new(0.0, 2.0 * n / (t - b), 0.0, 0.0),
-        DVec4::new((r + l) / (r - l), (t + b) / (t - b), (n + f) / (n - f), -1.0),
+        DVec4::new(
+            (r + l) / (r - l),
+            (t + b) / (t - b),
+            (n + f) / (n - f),
+            -1.0,
+        ),
         DVec4::new(0.0, 0.0, 2.0 * n * f / (n - f), 0.0),
     );
     Ok(p * DMat4::from_translation(DVec3::new(-side * half, 0.0, 0.0)) * view)
@@ -278,9 +283,8 @@ pub fn off_axis_mvp_f64(scene: &Scene, side: f64) -> Result<DMat4> {
 fn window_positions(scene: &Scene, way: u8) -> Result<Vec<Option<(f64, f64)>>> {
     let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
     let (w, h) = (f64::from(scene.width), f64::from(scene.height));
-    let win = |c: DVec4| {
-        (c.w > 0.0).then(|| ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h))
-    };
+    let win =
+        |c: DVec4| (c.w > 0.0).then(|| ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h));
     let mut out = Vec::new();
     for (e, side) in eyes.iter().zip([-1.0, 1.0]) {
         let mvp64 = off_axis_mvp_f64(scene, side)?;
@@ -539,7 +543,11 @@ fn sirds_knobs(scale: Scale) -> Result<Vec<Knob>> {
         };
         let (e, ms) = sirds_point(&s, None, it)?;
         pts.push(point(
-            format!("{} start, {}", format!("{start:?}").to_lowercase(), format!("{filter:?}").to_lowercase()),
+            format!(
+                "{} start, {}",
+                format!("{start:?}").to_lowercase(),
+                format!("{filter:?}").to_lowercase()
+            ),
             e,
             ms,
         ));
@@ -596,7 +604,11 @@ fn sirds_knobs(scale: Scale) -> Result<Vec<Knob>> {
         let mut s = base.clone();
         s.objects[0].mesh = Mesh::plane(20.0, n);
         let (e, ms) = sirds_point(&s, None, it)?;
-        pts.push(point(format!("{n}×{n} quads ({} triangles)", 2 * n * n), e, ms));
+        pts.push(point(
+            format!("{n}×{n} quads ({} triangles)", 2 * n * n),
+            e,
+            ms,
+        ));
     }
     out.push(knob(
         "sirds_tessellation",
@@ -651,7 +663,11 @@ fn sirds_knobs(scale: Scale) -> Result<Vec<Knob>> {
         0.5,
     ));
     let mut pts = Vec::new();
-    for x in if scale.quick { &[1, 2][..] } else { &[1, 2, 4][..] } {
+    for x in if scale.quick {
+        &[1, 2][..]
+    } else {
+        &[1, 2, 4][..]
+    } {
         let (e, ms) = tiw(true, *x)?;
         pts.push(point(format!("oversample ×{x}"), e, ms));
     }
@@ -687,10 +703,18 @@ fn threads(scene: &Scene, iters: usize) -> Result<Knob> {
             Ok(b)
         })?;
         let want = reference.get_or_insert_with(|| bytes.clone());
-        let diff = bytes.iter().zip(want.iter()).filter(|(a, b)| a != b).count()
+        let diff = bytes
+            .iter()
+            .zip(want.iter())
+            .filter(|(a, b)| a != b)
+            .count()
             + bytes.len().abs_diff(want.len());
         let ms = pool.install(|| median_ms(iters, || render(scene, &plan).is_ok()));
-        points.push(point(format!("{n} thread{}", if n == 1 { "" } else { "s" }), diff as f64, ms));
+        points.push(point(
+            format!("{n} thread{}", if n == 1 { "" } else { "s" }),
+            diff as f64,
+            ms,
+        ));
     }
     Ok(Knob {
         id: "threads".into(),

@@ -81,9 +81,13 @@ pub fn reading(k: &Knob) -> String {
     let by = |a: &usize, b: &usize, err_first: bool| {
         let (pa, pb) = (p(*a), p(*b));
         if err_first {
-            pa.error.total_cmp(&pb.error).then(pa.seconds.total_cmp(&pb.seconds))
+            pa.error
+                .total_cmp(&pb.error)
+                .then(pa.seconds.total_cmp(&pb.seconds))
         } else {
-            pa.seconds.total_cmp(&pb.seconds).then(pa.error.total_cmp(&pb.error))
+            pa.seconds
+                .total_cmp(&pb.seconds)
+                .then(pa.error.total_cmp(&pb.error))
         }
     };
     let best = *idx.iter().min_by(|a, b| by(a, b, true)).unwrap_or(&idx[0]);
@@ -141,10 +145,7 @@ pub fn reading(k: &Knob) -> String {
     } else {
         let _ = write!(s, "It is also the most accurate setting. ");
     }
-    let worst = *idx
-        .iter()
-        .max_by(|a, b| by(a, b, true))
-        .unwrap_or(&idx[0]);
+    let worst = *idx.iter().max_by(|a, b| by(a, b, true)).unwrap_or(&idx[0]);
     if p(worst).error > k.negligible && worst != pick {
         let _ = write!(
             s,
@@ -209,7 +210,9 @@ fn preamble(scene: &Path, quick: bool, scale: Scale) -> String {
          ```sh\ncargo run --release -- bench --report docs/accuracy --slides slides/figures\n```\n",
         if quick { " --quick" } else { "" },
         std::env::consts::ARCH,
-        scene.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+        scene
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
         scale.width,
         scale.height,
         scale.iters,
@@ -250,11 +253,7 @@ pub fn markdown(knobs: &[Knob], preamble: &str) -> String {
     s.push_str("| knob | use | error | time |\n| --- | --- | --- | --- |\n");
     for k in knobs {
         let (pick, e, t) = summary(k);
-        let _ = writeln!(
-            s,
-            "| [{}](#{}) | {pick} | {e} | {t} |",
-            k.title, k.id
-        );
+        let _ = writeln!(s, "| [{}](#{}) | {pick} | {e} | {t} |", k.title, k.id);
     }
     for k in knobs {
         let _ = write!(
@@ -465,22 +464,39 @@ mod tests {
     #[test]
     fn the_reading_picks_the_fastest_negligible_setting_from_the_numbers() {
         let k = knob(
-            &[("coarse", 2.0, 0.001), ("fine", 0.1, 0.002), ("exact", 0.0, 0.008)],
+            &[
+                ("coarse", 2.0, 0.001),
+                ("fine", 0.1, 0.002),
+                ("exact", 0.0, 0.008),
+            ],
             0.5,
         );
         let r = reading(&k);
         assert!(r.starts_with("**Use fine**: error 0.100 (px), 2.00 ms, 2.00× the time of the fastest setting (coarse, 1.00 ms, error 2.00)"), "{r}");
-        assert!(r.contains("The most accurate, exact, errs by 0 and takes 8.00 ms (4.00× the time)"), "{r}");
+        assert!(
+            r.contains("The most accurate, exact, errs by 0 and takes 8.00 ms (4.00× the time)"),
+            "{r}"
+        );
         assert!(r.contains("Pareto front: coarse, fine, exact."), "{r}");
         // Nothing negligible: the most accurate.
         let r = reading(&knob(&[("a", 2.0, 0.001), ("b", 1.0, 0.003)], 0.5));
         assert!(r.starts_with("**Use b**"), "{r}");
         assert!(r.contains("No setting reaches a negligible error"), "{r}");
         // Same times: say so; a dominated setting is named.
-        let r = reading(&knob(&[("a", 2.0, 0.00100), ("b", 0.0, 0.00101), ("c", 3.0, 0.00105)], 0.0));
+        let r = reading(&knob(
+            &[
+                ("a", 2.0, 0.00100),
+                ("b", 0.0, 0.00101),
+                ("c", 3.0, 0.00105),
+            ],
+            0.0,
+        ));
         assert!(r.starts_with("**Use b**"), "{r}");
         assert!(r.contains("same time within 10%"), "{r}");
-        assert!(r.contains("dominated (another setting is as fast and as accurate or better): c."), "{r}");
+        assert!(
+            r.contains("dominated (another setting is as fast and as accurate or better): c."),
+            "{r}"
+        );
     }
 
     #[test]

@@ -12,10 +12,10 @@
 
 pub mod bench;
 pub mod canvas;
-pub mod plot;
 mod chromadepth;
 mod finalize;
 mod perception;
+pub mod plot;
 mod raster;
 mod rig;
 mod sirds;

@@ -49,9 +49,9 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
         .iter()
         .map(|p| {
             ok(p)
-                && !points.iter().any(|q| {
-                    ok(q) && q.0 <= p.0 && q.1 <= p.1 && (q.0 < p.0 || q.1 < p.1)
-                })
+                && !points
+                    .iter()
+                    .any(|q| ok(q) && q.0 <= p.0 && q.1 <= p.1 && (q.0 < p.0 || q.1 < p.1))
         })
         .collect()
 }
@@ -202,7 +202,13 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
     } else {
         knob.error_unit.clone()
     };
-    c.vertical_text(l - 14.0 - widest - LABEL * 1.2, (t + b) / 2.0, LABEL, &y_label, INK);
+    c.vertical_text(
+        l - 14.0 - widest - LABEL * 1.2,
+        (t + b) / 2.0,
+        LABEL,
+        &y_label,
+        INK,
+    );
     c.text(l, 14.0, LABEL + 2.0, &knob.title, INK, Align::Left);
     // The front as a staircase (fastest first: each step is more accurate and slower).
     let front = knob.front();
@@ -247,10 +253,21 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
     }
     // The key: number, setting, on the front or not.
     let kx = r + 24.0;
-    c.text(kx, t - 4.0, SMALL, "settings (filled: Pareto front)", INK, Align::Left);
+    c.text(
+        kx,
+        t - 4.0,
+        SMALL,
+        "settings (filled: Pareto front)",
+        INK,
+        Align::Left,
+    );
     for (n, &i) in valid.iter().enumerate() {
         let y = t + 16.0 + n as f32 * (SMALL + 5.0);
-        let (color, mark) = if front[i] { (FRONT, "●") } else { (GRAY, "○") };
+        let (color, mark) = if front[i] {
+            (FRONT, "●")
+        } else {
+            (GRAY, "○")
+        };
         let label = &knob.points[i].label;
         let label = if text::width(label, SMALL) > 300.0 {
             let mut s: String = label.chars().take(40).collect();
@@ -260,7 +277,14 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
             label.clone()
         };
         c.text(kx, y, SMALL, mark, color, Align::Left);
-        c.text(kx + 16.0, y, SMALL, &format!("{}  {label}", n + 1), INK, Align::Left);
+        c.text(
+            kx + 16.0,
+            y,
+            SMALL,
+            &format!("{}  {label}", n + 1),
+            INK,
+            Align::Left,
+        );
     }
     let skipped = knob.points.len() - valid.len();
     if skipped > 0 {
@@ -318,7 +342,9 @@ mod tests {
         // A tiny LCG: deterministic points on a coarse grid, so ties happen.
         let mut s = 12345u64;
         let mut next = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((s >> 33) % 6) as f64
         };
         for _ in 0..200 {
@@ -338,10 +364,11 @@ mod tests {
                 .filter(|p| p.0 == fastest)
                 .map(|p| p.1)
                 .fold(f64::INFINITY, f64::min);
-            assert!(pts
-                .iter()
-                .zip(&front)
-                .any(|(p, f)| *f && p.0 == fastest && p.1 == best));
+            assert!(
+                pts.iter()
+                    .zip(&front)
+                    .any(|(p, f)| *f && p.0 == fastest && p.1 == best)
+            );
         }
     }
 
