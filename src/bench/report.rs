@@ -98,11 +98,19 @@ pub fn reading(k: &Knob) -> String {
         .copied()
         .filter(|&i| p(i).error <= k.negligible)
         .collect();
+    // The fastest negligible setting; among those within 10% of its time (run-to-run noise),
+    // the most accurate.
     let pick = good
         .iter()
         .copied()
         .min_by(|a, b| by(a, b, false))
-        .unwrap_or(best);
+        .map_or(best, |f| {
+            good.iter()
+                .copied()
+                .filter(|&i| p(i).seconds <= 1.1 * p(f).seconds)
+                .min_by(|a, b| by(a, b, true))
+                .unwrap_or(f)
+        });
     let unit = &k.error_unit;
     let mut s = String::new();
     let _ = write!(
@@ -181,14 +189,14 @@ pub fn reading(k: &Knob) -> String {
         .filter(|&&i| !front[i])
         .map(|&i| p(i).label.as_str())
         .collect();
-    let _ = write!(s, "Pareto front: {}", on.join(", "));
+    let _ = write!(s, "Pareto front: {}", on.join("; "));
     if off.is_empty() {
         s.push('.');
     } else {
         let _ = write!(
             s,
             "; dominated (another setting is as fast and as accurate or better): {}.",
-            off.join(", ")
+            off.join("; ")
         );
     }
     s
@@ -197,13 +205,20 @@ pub fn reading(k: &Knob) -> String {
 /// How the numbers were measured, for the report's head.
 fn preamble(scene: &Path, quick: bool, scale: Scale) -> String {
     let threads = std::thread::available_parallelism().map_or(0, |n| n.get());
+    // How busy the machine was (Linux): timings on a loaded machine are noisier.
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next().map(str::to_string))
+        .map_or(String::new(), |l| {
+            format!(", 1-minute load average {l} as it finished")
+        });
     format!(
         "Every accuracy knob of stereolab measured for error and time in one run, one plot \
          each: error against median wall time, the Pareto front filled (no other setting is \
          both at least as fast and at least as accurate). Under each plot, a reading generated \
          from the measured numbers: the setting a course should use (the fastest whose error \
          is negligible for teaching, else the most accurate) and what it costs.\n\n\
-         Measured by `stereolab bench --report{}` on {} ({threads} hardware threads), {} with \
+         Measured by `stereolab bench --report{}` on {} ({threads} hardware threads{load}), {} with \
          the real model at {}×{} unless a knob says otherwise, median of {} repetition(s). \
          Times vary from run to run and machine to machine: compare settings within a plot, \
          not across plots or runs. Regenerate (a few minutes on 2 cores):\n\n\
@@ -477,7 +492,7 @@ mod tests {
             r.contains("The most accurate, exact, errs by 0 and takes 8.00 ms (4.00× the time)"),
             "{r}"
         );
-        assert!(r.contains("Pareto front: coarse, fine, exact."), "{r}");
+        assert!(r.contains("Pareto front: coarse; fine; exact."), "{r}");
         // Nothing negligible: the most accurate.
         let r = reading(&knob(&[("a", 2.0, 0.001), ("b", 1.0, 0.003)], 0.5));
         assert!(r.starts_with("**Use b**"), "{r}");
