@@ -1,5 +1,6 @@
 //! One integration-test binary (tiny-skia's layout): `mod` per area.
 
+mod accuracy_report;
 mod architecture;
 mod chromadepth;
 mod cli;

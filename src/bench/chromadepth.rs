@@ -45,7 +45,7 @@ rotate = [-70.0, 0.0, 0.0]
 /// A scene that cannot be rendered.
 pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let mut rows = texgen_modes(iters)?;
-    rows.extend(ramp_sampling(iters));
+    rows.extend(ramp_sampling(iters, &[16, 256]));
     rows.extend(pass_vs_pair(scene, iters)?);
     rows.extend(glasses_and_terrain(scene, iters)?);
     Ok(rows)
@@ -65,7 +65,7 @@ fn row(knob: &str, setting: &str, error: Option<f64>, unit: &str, ms: f64, note:
 
 /// Hue error (degrees, `240° · |Δs|` after clamping) of each texgen mode against `s` from an
 /// exact f64 ray–plane intersection at every pixel center, and the pass time.
-fn texgen_modes(iters: usize) -> Result<Vec<Row>> {
+pub(super) fn texgen_modes(iters: usize) -> Result<Vec<Row>> {
     let base = Scene::from_toml(
         SLANTED_PLANE,
         Path::new("<slanted plane>"),
@@ -136,12 +136,12 @@ fn exact_plane_s(scene: &Scene, d1: f64, d2: f64) -> Vec<f64> {
     out
 }
 
-/// Max hue error of the HSV ramp sampled nearest and linear, against the exact ramp, over
-/// 100 001 evenly spaced `s`; time for a million samples.
-fn ramp_sampling(iters: usize) -> Vec<Row> {
+/// Max hue error of the HSV ramp of each texel count sampled nearest and linear, against the
+/// exact ramp, over 100 001 evenly spaced `s`; time for a million samples.
+pub(super) fn ramp_sampling(iters: usize, texel_counts: &[usize]) -> Vec<Row> {
     const SAMPLES: usize = 100_000;
     let mut rows = Vec::new();
-    for texels in [16, 256] {
+    for &texels in texel_counts {
         let Ok(r) = Ramp::new(RampKind::Hsv, texels) else {
             continue;
         };

@@ -110,19 +110,35 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         px * 4,
         memcpy_ms(px * 4, iters),
     ));
-    rows.extend(remap_precision_rows(left, &mvp, "near/far 1/20", iters)?);
-    // The same model with near = far / 1e5: where f32 unprojection struggles.
-    let mut deep = scene.clone();
-    deep.camera.near = deep.camera.far * 1e-5;
-    let eyes = deep.rig.eyes(&deep.camera, deep.aspect())?;
-    let (deep_left, _) = render_view(&deep, &eyes[0], Shading::DepthOnly)?;
-    rows.extend(remap_precision_rows(
-        &deep_left,
-        &[eyes[0].mvp, eyes[1].mvp],
-        "near/far 1e-5",
-        iters,
-    )?);
+    let (near, deep) = remap_precision(scene, iters)?;
+    rows.extend(near);
+    rows.extend(deep);
     Ok(rows)
+}
+
+/// The remap precision rows on `scene` as it is ("near/far 1/20", wuson's planes) and with
+/// near = far / 1e5, where f32 unprojection struggles.
+///
+/// # Errors
+/// The scene cannot be rendered.
+pub(super) fn remap_precision(scene: &Scene, iters: usize) -> Result<(Vec<Row>, Vec<Row>)> {
+    let mut out = Vec::new();
+    for (near, label) in [(None, "near/far 1/20"), (Some(1e-5), "near/far 1e-5")] {
+        let mut s = scene.clone();
+        if let Some(k) = near {
+            s.camera.near = s.camera.far * k;
+        }
+        let eyes = s.rig.eyes(&s.camera, s.aspect())?;
+        let (left, _) = render_view(&s, &eyes[0], Shading::DepthOnly)?;
+        out.push(remap_precision_rows(
+            &left,
+            &[eyes[0].mvp, eyes[1].mvp],
+            label,
+            iters,
+        )?);
+    }
+    let deep = out.pop().unwrap_or_default();
+    Ok((out.pop().unwrap_or_default(), deep))
 }
 
 /// Each anaglyph kind on stored values and in linear light: time, and the largest and mean

@@ -1,6 +1,7 @@
 //! `stereolab bench`: one row per measurement — area, knob, setting, error against the most
 //! accurate setting, milliseconds — printed and optionally written as CSV.
 
+pub mod accuracy;
 mod chromadepth;
 pub mod depth;
 mod finalize;
@@ -8,6 +9,7 @@ mod finalize;
 mod gpu;
 #[cfg(feature = "gpu")]
 mod gpu_oneshot;
+pub mod report;
 mod scaling;
 mod sirds;
 
@@ -63,7 +65,7 @@ pub struct BenchOptions {
 }
 
 /// The benchmark groups, in the order they run.
-pub(crate) const GROUPS: [&str; 7] = [
+pub(crate) const GROUPS: [&str; 8] = [
     "stereo",
     "raster",
     "depth",

@@ -65,9 +65,12 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// Every accuracy knob on the Fig. 5 ramp at 512×256: time to make the SIRDS from the depth
-/// pass, and the decoded separation's RMS error (share within ±1 px in the note).
-fn knobs(iters: usize) -> Result<Vec<Row>> {
+/// The Fig. 5 ramp: a 20×20 plane (16×16 quads) turned 35° about y, 512×256, black-white
+/// dots with seed 5; the scene of every SIRDS accuracy knob.
+///
+/// # Errors
+/// None in practice (the scene text is fixed).
+pub(super) fn ramp_scene() -> Result<Scene> {
     let mut base = scene_from_text(
         r#"outputs = ["sirds"]
 [image]
@@ -87,6 +90,13 @@ rotate = [0.0, 35.0, 0.0]
 "#,
     )?;
     base.sirds.pattern = Pattern::BlackWhite { seed: 5 };
+    Ok(base)
+}
+
+/// Every accuracy knob on the Fig. 5 ramp at 512×256: time to make the SIRDS from the depth
+/// pass, and the decoded separation's RMS error (share within ±1 px in the note).
+fn knobs(iters: usize) -> Result<Vec<Row>> {
+    let base = ramp_scene()?;
     let frame = render(&base, &Plan::new(&[Output::Sirds]))?;
     let (depth, _) = scene_depth(&frame, &base)?;
     let mut variants: Vec<(&str, String, Scene)> = Vec::new();

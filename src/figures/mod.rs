@@ -15,6 +15,7 @@ pub mod canvas;
 mod chromadepth;
 mod finalize;
 mod perception;
+pub mod plot;
 mod raster;
 mod rig;
 mod sirds;

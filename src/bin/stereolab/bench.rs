@@ -21,6 +21,16 @@ pub struct BenchArgs {
     /// scaling, gpu (default: all).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
+    /// Write the accuracy-against-time report instead: DIR/report.md, DIR/report.html and one
+    /// plot per knob (docs/accuracy holds the committed one).
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+    /// With --report: small images, one repetition, fewer settings (seconds, for tests).
+    #[arg(long, requires = "report")]
+    pub quick: bool,
+    /// With --report: also copy the slides' plots into this folder (slides/figures).
+    #[arg(long, value_name = "DIR", requires = "report")]
+    pub slides: Option<PathBuf>,
 }
 
 /// Runs `stereolab bench`.
@@ -33,6 +43,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
         scene,
         iterations,
         only,
+        report,
+        quick,
+        slides,
     } = args;
     let mut opts = bench::BenchOptions {
         iterations,
@@ -41,6 +54,19 @@ pub fn run(args: BenchArgs) -> Result<()> {
     };
     if let Some(s) = scene {
         opts.scene = s;
+    }
+    if let Some(dir) = report {
+        let written = bench::report::write_report(
+            &opts,
+            &bench::report::ReportOptions { dir, quick, slides },
+        )?;
+        for k in &written.knobs {
+            out!("{}: {}\n\n", k.title, bench::report::reading(k));
+        }
+        for f in &written.files {
+            out!("wrote {}\n", f.display());
+        }
+        return Ok(());
     }
     let rows = bench::run(&opts)?;
     out!("{}", bench::table(&rows));
