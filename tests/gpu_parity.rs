@@ -412,8 +412,15 @@ fn shipped_scenes_match_coverage_depth_and_color() {
                 );
                 continue;
             }
+            // The shear-vs-rotate picture shows the two left eyes' difference ×4
+            // (`effects::shear_rotate::difference`), so an eye's step shows as four there.
+            let bound = if row.name == "shear_vs_rotate" {
+                4 * SHIPPED_MAX_CHANNEL_DIFF
+            } else {
+                SHIPPED_MAX_CHANNEL_DIFF
+            };
             assert!(
-                m.max_channel_diff <= SHIPPED_MAX_CHANNEL_DIFF,
+                m.max_channel_diff <= bound,
                 "{}: {}: max channel difference {}",
                 path.display(),
                 row.name,
@@ -432,15 +439,19 @@ fn shipped_scenes_match_coverage_depth_and_color() {
     }
 }
 
-/// Share of the pixels both paths cover whose depth is the same `f32` on both, over every pass
-/// of every shipped scene (issue 20's target: 99%). Measured figures: docs/gpu-parity.md.
-/// Measured: 99.10% (38.67% before issue 20).
-const SHIPPED_DEPTH_IDENTICAL_PERCENT: f64 = 99.0;
-
+/// Share of the pixels both paths cover whose depth is the same `f32` on both. In every
+/// shipped scene whose passes clip no triangle, that share is 100%: the CPU's depth plane
+/// follows llvmpipe's setup and evaluation (issue 20). Triangles cut by the near or far plane
+/// go through the CPU's clipper, not a mirror of lavapipe's `draw_pipe_clip.c`, so their new
+/// vertices differ in the last bits; the scenes that clip are measured and printed, and their
+/// depth difference is bounded by `MAX_DEPTH_DIFF` in `shipped_scenes_match_coverage_depth_and_color`.
+/// Measured figures: docs/gpu-parity.md.
 #[test]
 fn shipped_scenes_have_bit_identical_depth_where_both_cover() {
     let Some(r) = gpu() else { return };
     let (mut same, mut both) = (0, 0);
+    let mut unclipped_scenes = 0;
+    let mut not_identical = Vec::new();
     for path in shipped_scenes() {
         let scene = Scene::load(&path, &[]).expect("shipped scene loads");
         let plan = Plan::new(&scene.outputs);
@@ -456,13 +467,23 @@ fn shipped_scenes_have_bit_identical_depth_where_both_cover() {
             path.display(),
             100.0 * s as f64 / b.max(1) as f64
         );
+        if clipped == 0 && b > 0 {
+            unclipped_scenes += 1;
+            if s != b {
+                not_identical.push(format!("{}: {s} of {b}", path.display()));
+            }
+        }
         (same, both) = (same + s, both + b);
     }
     let share = 100.0 * same as f64 / both.max(1) as f64;
     eprintln!("shipped scenes: depth bit-identical on {same} of {both} ({share:.2}%)");
     assert!(
-        share >= SHIPPED_DEPTH_IDENTICAL_PERCENT,
-        "depth bit-identical on {share:.2}% < {SHIPPED_DEPTH_IDENTICAL_PERCENT}%"
+        unclipped_scenes >= 10,
+        "{unclipped_scenes} scenes without clipping"
+    );
+    assert!(
+        not_identical.is_empty(),
+        "scenes without clipped triangles whose depth is not bit-identical: {not_identical:?}"
     );
 }
 

@@ -73,6 +73,38 @@ pub fn from_rows(
     }
 }
 
+/// The `[raster] depth` knob (`bench --only depth`, [`super::depth`]) at two near/far ratios:
+/// 1e6, where the standard depth buffer starts to lose decals, and 1e9, where it loses most of
+/// them; one knob each, its points the four depth modes.
+///
+/// # Errors
+/// As [`super::depth::measure`].
+fn depth_modes(scale: Scale) -> Result<Vec<Knob>> {
+    let rows = super::depth::measure(192, 128, scale.iters)?;
+    let ratios: &[f64] = if scale.quick { &[1e6] } else { &[1e6, 1e9] };
+    Ok(ratios
+        .iter()
+        .map(|&ratio| Knob {
+            id: format!("depth_mode_{ratio:.0e}"),
+            title: format!("raster: depth mode at near/far 1/{ratio:.0e}"),
+            error_unit: "% of covered pixels wrong or lost".into(),
+            time_unit: "one 192×128 pass of 24 triangles".into(),
+            points: rows
+                .iter()
+                .filter(|r| r.ratio == ratio)
+                .map(|r| point(r.setting.clone(), r.error, r.seconds * 1e3))
+                .collect(),
+            notes: format!(
+                "Six decals, each 1/10 000 of its depth in front of a square (depths 2 to 90, \
+                 far plane 100, near plane 100/{ratio:.0e}); error: pixels where a different \
+                 square won or nothing was drawn, against the f64 reference (`src/reference`). \
+                 Standard is lavapipe's depth; reversed-z stores n·f/(f−n)/w − n/(f−n) in f32."
+            ),
+            negligible: 0.01,
+        })
+        .collect())
+}
+
 /// Every knob of the report, in the order it prints them.
 ///
 /// # Errors
@@ -150,6 +182,7 @@ pub fn knobs(scene: &Scene, scale: Scale) -> Result<Vec<Knob>> {
         1e-4,
         remap_label,
     ));
+    out.extend(depth_modes(scale)?);
     out.push(rig_precision(scene, 0.0, it)?);
     out.push(rig_precision(scene, 1e5, it)?);
     out.push(rig_mode(scene, it)?);

@@ -2,9 +2,9 @@
 
 pub mod animate;
 pub mod chromadepth;
-pub mod shear_rotate;
 pub mod frame_sequential;
 pub mod report;
+pub mod shear_rotate;
 pub mod sirds;
 pub mod stereo_photo;
 

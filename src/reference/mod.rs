@@ -76,7 +76,11 @@ pub fn eye(
     let half = 0.5 * separation;
     let t = DMat4::from_translation(DVec3::new(-side * half, 0.0, 0.0));
     let (view, shift) = match rig.mode {
-        CameraMode::OffAxis => (t * mv, -side * half * f64::from(rig.user_balance) * n / z0),
+        // Image-shift moves the parallel rig's image sideways; unrounded, that move is exactly
+        // off-axis's frustum shift (the renderer rounds it to whole pixels, its `ImageShift`).
+        CameraMode::OffAxis | CameraMode::ImageShift => {
+            (t * mv, -side * half * f64::from(rig.user_balance) * n / z0)
+        }
         CameraMode::Parallel => (t * mv, 0.0),
         CameraMode::ToeIn => {
             let inv = mv.inverse();

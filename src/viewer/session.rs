@@ -344,7 +344,8 @@ pub const MODES: &[CameraMode] = &[
 /// Fails to compile when `CameraMode` gains a variant: add the new mode to [`MODES`] too.
 const fn _every_mode_listed(m: CameraMode) {
     match m {
-        CameraMode::OffAxis | CameraMode::ToeIn | CameraMode::Parallel | CameraMode::ImageShift => {}
+        CameraMode::OffAxis | CameraMode::ToeIn | CameraMode::Parallel | CameraMode::ImageShift => {
+        }
     }
 }
 
