@@ -48,6 +48,8 @@ fn point(label: impl Into<String>, error: f64, ms: f64) -> Point {
 
 /// A knob from `stereolab bench` rows: every row with an error becomes a point (its setting
 /// through `label`); `unit` says what the rows' error measures, with its unit.
+// Each argument is one field of the knob's description; a struct for them would only rename them.
+#[allow(clippy::too_many_arguments)]
 pub fn from_rows(
     rows: &[Row],
     unit: &str,

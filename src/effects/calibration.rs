@@ -8,8 +8,8 @@
 //! mode: "This usually means providing the user with some kind of calibration screen, in which
 //! the user lines up two arrows while in stereo mode."
 //!
-//! This screen lays the frame out exactly as [`above_below_squashed`](super::layout::
-//! above_below_squashed) does (`rows = (H − blank)/2` rows per view, left on top, the blank
+//! This screen lays the frame out exactly as
+//! [`above_below_squashed`](super::layout::above_below_squashed) does (`rows = (H − blank)/2` rows per view, left on top, the blank
 //! band between) and draws one arrow in the middle row of each view, their tips meeting at the
 //! centre column: the left eye's arrow points right, the right eye's points left. With the
 //! glasses on, the arrows meet on one line exactly when `layout.blank_interval` matches the
