@@ -459,3 +459,57 @@ fn catalogue_edge_on_slivers_match_the_f64_reference() {
     );
     assert_eq!(m.total(), 0, "slivers differ from the reference: {m:?}");
 }
+
+/// Catalogue: D1 = D2 is refused by name; D2 one ulp beyond D1, inside the scene's depth range,
+/// is a legal ramp one ulp long: the image must be the ramp's two ends only (a step from red to
+/// blue at D1), with no NaN or infinity turning into black or green pixels. Tolerance: every
+/// lit pixel red or blue by hue, both present. A scene wholly beyond such a thin range is
+/// warned about (the all-outside warning).
+#[test]
+fn catalogue_chromadepth_d1_equal_to_d2_within_an_ulp() {
+    let out = render(
+        "chromadepth_molecule.toml",
+        "hard_cases_d1_d2_equal",
+        &["chromadepth.d1=10", "chromadepth.d2=10"],
+    );
+    assert_refused(&out, &["chromadepth.d2", "chromadepth.d1"]);
+    let d2 = format!("chromadepth.d2={}", 10.0f32.next_up());
+    let out = render(
+        "chromadepth_molecule.toml",
+        "hard_cases_d1_d2_ulp",
+        &["chromadepth.d1=10", &d2, "outputs=[\"chromadepth\"]"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // `render` made this folder (`out_dir` would empty it again).
+    let dir = crate::common::root().join("target/test-out/hard_cases_d1_d2_ulp");
+    let img = image::open(dir.join("chromadepth.png"))
+        .expect("chromadepth.png")
+        .to_rgb8();
+    let (mut red, mut blue) = (0, 0);
+    for p in img.pixels() {
+        let [r, g, b] = p.0;
+        if r.max(g).max(b) < 24 {
+            continue; // background or a pixel lit too dimly to have a hue
+        }
+        assert!(
+            g < r.max(b),
+            "a pixel that is neither end of the ramp: {:?}",
+            p.0
+        );
+        if r > b { red += 1 } else { blue += 1 }
+    }
+    assert!(
+        red > 20 && blue > 20,
+        "red {red}, blue {blue}: the step must show both ends"
+    );
+    let beyond = render(
+        "chromadepth_molecule.toml",
+        "hard_cases_d1_d2_ulp_beyond",
+        &["chromadepth.d1=5", "chromadepth.d2=5.0000005"],
+    );
+    assert_warned(&beyond, &["beyond chromadepth.d2"]);
+}
