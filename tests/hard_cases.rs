@@ -513,3 +513,47 @@ fn catalogue_chromadepth_d1_equal_to_d2_within_an_ulp() {
     );
     assert_warned(&beyond, &["beyond chromadepth.d2"]);
 }
+
+/// Catalogue: the SIRDS paper's eq. 3, `d = a t / (t + f)`, near its pole `t + f ≈ 0` (a point
+/// almost at the eyes). Sterbenz's lemma makes `t + f` exact in f32 when t is within a factor 2
+/// of −f, so only the product and the quotient round: tolerance 4 ulp relative to the same
+/// formula in f64 on the same inputs. At and behind the pole (`t + f ≤ 0`) the result is a
+/// refusal naming `t + f`, never an infinity or NaN passed on.
+#[test]
+fn catalogue_sirds_eq3_near_the_pole_stays_within_ulps_or_is_refused() {
+    use stereolab::effects::sirds::disparity::separation_eye_distance;
+    let (a, f) = (180.0f32, 864.0f32);
+    let mut t = -f + 1.0;
+    let mut checked = 0;
+    let mut last_gap = f32::NAN;
+    while t + f > 0.0 {
+        last_gap = t + f;
+        let d = separation_eye_distance(t, a, f).expect("in front of the pole");
+        let exact = f64::from(a) * f64::from(t) / (f64::from(t) + f64::from(f));
+        assert!(d.is_finite(), "t + f = {:e}: {d}", t + f);
+        let rel = ((f64::from(d) - exact) / exact).abs();
+        assert!(
+            rel <= 4.0 * f64::from(f32::EPSILON),
+            "t + f = {:e}: {d} against {exact} ({rel:e} relative)",
+            t + f
+        );
+        checked += 1;
+        // Halve the distance to the pole, down to its last representable step.
+        let next = -f + (t + f) * 0.5;
+        if next == t {
+            break;
+        }
+        t = next;
+    }
+    // From t + f = 1 down to f32's last step below 864 (2^-14): 15 halvings.
+    assert!(checked >= 15, "{checked} steps towards the pole");
+    assert_eq!(
+        last_gap,
+        2f32.powi(-14),
+        "the walk must reach the last step before the pole"
+    );
+    for t in [-f, -f - 1.0, (-f).next_down()] {
+        let err = separation_eye_distance(t, a, f).expect_err("at or behind the pole");
+        assert!(err.to_string().contains("t + f"), "{err}");
+    }
+}
