@@ -557,3 +557,81 @@ fn catalogue_sirds_eq3_near_the_pole_stays_within_ulps_or_is_refused() {
         assert!(err.to_string().contains("t + f"), "{err}");
     }
 }
+
+/// Catalogue: toe-in at extreme separations, from 1e-6 to 1e6 times the model's size. Each
+/// eye's f32 matrix (`StereoRig::eyes_for_image`, what every render uses) against the f64
+/// reference rig (`stereolab::reference::eye`) on the model's bounding-box corners and
+/// centre. Tolerance: 0.01 px on a 320×240 image for every point in front of the eye; a
+/// separation whose cameras overflow is refused by name instead (`1e20`, tested above).
+#[test]
+fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
+    use glam::{DVec3, Vec3};
+    use stereolab::math::CameraMode;
+    let path = asset("scenes/anaglyph.toml");
+    let (w, h) = (320u32, 240u32);
+    let mut worst = 0.0f64;
+    let mut checked = 0;
+    for exp in -6..=6 {
+        let sep = 10f64.powi(exp);
+        let sets = vec![
+            "stereo.mode=\"toe-in\"".to_string(),
+            format!("stereo.eye_separation={sep:e}"),
+        ];
+        let scene = stereolab::scene::Scene::load(&path, &sets).expect("scene");
+        assert_eq!(scene.rig.mode, CameraMode::ToeIn);
+        let aspect = f64::from(w) / f64::from(h);
+        let resolved = scene
+            .rig
+            .resolve(&scene.camera, aspect as f32)
+            .expect("resolve");
+        let eyes = scene
+            .rig
+            .eyes_for_image(&scene.camera, w, h)
+            .expect("toe-in eyes");
+        let target = DVec3::from(scene.camera.target.map(f64::from));
+        let mut points: Vec<DVec3> = Vec::new();
+        for dx in [-1.0, 1.0] {
+            for dy in [-1.0, 1.0] {
+                for dz in [-1.0, 1.0] {
+                    points.push(target + DVec3::new(dx, dy, dz));
+                }
+            }
+        }
+        points.push(target);
+        for (side, eye) in [(-1.0, &eyes[0]), (1.0, &eyes[1])] {
+            let m64 = stereolab::reference::eye(
+                &scene.rig,
+                &scene.camera,
+                aspect,
+                f64::from(resolved.eye_separation),
+                f64::from(resolved.zero_parallax_distance),
+                side,
+            );
+            for p in &points {
+                let c64 = m64 * p.extend(1.0);
+                if c64.w <= 0.0 {
+                    continue;
+                }
+                let c32 = (eye.mvp * Vec3::new(p.x as f32, p.y as f32, p.z as f32).extend(1.0))
+                    .as_dvec4();
+                let px = |c: glam::DVec4| {
+                    (
+                        (c.x / c.w + 1.0) * 0.5 * f64::from(w),
+                        (c.y / c.w + 1.0) * 0.5 * f64::from(h),
+                    )
+                };
+                let (a, b) = (px(c32), px(c64));
+                let err = (a.0 - b.0).hypot(a.1 - b.1);
+                assert!(
+                    err <= 0.01,
+                    "separation {sep:e}, side {side}: {p:?} lands {err:e} px from the f64 rig"
+                );
+                worst = worst.max(err);
+                checked += 1;
+            }
+        }
+    }
+    // 13 separations × 2 eyes × 9 points, every one in front of its eye.
+    assert_eq!(checked, 13 * 2 * 9);
+    eprintln!("toe-in 1e-6 … 1e6: worst {worst:e} px from the f64 rig");
+}
