@@ -635,3 +635,61 @@ fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
     assert_eq!(checked, 13 * 2 * 9);
     eprintln!("toe-in 1e-6 … 1e6: worst {worst:e} px from the f64 rig");
 }
+
+/// Catalogue: the remap (right eye's pixel for each left-eye pixel, `effects::remap`) with the
+/// near plane at 1e-6 of the far plane, where window depth crowds against 1.0, on every pixel
+/// the left eye draws. The CPU outputs remap in f64 (`Precision::default()`), the reference
+/// itself. The WGSL mirror's way (`F32Composed`: composed in f64, applied in f32) must stay
+/// within 0.5 px, half a texel (a remap that lands in the wrong texel fetches the wrong
+/// color). The exercise slides' way (`F32`, through world space) is measured and printed; at
+/// this ratio the near plane is warned about, naming `camera.near`.
+#[test]
+fn catalogue_remap_at_near_far_1e_minus_6_stays_within_half_a_pixel() {
+    use stereolab::effects::remap::{Precision, remap_coordinates};
+    use stereolab::plan::{Output as Out, Plan, View};
+    let (w, h) = (160u32, 120u32);
+    let sets = vec!["camera.near=2e-5".to_string()];
+    let mut scene =
+        stereolab::scene::Scene::load(&asset("scenes/anaglyph.toml"), &sets).expect("scene");
+    scene.set_size(w, h).expect("size");
+    assert!(scene.camera.near / scene.camera.far <= 1e-6);
+    assert_eq!(
+        Precision::default(),
+        Precision::F64,
+        "the outputs remap in f64"
+    );
+    let frame = stereolab::render::render(&scene, &Plan::new(&[Out::RemapLeft])).expect("render");
+    let left = frame.view(View::Left).expect("left pass");
+    let (ml, mr) = (frame.eyes[0].mvp, frame.eyes[1].mvp);
+    let exact = remap_coordinates(left, &ml, &mr, Precision::F64).expect("f64");
+    let worst_of = |p: Precision| {
+        let got = remap_coordinates(left, &ml, &mr, p).expect("remap");
+        let (mut drawn, mut worst) = (0, 0.0f64);
+        for ((a, b), d) in exact.iter().zip(&got).zip(&left.depth) {
+            if *d >= 1.0 {
+                continue;
+            }
+            drawn += 1;
+            let Some(a) = a else { continue };
+            let e = b.map_or(f64::INFINITY, |b| {
+                let (pa, pb) = (a.window(w, h), b.window(w, h));
+                (pa[0] - pb[0]).hypot(pa[1] - pb[1])
+            });
+            worst = worst.max(e);
+        }
+        (drawn, worst)
+    };
+    let (drawn, composed) = worst_of(Precision::F32Composed);
+    let (_, slides) = worst_of(Precision::F32);
+    eprintln!(
+        "remap at near/far 1e-6 on {drawn} pixels: f32 composed {composed:e} px, \
+         f32 through world space {slides:e} px from f64"
+    );
+    assert!(drawn > 1000, "{drawn} pixels drawn");
+    assert!(
+        composed <= 0.5,
+        "f32 composed remap is {composed} px off f64"
+    );
+    let out = info("anaglyph.toml", &["camera.near=2e-5"]);
+    assert_warned(&out, &["camera.near"]);
+}
