@@ -693,3 +693,92 @@ fn catalogue_remap_at_near_far_1e_minus_6_stays_within_half_a_pixel() {
     let out = info("anaglyph.toml", &["camera.near=2e-5"]);
     assert_warned(&out, &["camera.near"]);
 }
+
+/// Catalogue: a model of size 2 at distance `t` from the origin, the camera 6 units from it.
+/// The renderer's f32 view (`math::look_at`, `math::frustum`) against the f64 rig on the same
+/// f32 vertices, so only the transform's precision is measured. Tolerance: no decided pixel
+/// differs while f32 spaces coordinates there at most 1e-4 of the model's size (where the
+/// scene check stays silent, `ORIGIN_PRECISION_WARN`); beyond, the check warns (tested in
+/// `a_model_far_from_the_origin_is_warned_about_with_the_precision_lost`), and at 1e7 the
+/// image is visibly wrong, which is why it must.
+#[test]
+fn catalogue_coordinates_far_from_the_origin_against_the_f64_reference() {
+    use glam::{DVec3, Vec3};
+    use stereolab::framebuffer::Framebuffer;
+    use stereolab::raster::{RasterOptions, rasterize};
+    use stereolab::reference::{IdShader, compare, soup, visible};
+    let (w, h) = (160u32, 120u32);
+    let (near, far) = (0.5f32, 20.0f32);
+    let aspect = w as f32 / h as f32;
+    let mut shares = Vec::new();
+    for t in [0.0f64, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7] {
+        let c = DVec3::new(t, 0.0, 0.0);
+        // Three overlapping squares 0.3 apart in depth, and a slanted one through them.
+        let mut world = Vec::new();
+        let mut triangles = Vec::new();
+        for (k, (dx, dy, dz)) in [(-0.3, -0.2, 0.0), (0.0, 0.1, -0.3), (0.3, -0.1, -0.6)]
+            .into_iter()
+            .enumerate()
+        {
+            let base = (4 * k) as u32;
+            for (sx, sy) in [(-0.7, -0.7), (0.7, -0.7), (0.7, 0.7), (-0.7, 0.7)] {
+                world.push(c + DVec3::new(dx + sx, dy + sy, dz));
+            }
+            triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+        }
+        let base = world.len() as u32;
+        world.extend([
+            c + DVec3::new(-1.0, -1.0, 0.4),
+            c + DVec3::new(1.0, -1.0, -1.0),
+            c + DVec3::new(0.0, 1.0, -0.3),
+        ]);
+        triangles.push([base, base + 1, base + 2]);
+        // The vertices as the renderer holds them (f32); the reference reads the same values.
+        let positions: Vec<Vec3> = world.iter().map(|p| p.as_vec3()).collect();
+        let world: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
+        let eye = c + DVec3::new(0.5, 0.8, 6.0);
+        // A 34° vertical field of view: the model fills most of the image.
+        let (x, y) = (0.15 * near * aspect, 0.15 * near);
+        let mvp = stereolab::math::frustum(-x, x, -y, y, near, far)
+            * stereolab::math::look_at(eye.as_vec3(), c.as_vec3(), Vec3::Y);
+        let (n, f, a) = (f64::from(near), f64::from(far), f64::from(aspect));
+        let (x, y) = (0.15 * n * a, 0.15 * n);
+        let mvp64 = stereolab::reference::frustum(-x, x, -y, y, n, f)
+            * stereolab::reference::look_at(eye, c, DVec3::Y);
+        let reference = visible(&world, &triangles, &mvp64, w, h);
+        let soup_positions = soup(&positions, &triangles);
+        let soup_triangles: Vec<[u32; 3]> = (0..triangles.len() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect();
+        let shader = IdShader {
+            positions: &soup_positions,
+            mvp,
+        };
+        let mut fb = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("framebuffer");
+        rasterize(
+            &soup_triangles,
+            soup_positions.len(),
+            &shader,
+            &mut fb,
+            &RasterOptions::default(),
+        );
+        let m = compare(&fb, &reference);
+        assert!(m.covered > 2000, "t = {t:e}: {m:?}");
+        let share = m.total() as f64 / m.covered as f64;
+        let spacing = f64::from((t as f32 + 1.0).next_up() - (t as f32 + 1.0));
+        let silent = spacing <= 1e-4 * 2.0;
+        eprintln!("t = {t:e}: {m:?}, spacing {spacing:e}, warned {}", !silent);
+        if silent {
+            assert_eq!(
+                m.total(),
+                0,
+                "t = {t:e}: differs from the f64 reference: {m:?}"
+            );
+        }
+        shares.push(share);
+    }
+    assert!(
+        shares[7] > 0.05,
+        "at 1e7 the f32 view must go visibly wrong (else the warning warns of nothing): {shares:?}"
+    );
+}
