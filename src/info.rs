@@ -248,8 +248,47 @@ pub fn frame_budget_report(frame: &Frame, scene: &Scene) -> Result<Option<String
         if let Some(fb) = frame.view(view) {
             let b = budget_of(fb, &rig)?;
             let shift = image_shift_line(scene)?.unwrap_or_default();
-            return Ok(Some(format!("  {name} eye {}{shift}", b.report())));
+            let step = depth_step_parallax(fb, &rig);
+            let uncertain = if step > DEPTH_STEP_PARALLAX_WARN {
+                format!(
+                    "\n  warning: one step of the f32 depth buffer at the scene's nearest or \
+                     farthest surface is worth {step:.2} px of parallax, so these parallax \
+                     figures (read back from depth) are uncertain by that much; raise \
+                     camera.near (or set raster.depth = \"reversed-z\"; `stereolab info` \
+                     computes the range from the vertices instead)"
+                )
+            } else {
+                String::new()
+            };
+            return Ok(Some(format!(
+                "  {name} eye {}{shift}{uncertain}",
+                b.report()
+            )));
         }
     }
     Ok(None)
+}
+
+/// A depth step worth more parallax than this (pixels) makes the budget's figures uncertain.
+pub const DEPTH_STEP_PARALLAX_WARN: f64 = 0.1;
+
+/// The parallax, in pixels, of one step of the f32 depth buffer at the nearest and at the
+/// farthest drawn depth of `fb` (the larger of the two): how far a budget read back from the
+/// depth buffer can be off. 0 when nothing is drawn.
+pub fn depth_step_parallax(
+    fb: &crate::Framebuffer,
+    rig: &crate::effects::parallax::ParallaxRig,
+) -> f64 {
+    let drawn = fb.depth.iter().copied().filter(|d| *d < 1.0);
+    let (lo, hi) = drawn.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| {
+        (lo.min(d), hi.max(d))
+    });
+    [lo, hi]
+        .into_iter()
+        .filter(|d| d.is_finite())
+        .filter_map(|d| {
+            let next = d.next_up();
+            Some((rig.parallax_pixels(next)? - rig.parallax_pixels(d)?).abs())
+        })
+        .fold(0.0, f64::max)
 }

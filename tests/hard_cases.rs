@@ -782,3 +782,23 @@ fn catalogue_coordinates_far_from_the_origin_against_the_f64_reference() {
         "at 1e7 the f32 view must go visibly wrong (else the warning warns of nothing): {shares:?}"
     );
 }
+
+/// The parallax budget is read back from the depth buffer; where one depth step is worth
+/// more than 0.1 px of parallax (`info::DEPTH_STEP_PARALLAX_WARN`), its figures are uncertain
+/// by that much and the report says so (issue 18: at near 1e-6 / far 1e7 the budget said
+/// −0.86 px where the vertices give −0.5 px, silently). A well-set near plane stays silent.
+#[test]
+fn a_budget_read_from_a_too_coarse_depth_buffer_says_it_is_uncertain() {
+    let out = render(
+        "wuson.toml",
+        "hard_cases_budget_uncertain",
+        &["camera.near=1e-5", "camera.far=1e5"],
+    );
+    assert_warned(&out, &["parallax figures", "uncertain", "camera.near"]);
+    let out = render(
+        "wuson.toml",
+        "hard_cases_budget_certain",
+        &["camera.near=1", "camera.far=20"],
+    );
+    assert_no_warning_naming(&out, "uncertain");
+}
