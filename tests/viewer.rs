@@ -47,6 +47,7 @@ struct Xvfb {
 
 fn start_xvfb() -> Xvfb {
     let xvfb = need("Xvfb", "xvfb");
+    let xdotool = need("xdotool", "xdotool");
     let first = 70 + std::process::id() % 100;
     for n in first..first + 40 {
         if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
@@ -71,7 +72,19 @@ fn start_xvfb() -> Xvfb {
         let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
         let start = Instant::now();
         while start.elapsed() < Duration::from_secs(10) {
-            if socket.exists() {
+            // Ready means an X client completes its handshake, not only that the socket file
+            // exists: in a CI run under load the viewer once found the socket but could not
+            // open a connection (winit: "Failed to open connection to X server").
+            let serving = || {
+                Command::new(&xdotool)
+                    .arg("getdisplaygeometry")
+                    .env("DISPLAY", format!(":{n}"))
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::null())
+                    .status()
+                    .is_ok_and(|s| s.success())
+            };
+            if socket.exists() && serving() {
                 return Xvfb {
                     _server: server,
                     display: format!(":{n}"),
@@ -108,22 +121,33 @@ fn json(path: &Path) -> Option<serde_json::Value> {
 impl Viewer<'_> {
     fn start<'a>(x: &'a Xvfb, out: &Path, args: &[&str]) -> Viewer<'a> {
         let state = out.join("state.json");
-        let log = std::fs::File::create(out.join("viewer.log")).expect("log file");
-        let child = stereolab()
-            .arg("view")
-            .args(args)
-            .arg("--shots")
-            .arg(out)
-            .arg("--state-file")
-            .arg(&state)
-            .env("DISPLAY", &x.display)
-            .env_remove("WAYLAND_DISPLAY")
-            .env("LIBGL_ALWAYS_SOFTWARE", "1")
-            .stdout(log.try_clone().expect("log"))
-            .stderr(log)
-            .spawn()
-            .expect("start stereolab view");
-        let child = Killed(child);
+        let log_path = out.join("viewer.log");
+        let _ = std::fs::remove_file(&log_path);
+        let spawn = || {
+            let log = std::fs::File::options()
+                .create(true)
+                .append(true)
+                .open(&log_path)
+                .expect("log file");
+            Killed(
+                stereolab()
+                    .arg("view")
+                    .args(args)
+                    .arg("--shots")
+                    .arg(out)
+                    .arg("--state-file")
+                    .arg(&state)
+                    .env("DISPLAY", &x.display)
+                    .env_remove("WAYLAND_DISPLAY")
+                    .env("LIBGL_ALWAYS_SOFTWARE", "1")
+                    .stdout(log.try_clone().expect("log"))
+                    .stderr(log)
+                    .spawn()
+                    .expect("start stereolab view"),
+            )
+        };
+        let mut child = spawn();
+        let mut attempts = 1;
         let xdotool = need("xdotool", "xdotool");
         let start = Instant::now();
         let window = loop {
@@ -136,10 +160,23 @@ impl Viewer<'_> {
             if let Some(id) = text.lines().next().filter(|l| !l.trim().is_empty()) {
                 break id.trim().to_string();
             }
+            let log = std::fs::read_to_string(&log_path).unwrap_or_default();
+            // A viewer that could not connect to a busy X server exits at once with the
+            // error naming DISPLAY (the behaviour `missing_display` checks); the test's
+            // server is up (`start_xvfb` waited for a client handshake), so try twice more
+            // before calling it a failure.
+            if let Ok(Some(_)) = child.0.try_wait() {
+                assert!(
+                    attempts < 3 && log.contains("could not open the viewer's window"),
+                    "the viewer exited ({attempts} attempts); its log: {log}"
+                );
+                std::thread::sleep(Duration::from_secs(1));
+                child = spawn();
+                attempts += 1;
+            }
             assert!(
                 start.elapsed() < Duration::from_secs(90),
-                "no viewer window after 90 s; its log: {}",
-                std::fs::read_to_string(out.join("viewer.log")).unwrap_or_default()
+                "no viewer window after 90 s; its log: {log}"
             );
             std::thread::sleep(Duration::from_millis(100));
         };
