@@ -334,29 +334,18 @@ fn depth_mode_values_are_checked_by_name() {
     );
 }
 
-/// Draws `triangles` (eye space: the camera at the origin looking down −Z) through a symmetric
-/// frustum on the CPU, as triangle ids, and compares each pixel the f64 reference decides with
-/// the reference's winner (`stereolab::reference`).
-fn against_reference(
+/// Draws `triangles` through `mvp` on the CPU, as triangle ids, and compares each pixel the
+/// f64 reference decides (the same f32 vertices through `mvp64`) with the reference's winner
+/// (`stereolab::reference`).
+fn against_reference_through(
     positions: &[glam::Vec3],
     triangles: &[[u32; 3]],
-    (near, far): (f32, f32),
+    (mvp, mvp64): (glam::Mat4, glam::DMat4),
     (width, height): (u32, u32),
 ) -> stereolab::reference::Mismatch {
     use stereolab::framebuffer::Framebuffer;
     use stereolab::raster::{RasterOptions, rasterize};
     use stereolab::reference::{IdShader, compare, soup, visible};
-    let aspect = width as f32 / height as f32;
-    let (a, b) = (near * aspect, near);
-    let mvp = stereolab::math::frustum(-a, a, -b, b, near, far);
-    let mvp64 = stereolab::reference::frustum(
-        -f64::from(a),
-        f64::from(a),
-        -f64::from(b),
-        f64::from(b),
-        f64::from(near),
-        f64::from(far),
-    );
     let world: Vec<glam::DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
     let reference = visible(&world, triangles, &mvp64, width, height);
     let soup_positions = soup(positions, triangles);
@@ -376,6 +365,28 @@ fn against_reference(
         &RasterOptions::default(),
     );
     compare(&fb, &reference)
+}
+
+/// [`against_reference_through`] for triangles in eye space (the camera at the origin looking
+/// down −Z) through a symmetric frustum.
+fn against_reference(
+    positions: &[glam::Vec3],
+    triangles: &[[u32; 3]],
+    (near, far): (f32, f32),
+    (width, height): (u32, u32),
+) -> stereolab::reference::Mismatch {
+    let aspect = width as f32 / height as f32;
+    let (a, b) = (near * aspect, near);
+    let mvp = stereolab::math::frustum(-a, a, -b, b, near, far);
+    let mvp64 = stereolab::reference::frustum(
+        -f64::from(a),
+        f64::from(a),
+        -f64::from(b),
+        f64::from(b),
+        f64::from(near),
+        f64::from(far),
+    );
+    against_reference_through(positions, triangles, (mvp, mvp64), (width, height))
 }
 
 /// Catalogue: triangles crossing w = 0 (a vertex behind the eye) and the near plane. The CPU
@@ -704,9 +715,6 @@ fn catalogue_remap_at_near_far_1e_minus_6_stays_within_half_a_pixel() {
 #[test]
 fn catalogue_coordinates_far_from_the_origin_against_the_f64_reference() {
     use glam::{DVec3, Vec3};
-    use stereolab::framebuffer::Framebuffer;
-    use stereolab::raster::{RasterOptions, rasterize};
-    use stereolab::reference::{IdShader, compare, soup, visible};
     let (w, h) = (160u32, 120u32);
     let (near, far) = (0.5f32, 20.0f32);
     let aspect = w as f32 / h as f32;
@@ -735,7 +743,6 @@ fn catalogue_coordinates_far_from_the_origin_against_the_f64_reference() {
         triangles.push([base, base + 1, base + 2]);
         // The vertices as the renderer holds them (f32); the reference reads the same values.
         let positions: Vec<Vec3> = world.iter().map(|p| p.as_vec3()).collect();
-        let world: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
         let eye = c + DVec3::new(0.5, 0.8, 6.0);
         // A 34° vertical field of view: the model fills most of the image.
         let (x, y) = (0.15 * near * aspect, 0.15 * near);
@@ -745,24 +752,7 @@ fn catalogue_coordinates_far_from_the_origin_against_the_f64_reference() {
         let (x, y) = (0.15 * n * a, 0.15 * n);
         let mvp64 = stereolab::reference::frustum(-x, x, -y, y, n, f)
             * stereolab::reference::look_at(eye, c, DVec3::Y);
-        let reference = visible(&world, &triangles, &mvp64, w, h);
-        let soup_positions = soup(&positions, &triangles);
-        let soup_triangles: Vec<[u32; 3]> = (0..triangles.len() as u32)
-            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-            .collect();
-        let shader = IdShader {
-            positions: &soup_positions,
-            mvp,
-        };
-        let mut fb = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("framebuffer");
-        rasterize(
-            &soup_triangles,
-            soup_positions.len(),
-            &shader,
-            &mut fb,
-            &RasterOptions::default(),
-        );
-        let m = compare(&fb, &reference);
+        let m = against_reference_through(&positions, &triangles, (mvp, mvp64), (w, h));
         assert!(m.covered > 2000, "t = {t:e}: {m:?}");
         let share = m.total() as f64 / m.covered as f64;
         let spacing = f64::from((t as f32 + 1.0).next_up() - (t as f32 + 1.0));

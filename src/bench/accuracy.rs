@@ -9,7 +9,7 @@
 //! Another benchmark group plugs in by building `Knob`s (a name, the error unit, the time
 //! unit, its points as label / error / seconds, notes) and appending them in [`knobs`].
 
-use glam::{DMat4, DVec3, DVec4, Vec3};
+use glam::{DMat4, DVec4, Vec3};
 
 use super::{Row, median_ms};
 use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
@@ -20,7 +20,7 @@ use crate::effects::sirds::{
 use crate::error::{Error, Result};
 use crate::figures::plot::{Knob, Point};
 use crate::figures::vertical_parallax_grid;
-use crate::math::{CameraMode, Separation, ZeroParallax};
+use crate::math::{CameraMode, Separation};
 use crate::plan::{Output, Plan, Shading, View};
 use crate::render::{render, render_view};
 use crate::scene::{Mesh, Scene};
@@ -273,44 +273,22 @@ pub fn off_axis_mvp_f64(scene: &Scene, side: f64) -> Result<DMat4> {
         ));
     }
     let c = &scene.camera;
-    let v = |a: [f32; 3]| DVec3::new(a[0].into(), a[1].into(), a[2].into());
-    // gluLookAt, as `crate::math::look_at` in f64.
-    let (eye, fwd) = (v(c.eye), (v(c.target) - v(c.eye)).normalize());
-    let right = fwd.cross(v(c.up)).normalize();
-    let up = right.cross(fwd);
-    let view = DMat4::from_cols(
-        DVec4::new(right.x, up.x, -fwd.x, 0.0),
-        DVec4::new(right.y, up.y, -fwd.y, 0.0),
-        DVec4::new(right.z, up.z, -fwd.z, 0.0),
-        DVec4::new(-right.dot(eye), -up.dot(eye), fwd.dot(eye), 1.0),
-    );
     let aspect = f64::from(scene.width) / f64::from(scene.height);
-    let (n, f) = (f64::from(c.near), f64::from(c.far));
     let tan = (f64::from(c.fov_y).to_radians() * 0.5).tan();
-    let z0 = match scene.rig.zero_parallax {
-        ZeroParallax::Distance(z) => f64::from(z),
-        ZeroParallax::Fraction(t) => n + f64::from(t) * (f - n),
-    };
+    let z0 = crate::reference::zero_parallax(&scene.rig, c);
     let base = match scene.rig.separation {
         Separation::Absolute(d) => f64::from(d),
         Separation::Auto => 2.0 * (2.0 * z0 * tan * aspect) * 0.035,
     };
-    let half = 0.5 * base * f64::from(scene.rig.user_offset);
-    let (h, w) = (n * tan, n * tan * aspect);
-    let shift = -side * half * f64::from(scene.rig.user_balance) * n / z0;
-    let (l, r, b, t) = (-w + shift, w + shift, -h, h);
-    let p = DMat4::from_cols(
-        DVec4::new(2.0 * n / (r - l), 0.0, 0.0, 0.0),
-        DVec4::new(0.0, 2.0 * n / (t - b), 0.0, 0.0),
-        DVec4::new(
-            (r + l) / (r - l),
-            (t + b) / (t - b),
-            (n + f) / (n - f),
-            -1.0,
-        ),
-        DVec4::new(0.0, 0.0, 2.0 * n * f / (n - f), 0.0),
-    );
-    Ok(p * DMat4::from_translation(DVec3::new(-side * half, 0.0, 0.0)) * view)
+    // The rig in f64 (`crate::reference::eye`), with the separation resolved in f64 as above.
+    Ok(crate::reference::eye(
+        &scene.rig,
+        c,
+        aspect,
+        base * f64::from(scene.rig.user_offset),
+        z0,
+        side,
+    ))
 }
 
 /// Window x, y (pixels) of every vertex of every object in both eyes, for the three ways

@@ -20,7 +20,7 @@ use glam::Mat4;
 use image::RgbaImage;
 use serde::Deserialize;
 
-use super::eye_input::check_depth;
+use super::eye_input::{check_depth, check_same_size};
 use super::remap::{Precision, Remapper, Visibility, classify, depth_slope, tolerance};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
@@ -65,14 +65,9 @@ impl RdsSettings {
 const WHITE: [u8; 4] = [255, 255, 255, 255];
 const BLACK: [u8; 4] = [0, 0, 0, 255];
 
-/// SplitMix64's finalizer: every dot is a pure function of (seed, x, y), so the bytes do not
-/// depend on the order pixels are computed in.
-#[inline]
-fn mix(mut v: u64) -> u64 {
-    v = (v ^ (v >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    v = (v ^ (v >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    v ^ (v >> 31)
-}
+// Every dot is a pure function of (seed, x, y) through SplitMix64's finalizer, the SIRDS
+// patterns' own hash, so the bytes do not depend on the order pixels are computed in.
+use super::sirds::pattern::mix;
 
 /// The dot covering pixel (x, y) of the texture with `seed`: black or white with equal chance.
 #[inline]
@@ -135,16 +130,7 @@ pub fn rds_right(
     s: &RdsSettings,
 ) -> Result<RgbaImage> {
     s.validate()?;
-    if (left.width, left.height) != (right.width, right.height) {
-        return Err(Error::invalid(
-            "eye framebuffers",
-            format!(
-                "{}x{} vs {}x{}",
-                left.width, left.height, right.width, right.height
-            ),
-            "left and right must have the same size",
-        ));
-    }
+    check_same_size(left, right)?;
     check_depth("left", left)?;
     check_depth("right", right)?;
     let r = Remapper::new(

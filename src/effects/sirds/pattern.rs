@@ -30,7 +30,7 @@ pub enum Pattern {
 /// SplitMix64's finalizer: a well-mixed 64-bit hash, so every pixel's dot is a pure function of
 /// (seed, x, y) — the same bytes for any thread count.
 #[inline]
-fn mix(mut v: u64) -> u64 {
+pub(crate) fn mix(mut v: u64) -> u64 {
     v = (v ^ (v >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     v = (v ^ (v >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     v ^ (v >> 31)
