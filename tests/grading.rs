@@ -128,11 +128,11 @@ fn solution_scores_full_marks_on_every_task() {
     for t in tests_of(&v) {
         assert_eq!(t["status"], "passed", "{}: {}", t["name"], t["output"]);
     }
-    // 17 + 5 + 5 points, plus ex1's Dubois bonus point.
-    assert_eq!(v["score"].as_f64(), Some(28.0), "{v}");
+    // 19 + 5 + 5 points, plus ex1's Dubois bonus point.
+    assert_eq!(v["score"].as_f64(), Some(30.0), "{v}");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        stdout.contains("\nPASSED: 28.00 of 27.00 points"),
+        stdout.contains("\nPASSED: 30.00 of 29.00 points"),
         "{stdout}"
     );
 }
@@ -159,7 +159,7 @@ fn untouched_stubs_score_zero_and_the_grader_exits_cleanly_with_the_table() {
         "the points table:\n{stdout}"
     );
     assert!(
-        stdout.contains("NOT PASSED: 0.00 of 27.00 points"),
+        stdout.contains("NOT PASSED: 0.00 of 29.00 points"),
         "{stdout}"
     );
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
@@ -250,6 +250,7 @@ fn swapped_eyes_transposed_anaglyph_opengl_depth_nan_reversed_ramp_full_disparit
                 loses: &[
                     ("ex1 remap", "opengl-depth"),
                     ("ex1 remap_right_to_left", "depends-on"),
+                    ("ex1 rds_right", "depends-on"),
                 ],
             },
             Planted {
@@ -327,6 +328,7 @@ fn mv_t_order_one_sided_depth_hue_to_360_and_degrees_lose_all_points_with_their_
                 loses: &[
                     ("ex1 remap", "one-sided-depth"),
                     ("ex1 remap_right_to_left", "depends-on"),
+                    ("ex1 rds_right", "depends-on"),
                 ],
             },
             Planted {
@@ -383,6 +385,8 @@ fn transposed_frustum_fails_stereo_matrices_through_its_dependency_and_no_w_divi
                 loses: &[
                     ("ex1 remap", "no-w-divide"),
                     ("ex1 remap_right_to_left", "depends-on"),
+                    // Its toe-in pair has clip.w ≠ 1 (the off-axis pairs have w = 1).
+                    ("ex1 rds_right", "depends-on"),
                 ],
             },
         ],
@@ -415,7 +419,10 @@ fn the_sheets_frustum_remapping_back_and_the_finalize_pixel_lose_points_with_the
             },
             Planted {
                 mutant: "remap-back-same-order",
-                loses: &[("ex1 remap_right_to_left", "matrix-order")],
+                loses: &[
+                    ("ex1 remap_right_to_left", "matrix-order"),
+                    ("ex1 rds_right", "depends-on"),
+                ],
             },
             Planted {
                 mutant: "finalize-transposed",
@@ -445,6 +452,42 @@ fn the_sheets_frustum_remapping_back_and_the_finalize_pixel_lose_points_with_the
             loses: &[("ex1 finalize_pixel", "swapped-eyes")],
         }],
         "mutants_i",
+    );
+}
+
+#[test]
+fn the_random_dot_pair_s_mistakes_lose_its_points_with_their_hints() {
+    check_planted(
+        "ex1",
+        &[Planted {
+            mutant: "rds-no-visibility",
+            loses: &[("ex1 rds_right", "rds-no-visibility")],
+        }],
+        "mutants_rds_a",
+    );
+    check_planted(
+        "ex1",
+        &[Planted {
+            mutant: "rds-v-not-flipped",
+            loses: &[("ex1 rds_right", "rds-v-not-flipped")],
+        }],
+        "mutants_rds_b",
+    );
+    check_planted(
+        "ex1",
+        &[Planted {
+            mutant: "rds-pixel-corner",
+            loses: &[("ex1 rds_right", "rds-pixel-corner")],
+        }],
+        "mutants_rds_c",
+    );
+    check_planted(
+        "ex1",
+        &[Planted {
+            mutant: "rds-left-fallback",
+            loses: &[("ex1 rds_right", "rds-left-fallback")],
+        }],
+        "mutants_rds_d",
     );
 }
 
@@ -832,8 +875,8 @@ fn render_exercise_writes_the_solution_next_to_the_reference_on_any_scene() {
         String::from_utf8_lossy(&out.stderr)
     );
     // Four eye renders, four anaglyphs, two finalize pictures, remap both ways, visibility,
-    // parallax colors.
-    assert_eq!(stdout.lines().count(), 14, "{stdout}");
+    // the random-dot pair's right dots and anaglyph, parallax colors.
+    assert_eq!(stdout.lines().count(), 16, "{stdout}");
     for line in stdout.lines() {
         assert!(
             line.contains("mismatch   0.00%, mean channel difference   0.00"),

@@ -138,9 +138,9 @@ fn results_json_follows_gradescopes_fields_with_the_bonus_as_extra_credit() {
         "gs_solution",
     );
     let max = check_gradescope_schema(&v);
-    // 17 + 5 + 5 points to reach; ex1's Dubois bonus point beyond them.
-    assert_eq!(max, 27.0, "{v}");
-    assert_eq!(v["score"].as_f64(), Some(28.0), "{v}");
+    // 19 + 5 + 5 points to reach; ex1's Dubois bonus point beyond them.
+    assert_eq!(max, 29.0, "{v}");
+    assert_eq!(v["score"].as_f64(), Some(30.0), "{v}");
     assert!(v["execution_time"].is_u64(), "{v}");
     let bonus: Vec<&Value> = tests_of(&v)
         .iter()
@@ -161,7 +161,7 @@ fn results_json_follows_gradescopes_fields_with_the_bonus_as_extra_credit() {
         v["output"]
             .as_str()
             .unwrap()
-            .contains("PASSED: 28.00 of 27.00"),
+            .contains("PASSED: 30.00 of 29.00"),
         "the full report is the top-level output: {v}"
     );
 
@@ -455,8 +455,8 @@ fn the_gradescope_bundle_runs_in_an_autograder_layout() {
     submit(&root, &files);
     run_script(&root, "run_autograder");
     let v = read_json(&root.join("results/results.json"));
-    assert_eq!(check_gradescope_schema(&v), 27.0, "{v}");
-    assert_eq!(v["score"].as_f64(), Some(28.0), "{v}");
+    assert_eq!(check_gradescope_schema(&v), 29.0, "{v}");
+    assert_eq!(v["score"].as_f64(), Some(30.0), "{v}");
     let tasks = tests_of(&v).len();
 
     // The untouched stubs in the handout's layout, one folder down.

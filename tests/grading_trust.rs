@@ -56,9 +56,9 @@ fn one_shared_build_folder_grades_each_submission_by_its_own_code() {
         let (_, v) = grade("ex1", &[], &dir, None, &format!("shared_{name}"));
         scores.push(score(&v));
     }
-    // Full marks (17 and the bonus), partial (the swapped eyes cost their tasks), zero.
-    assert_eq!(scores[0], 18.0, "{scores:?}");
-    assert!(scores[1] > 2.0 && scores[1] < 17.0, "{scores:?}");
+    // Full marks (19 and the bonus), partial (the swapped eyes cost their tasks), zero.
+    assert_eq!(scores[0], 20.0, "{scores:?}");
+    assert!(scores[1] > 2.0 && scores[1] < 19.0, "{scores:?}");
     assert_eq!(scores[2], 0.0, "{scores:?}");
 }
 
@@ -107,7 +107,7 @@ fn a_solution_that_prints_a_megabyte_in_every_task_still_scores_full_marks() {
     for t in tests_of(&v) {
         assert_eq!(t["status"], "passed", "{}: {}", t["name"], t["output"]);
     }
-    assert_eq!(score(&v), 28.0, "{v}");
+    assert_eq!(score(&v), 30.0, "{v}");
     let out = test_named(&v, "ex2 texgen")["output"].as_str().unwrap();
     assert!(out.contains("debug output that is not an answer"), "{out}");
 }

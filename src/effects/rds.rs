@@ -78,7 +78,7 @@ pub fn dot(seed: u64, dot_size: u32, x: u32, y: u32) -> [u8; 4] {
 }
 
 /// The seed of the second stream, for the pixels only the right eye sees.
-fn right_only_seed(seed: u64) -> u64 {
+pub(crate) fn right_only_seed(seed: u64) -> u64 {
     mix(seed ^ 0x005e_ed0f_4a11_0e5e)
 }
 

@@ -85,6 +85,7 @@ pub fn all() -> Vec<Figure> {
         f("linear_light", "03-finalize", finalize::linear_light),
         f("remap_one_pixel", "04-remap", finalize::remap_one_pixel),
         f("remap_occlusion", "04-remap", finalize::remap_occlusion),
+        f("rds_pair", "04-remap", finalize::rds_pair),
         f(
             "chromadepth_texgen",
             "05-chromadepth",

@@ -191,7 +191,7 @@ Three exercises, one crate each:
 
 | crate | topic | source (see `stereolab/docs/sources.md`) | points |
 | --- | --- | --- | --- |
-| `ex1_stereo` | stereo frusta, anaglyphs, remapping, visibility, parallax | the exercise slides, *Exercise 1: Stereoscopy* | see `grade` |
+| `ex1_stereo` | stereo frusta, anaglyphs, remapping, visibility, parallax, a random-dot pair | the exercise slides, *Exercise 1: Stereoscopy* | see `grade` |
 | `ex2_chromadepth` | the ChromaDepth ramp and texgen | Bailey, Clark: *Using ChromaDepth to obtain Inexpensive Single-image Stereovision for Scientific Visualization* | 5 |
 | `ex3_sirds` | single-image random-dot stereograms | Petz, Goldlücke, Magnor: *Hardware-accelerated Autostereogram Rendering for Interactive 3D Visualization* | 5 |
 
@@ -207,7 +207,7 @@ What is here:
 - `slides/`: the course decks (Marp Markdown), one per topic; each exercise is introduced on the
   slide that teaches its formula. `ex1_stereo`: `01-perception.md` (parallax),
   `02-rig.md` (frusta, stereo matrices), `03-finalize.md` (anaglyphs), `04-remap.md`
-  (remapping, visibility); `ex2_chromadepth`: `05-chromadepth.md`; `ex3_sirds`:
+  (remapping, visibility, the random-dot pair); `ex2_chromadepth`: `05-chromadepth.md`; `ex3_sirds`:
   `06-sirds.md`. Read the Markdown as it is, or build HTML/PDF as `slides/README.md` says.
 - `stereolab/`: the renderer and the grader. `stereolab/docs/sources.md` names the course's
   source documents (title, authors, where to get them); `stereolab/docs/formulas.md` collects the

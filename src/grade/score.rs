@@ -134,10 +134,38 @@ fn fmt_matrices(expected: &[f64], actual: &[f64]) -> String {
     s
 }
 
+/// Answers longer than this (whole images) are described by how many numbers differ.
+const LONG_ANSWER: usize = 48;
+
 /// Why a numeric answer fails, or `None` when it passes.
 fn check(expected: &[f64], actual: &[f64], tol: &Tolerance, full: bool) -> Option<String> {
     if tol.accepts(expected, actual) {
         return None;
+    }
+    if expected.len() == actual.len() && expected.len() > LONG_ANSWER {
+        // A whole image of numbers: how many differ and the first few, not every number.
+        let wrong: Vec<usize> = (0..expected.len())
+            .filter(|&k| !tol.accepts(&expected[k..=k], &actual[k..=k]))
+            .collect();
+        let first: Vec<String> = wrong
+            .iter()
+            .take(3)
+            .map(|&k| {
+                format!(
+                    "element {k}: expected {}, actual {}",
+                    fmt_nums(&expected[k..=k], tol),
+                    fmt_nums(&actual[k..=k], tol)
+                )
+            })
+            .collect();
+        return Some(format!(
+            "{} of {} numbers differ beyond the tolerance {} ({}); the first: {}",
+            wrong.len(),
+            expected.len(),
+            tol.describe(),
+            tol.why,
+            first.join("; ")
+        ));
     }
     let matrices = expected.len() == actual.len() && matches!(expected.len(), 16 | 32);
     let diff = if expected.len() != actual.len() {

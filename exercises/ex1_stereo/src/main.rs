@@ -4,8 +4,22 @@
 use std::process::ExitCode;
 
 use exercise_api::Lighting;
-use exercise_api::{AnaglyphKind, AnaglyphMatrices, ScreenSetup, StereoSetup, serve, task};
+use exercise_api::{
+    AnaglyphKind, AnaglyphMatrices, ScreenSetup, StereoSetup, Texture, serve, task,
+};
 use glam::{Mat4, Vec2};
+
+/// `rds_right`'s input: `[MVP_l, MVP_r, left depth, right depth, left dots, fresh dots,
+/// tolerance]`.
+type RdsInput = (
+    [f32; 16],
+    [f32; 16],
+    Texture<f32>,
+    Texture<f32>,
+    Texture<bool>,
+    Texture<bool>,
+    f32,
+);
 
 fn main() -> ExitCode {
     serve(
@@ -62,6 +76,20 @@ fn main() -> ExitCode {
                 "visible",
                 |(uv, remapped, stored, tol): (Option<[f32; 2]>, f32, f32, f32)| {
                     ex1_stereo::visible(uv.map(Vec2::from), remapped, stored, tol)
+                },
+            ),
+            task(
+                "rds_right",
+                |(l, r, left_depth, right_depth, left_dots, fresh_dots, tolerance): RdsInput| {
+                    ex1_stereo::rds_right(
+                        Mat4::from_cols_array(&l),
+                        Mat4::from_cols_array(&r),
+                        &left_depth,
+                        &right_depth,
+                        &left_dots,
+                        &fresh_dots,
+                        tolerance,
+                    )
                 },
             ),
             task("parallax", |[z, z0, d]: [f32; 3]| {

@@ -5,10 +5,11 @@
 //! `opengl-depth`, `hang-parallax`, `nan-parallax`, `transposed-frustum`, `fov-degrees`,
 //! `mv-t-order`, `one-sided-depth`, `no-w-divide`, `never-none`, `sheet-unscaled-shift`,
 //! `sheet-d-not-dw`, `remap-back-same-order`, `finalize-transposed`, `finalize-no-clamp`,
-//! `finalize-swapped-eyes`.
+//! `finalize-swapped-eyes`, `rds-no-visibility`, `rds-v-not-flipped`, `rds-pixel-corner`,
+//! `rds-left-fallback`.
 
 use exercise_api::{
-    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, ScreenSetup, StereoSetup,
+    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, ScreenSetup, StereoSetup, Texture,
 };
 use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec2, Vec3, Vec4};
@@ -247,6 +248,57 @@ pub fn visible(
     let Some(uv) = uv_right else { return false };
     let inside = (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y);
     inside && (stored_depth - remapped_depth).abs() <= tolerance
+}
+
+/// Julesz's random-dot pair: the right image's dots through the remap and visibility check.
+#[allow(clippy::too_many_arguments)]
+pub fn rds_right(
+    mvp_left: Mat4,
+    mvp_right: Mat4,
+    left_depth: &Texture<f32>,
+    right_depth: &Texture<f32>,
+    left_dots: &Texture<bool>,
+    fresh_dots: &Texture<bool>,
+    tolerance: f32,
+) -> Texture<bool> {
+    let (w, h) = (right_depth.width, right_depth.height);
+    let mut out = Texture::new(w, h, false);
+    let corner = if planted("rds-pixel-corner") {
+        0.0
+    } else {
+        0.5
+    };
+    for y in 0..h {
+        for x in 0..w {
+            let uv = Vec2::new(
+                (x as f32 + corner) / w as f32,
+                1.0 - (y as f32 + corner) / h as f32,
+            );
+            let fallback = if planted("rds-left-fallback") {
+                left_dots.get(x, y)
+            } else {
+                fresh_dots.get(x, y)
+            };
+            let dot = remap_right_to_left(mvp_left, mvp_right, uv, right_depth.get(x, y))
+                .and_then(|p| {
+                    let row = if planted("rds-v-not-flipped") {
+                        p.y
+                    } else {
+                        1.0 - p.y
+                    };
+                    let (tx, ty) = ((p.x * w as f32).floor(), (row * h as f32).floor());
+                    let inside = tx >= 0.0 && ty >= 0.0 && tx < w as f32 && ty < h as f32;
+                    let (tx, ty) = (tx as usize, ty as usize);
+                    let seen = inside
+                        && (planted("rds-no-visibility")
+                            || visible(Some(p.truncate()), p.z, left_depth.get(tx, ty), tolerance));
+                    seen.then(|| left_dots.get(tx, ty))
+                })
+                .unwrap_or(fallback);
+            out.set(x, y, dot);
+        }
+    }
+    out
 }
 
 /// `p(z) = d (1 − z0/z)` (the exercise slides).

@@ -2,7 +2,7 @@
 //! from, and the conventions; `stereolab grade ex1` scores each function on its own.
 
 use exercise_api::Lighting;
-use exercise_api::{AnaglyphKind, AnaglyphMatrices, EyeView, ScreenSetup, StereoSetup};
+use exercise_api::{AnaglyphKind, AnaglyphMatrices, EyeView, ScreenSetup, StereoSetup, Texture};
 use glam::{Mat4, Vec2, Vec3};
 
 /// Task `frustum` (2 points): the projection matrix `P_frustum(l, r, b, t, n, f)`.
@@ -168,6 +168,51 @@ pub fn visible(
     // TODO: out of the image → false; then compare the depths.
     todo!(
         "visible? uv {uv_right:?}, remapped {remapped_depth:?}, stored {stored_depth:?}, tolerance {tolerance:?}"
+    )
+}
+
+/// Task `rds_right` (2 points, image check): the right image of Julesz's random-dot stereo
+/// pair, built from your [`remap_right_to_left`] and [`visible`].
+///
+/// Source: the SIRDS paper (Petz et al.), §1 (Julesz's random-dot stereograms: depth from
+/// stereopsis alone), with the exercise slides' remapping and visibility check. The left image
+/// is random dots (`left_dots`, true = white), which show no shape. The right image is the
+/// same dots as the right eye sees them: for every right pixel (x, y)
+/// 1. its texture coordinate is the pixel's center, `u = (x + ½)/width`, `v = 1 − (y + ½)/height`
+///    (v = 0 is the bottom row; texel (x, y) counts rows from the top, see [`Texture`]), and its
+///    stored depth is `right_depth.get(x, y)`;
+/// 2. [`remap_right_to_left`] gives where that surface point lies in the left image and its
+///    left window depth (`None`: behind the left eye);
+/// 3. the left texel there is the nearest one, `(⌊u_l · width⌋, ⌊(1 − v_l) · height⌋)`, when it
+///    lies inside the image; the left eye's stored depth there is `left_depth` at that texel;
+/// 4. when [`visible`] says the left eye sees the same point (`tolerance` as given), the right
+///    pixel takes the left dot at that texel;
+/// 5. otherwise (occluded in the left eye, outside the left image, behind the left eye) the right
+///    eye sees something the left eye does not: the pixel takes `fresh_dots.get(x, y)`, an
+///    independent random dot (Julesz's uncorrelated region).
+///
+/// Background pixels (depth 1) lie on the far plane and follow the same rule. Viewed as a pair
+/// (or as the red-cyan anaglyph `stereolab grade` draws), the dots shift by the parallax p(z)
+/// and the scene appears in depth. All textures have the same size; return one of that size.
+#[allow(clippy::too_many_arguments)]
+pub fn rds_right(
+    mvp_left: Mat4,
+    mvp_right: Mat4,
+    left_depth: &Texture<f32>,
+    right_depth: &Texture<f32>,
+    left_dots: &Texture<bool>,
+    fresh_dots: &Texture<bool>,
+    tolerance: f32,
+) -> Texture<bool> {
+    // TODO: for each right pixel: remap into the left image, look up the left texel, check
+    // visibility, take the left dot or the fresh one.
+    todo!(
+        "right dots of a {}×{} pair (tolerance {tolerance:?}, MVP_l {mvp_left:?}, MVP_r {mvp_right:?}, {} left dots, {} fresh dots, {} right depths)",
+        left_depth.width,
+        left_depth.height,
+        left_dots.texels.len(),
+        fresh_dots.texels.len(),
+        right_depth.texels.len()
     )
 }
 

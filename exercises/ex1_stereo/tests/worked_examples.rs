@@ -1,7 +1,7 @@
 //! Checks you can run yourself (`cargo test -p ex1_stereo`): the worked examples of the source
 //! documents. They fail until your functions are complete; `stereolab grade ex1` scores more.
 
-use exercise_api::{AnaglyphKind, ScreenSetup, StereoSetup};
+use exercise_api::{AnaglyphKind, ScreenSetup, StereoSetup, Texture};
 use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
@@ -115,6 +115,58 @@ fn remapping_to_the_right_and_back_returns_to_the_same_left_pixel() {
         (back.truncate() - uv).length() < 1e-4 && (back.z - 0.95).abs() < 1e-4,
         "{uv:?} at depth 0.95 → {there:?} → {back:?}"
     );
+}
+
+/// The random-dot pair of a wall facing the StereoGraphics guide's rig at eye distance `z`, in
+/// a 36×36 image (the 18-unit wide screen at z0 = 9 is 2 pixels per unit): returns the left
+/// dots, the fresh dots and the right dots.
+fn rds_of_a_wall(z: f32) -> (Vec<bool>, Vec<bool>, Vec<bool>) {
+    let (setup, mv) = stereographics_guide();
+    let mvp = |eye| {
+        let m = ex1_stereo::stereo_matrices(&setup, mv, eye, Lighting::PerEye);
+        m.projection * m.view
+    };
+    let (l, r) = (mvp(0), mvp(1));
+    // The wall's window depth (the same for both eyes: the off-axis eyes share their z).
+    let clip = l * Vec3::new(0.0, 0.0, 9.0 - z).extend(1.0);
+    let depth = 0.5 * (clip.z / clip.w + 1.0);
+    let n = 36;
+    let left_dots = Texture {
+        width: n,
+        height: n,
+        texels: (0..n * n).map(|i| (i * 7 + i / n) % 3 == 0).collect(),
+    };
+    let fresh = Texture::new(n, n, true);
+    let depths = Texture::new(n, n, depth);
+    let right = ex1_stereo::rds_right(l, r, &depths, &depths, &left_dots, &fresh, 1e-3);
+    assert_eq!(right.texels.len(), n * n, "one dot per pixel");
+    (left_dots.texels, fresh.texels, right.texels)
+}
+
+#[test]
+fn random_dots_on_the_screen_plane_are_the_same_in_both_eyes() {
+    let (left, _, right) = rds_of_a_wall(9.0);
+    assert!(
+        left == right,
+        "zero parallax at z0: the right dots are the left dots"
+    );
+}
+
+#[test]
+fn random_dots_on_a_wall_behind_the_screen_shift_right_by_its_parallax() {
+    // p(18) = d·(1 − z0/z) = 1·(1 − 9/18) = 0.5 units = 1 pixel: right pixel x shows left
+    // pixel x − 1; column 0 of the right image sees what the left eye cannot: a fresh dot.
+    let (left, fresh, right) = rds_of_a_wall(18.0);
+    for y in 0..36 {
+        for x in 0..36 {
+            let want = if x == 0 {
+                fresh[y * 36]
+            } else {
+                left[y * 36 + x - 1]
+            };
+            assert_eq!(right[y * 36 + x], want, "right pixel ({x}, {y})");
+        }
+    }
 }
 
 #[test]

@@ -19,5 +19,5 @@ pub use glam;
 pub use protocol::{Answer, Reply, Task, decode_reply, encode_reply, serve, task};
 pub use types::{
     AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, Lighting, ScreenSetup, SirdsGeometry,
-    SirdsSetup, StereoSetup, look_at,
+    SirdsSetup, StereoSetup, Texture, look_at,
 };

@@ -151,3 +151,60 @@ pub struct SirdsSetup {
     /// Depth behind the image plane of nearness 0 (the background plane).
     pub depth_far: f32,
 }
+
+/// A `width`×`height` texture stored row by row from the TOP row, as a framebuffer and a PNG
+/// store it: texel (x, y) is `texels[y · width + x]`, y = 0 is the top row. Texture
+/// coordinates are OpenGL's: v = 0 at the BOTTOM row, so pixel (x, y)'s center is at
+/// `u = (x + ½)/width`, `v = 1 − (y + ½)/height`, and nearest filtering fetches texel
+/// `(⌊u · width⌋, ⌊(1 − v) · height⌋)` when that lies inside the image.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Texture<T> {
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// `width · height` texels, top row first.
+    pub texels: Vec<T>,
+}
+
+impl<T: Copy> Texture<T> {
+    /// A texture of `width`×`height` texels, all `fill`.
+    pub fn new(width: usize, height: usize, fill: T) -> Texture<T> {
+        Texture {
+            width,
+            height,
+            texels: vec![fill; width * height],
+        }
+    }
+
+    /// Texel (x, y), y = 0 the top row. Panics outside the texture (as an out-of-bounds index
+    /// does).
+    pub fn get(&self, x: usize, y: usize) -> T {
+        assert!(
+            x < self.width && y < self.height,
+            "texel ({x}, {y}) outside a {}×{} texture",
+            self.width,
+            self.height
+        );
+        self.texels[y * self.width + x]
+    }
+
+    /// Sets texel (x, y). Panics outside the texture.
+    pub fn set(&mut self, x: usize, y: usize, value: T) {
+        assert!(
+            x < self.width && y < self.height,
+            "texel ({x}, {y}) outside a {}×{} texture",
+            self.width,
+            self.height
+        );
+        self.texels[y * self.width + x] = value;
+    }
+}
+
+/// Flattens the texels, top row first (the size is not part of the answer: a texture of the
+/// wrong size has the wrong number of numbers).
+impl<T: Answer> Answer for Texture<T> {
+    fn flatten(&self, out: &mut Vec<f64>) {
+        self.texels.flatten(out);
+    }
+}

@@ -3,14 +3,15 @@
 //! One file per task group: `frustum` (mono and stereo frusta), `sheet` (the stereo frusta in
 //! the exercise slides' screen-relative terms), `rig` (the stereo rig's view and projection
 //! matrices), `anaglyph` (anaglyph and Dubois matrices), `finalize` (the finalize shader's
-//! anaglyph pixel), `remap` (remapping in both directions), `visible` (occlusion) and
-//! `parallax` (parallax and its color map). This file holds the task list and the helpers they
+//! anaglyph pixel), `remap` (remapping in both directions), `visible` (occlusion), `rds` (the
+//! random-dot pair built from both) and `parallax` (parallax and its color map). This file holds the task list and the helpers they
 //! share.
 
 mod anaglyph;
 mod finalize;
 mod frustum;
 mod parallax;
+mod rds;
 mod remap;
 mod rig;
 mod sheet;
@@ -44,6 +45,7 @@ pub(crate) fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
         remap::remap_task(fx),
         remap::remap_right_to_left_task(fx),
         visible::visible_task(fx),
+        rds::rds_task(fx),
         parallax::parallax_task(),
         parallax::parallax_color_task(fx),
     ]

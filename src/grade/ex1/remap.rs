@@ -15,7 +15,7 @@ use crate::math::{CameraMode, Lighting};
 
 /// The known remapping mistakes as switches.
 #[derive(Clone, Copy, Default)]
-struct RemapVariant {
+pub(super) struct RemapVariant {
     depth_as_ndc: bool,
     /// Only the incoming depth left as it is (`z_ndc = depth`), the outgoing one converted.
     depth_in_raw: bool,
@@ -30,7 +30,13 @@ struct RemapVariant {
 
 /// The known mistakes' answers (and, with no switch set, the same numbers as
 /// [`stereolab_remap`]): the exercise slides' chain in f64 from a texture coordinate.
-fn remap_reference(l: &Mat4, r: &Mat4, uv: [f32; 2], depth: f32, v: RemapVariant) -> Vec<f64> {
+pub(super) fn remap_reference(
+    l: &Mat4,
+    r: &Mat4,
+    uv: [f32; 2],
+    depth: f32,
+    v: RemapVariant,
+) -> Vec<f64> {
     let (l, r) = (l.as_dmat4(), r.as_dmat4());
     let m: DMat4 = if v.order_swapped {
         l * r.inverse()
