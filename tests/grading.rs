@@ -650,6 +650,13 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
     }
     assert!(handout.join("stereolab/assets/scenes/wuson.toml").is_file());
     assert_includes_resolve(&handout.join("stereolab"));
+    // The handout compiles the grader unoptimized, dependencies and proc macros included (the
+    // repository's profile optimizes every dependency: 632 CPU-s against 109 for the grader).
+    let workspace = std::fs::read_to_string(handout.join("Cargo.toml")).unwrap();
+    assert!(
+        workspace.contains("[profile.dev.package.\"*\"]\nopt-level = 0\ndebug = false"),
+        "{workspace}"
+    );
     // What a student's crate can reach: exercise-api, glam and serde, never stereolab.
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     for ex in ["ex1_stereo", "ex2_chromadepth", "ex3_sirds"] {

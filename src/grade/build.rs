@@ -66,7 +66,8 @@ pub(crate) fn exercise_api_dir() -> PathBuf {
 }
 
 /// The build's manifest: the exercise's own, without the instructor's `solution` feature, with
-/// `exercise-api` by absolute path, as a workspace of its own with stereolab's profiles.
+/// `exercise-api` by absolute path, as a workspace of its own with stereolab's profiles (the
+/// handout's, [`super::export::HANDOUT_PROFILE`], in a handout).
 fn manifest(ex: Exercise) -> Result<String, String> {
     let text = strip_solution(template(ex).manifest);
     let mut table: toml::Table =
@@ -84,7 +85,11 @@ fn manifest(ex: Exercise) -> Result<String, String> {
     table.insert("workspace".into(), toml::Value::Table(toml::Table::new()));
     let stereolab: toml::Table =
         toml::from_str(STEREOLAB_MANIFEST).map_err(|e| format!("stereolab's manifest: {e}"))?;
-    if let Some(p) = stereolab.get("profile") {
+    // The repository's profiles; in a student's handout, whose copy of the manifest has none,
+    // the handout's (no optimization, no debug info: the exercise crates compile fastest).
+    let handout: toml::Table = toml::from_str(super::export::HANDOUT_PROFILE)
+        .map_err(|e| format!("the handout's profile: {e}"))?;
+    if let Some(p) = stereolab.get("profile").or_else(|| handout.get("profile")) {
         table.insert("profile".into(), p.clone());
     }
     toml::to_string(&table).map_err(|e| format!("the build's manifest: {e}"))

@@ -56,6 +56,20 @@ fn copy_tree(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()>
 /// (`cargo tree -e normal,build`), see docs/performance.md for the times.
 pub(crate) const HANDOUT_FEATURES: &[&str] = &["cli"];
 
+/// The handout workspace's build profile: no optimization and no debug info for the grader and
+/// every dependency, proc macros included. The grader's work (64×48 fixtures, a few thousand
+/// numbers per task) takes well under a second unoptimized; what a student waits for is the
+/// first build of 106 crates (docs/performance.md, "A student's first grade").
+pub(crate) const HANDOUT_PROFILE: &str = "\
+[profile.dev]
+opt-level = 0
+debug = false
+
+[profile.dev.package.\"*\"]
+opt-level = 0
+debug = false
+";
+
 /// The handout's copy of stereolab's manifest: the same package and dependencies, without the
 /// workspace, the repository's own tests and the profiles (the handout's workspace sets them),
 /// and with [`HANDOUT_FEATURES`] as its default features.
@@ -82,7 +96,7 @@ fn library_manifest(text: &str, path: &Path) -> Result<String> {
 }
 
 /// Writes the handout for the repository at `root` into `dir`:
-/// `dir/Cargo.toml` (a workspace of the three exercises, with stereolab's profiles),
+/// `dir/Cargo.toml` (a workspace of the three exercises, with [`HANDOUT_PROFILE`]),
 /// `dir/stereolab/` (library, CLI with the grader, docs, assets), `dir/ex*/` (stubs, student tests,
 /// the grader's entry binary; no `solution.rs`, no `solution` feature), `dir/README.md`.
 ///
@@ -154,15 +168,10 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
         }
         members.push(format!("\"{name}\""));
     }
-    let profiles = toml::from_str::<toml::Table>(&manifest)
-        .ok()
-        .and_then(|t| t.get("profile").cloned())
-        .map(|p| {
-            let mut t = toml::Table::new();
-            t.insert("profile".into(), p);
-            toml::to_string(&t).unwrap_or_default()
-        })
-        .unwrap_or_default();
+    // The handout's own profile, not the repository's (which optimizes every dependency for
+    // the test suite's renders): a student compiles the grader once and grades small pictures,
+    // so compile time is what they wait for (docs/performance.md, "A student's first grade").
+    let profiles = HANDOUT_PROFILE;
     let workspace = format!(
         "[workspace]\nmembers = [{}, \"stereolab\"]\nresolver = \"3\"\n\n{profiles}",
         members.join(", ")
@@ -225,7 +234,8 @@ cargo run -p stereolab -- render --exercise ex1 stereolab/assets/scenes/wuson.to
 
 **The first `cargo run -p stereolab` compiles the grader**: stereolab with its command line
 only (no viewer window, GPU path or C allocator), and its dependencies, 106 crates (the
-repository's full build has 218). Later runs start at once. Each `grade` then builds your crates in `target/stereolab-grade/` in seconds.
+repository's full build has 218), unoptimized (this workspace's profile: the grader's pictures
+are small, so compiling fast matters more than running fast). Later runs start at once. Each `grade` then builds your crates in `target/stereolab-grade/` in seconds.
 
 ## How points are given
 
@@ -256,6 +266,17 @@ and never reads it as an answer. Printing a lot slows a task down; remove it whe
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_handout_profile_compiles_everything_unoptimized_without_debug_info() {
+        let t: toml::Table = toml::from_str(HANDOUT_PROFILE).unwrap();
+        let dev = &t["profile"]["dev"];
+        let deps = &dev["package"]["*"];
+        for p in [dev, deps] {
+            assert_eq!(p["opt-level"].as_integer(), Some(0), "{t}");
+            assert_eq!(p["debug"].as_bool(), Some(false), "{t}");
+        }
+    }
 
     #[test]
     fn strip_solution_drops_marked_blocks_with_their_markers() {
