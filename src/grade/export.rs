@@ -96,7 +96,7 @@ fn library_manifest(text: &str, path: &Path) -> Result<String> {
 }
 
 /// Writes the handout for the repository at `root` into `dir`:
-/// `dir/Cargo.toml` (a workspace of the three exercises, with [`HANDOUT_PROFILE`]),
+/// `dir/Cargo.toml` (a workspace of the three exercises, with the handout's build profile),
 /// `dir/stereolab/` (library, CLI with the grader, docs, assets), `dir/ex*/` (stubs, student tests,
 /// the grader's entry binary; no `solution.rs`, no `solution` feature), `dir/README.md`.
 ///
