@@ -6,13 +6,15 @@
 //! channel i (R, G, B), column j multiplies that eye's input channel j. Where each matrix comes
 //! from is said at [`AnaglyphKind::matrices`].
 
+use std::mem::MaybeUninit;
+
 use image::RgbaImage;
-use rayon::prelude::*;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 
 use super::eye_input::check_same_size;
+use super::par_fill_rows;
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 
@@ -283,33 +285,54 @@ pub fn anaglyph(
     kind: AnaglyphKind,
     options: AnaglyphOptions,
 ) -> Result<RgbaImage> {
+    anaglyph_with(left, right, kind, options, true)
+}
+
+/// [`anaglyph`], on the AVX2 rows where `simd` and the CPU allow, else on the scalar loop (the
+/// bytes are the same; the benchmark times both).
+///
+/// # Errors
+/// As [`anaglyph`].
+pub fn anaglyph_with(
+    left: &Framebuffer,
+    right: &Framebuffer,
+    kind: AnaglyphKind,
+    options: AnaglyphOptions,
+    simd: bool,
+) -> Result<RgbaImage> {
     check_same_size(left, right)?;
     let (left, right) = options.eyes(left, right);
     let m = kind.matrices();
-    let mut bytes = vec![0u8; left.color.len() * 4];
     // Rows in parallel (every pixel is independent, so the bytes do not depend on the thread
     // count).
     let w = left.width.max(1) as usize;
-    let rows = bytes
-        .par_chunks_mut(4 * w)
-        .zip(left.color.par_chunks(w).zip(right.color.par_chunks(w)));
-    if options.linear_light {
+    let eyes = |y: usize, len: usize| {
+        let r = y * w..y * w + len;
+        (&left.color[r.clone()], &right.color[r])
+    };
+    let bytes = if options.linear_light {
         // A GPU decodes an sRGB texture in the sampler; a 256-entry table is the same thing.
         let decode: Vec<f32> = (0..=255u8)
             .map(|v| srgb_to_linear(v as f32 / 255.0))
             .collect();
         let lin = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| decode[v as usize]);
-        rows.for_each(|(out, (l, r))| {
-            for (out, (l, r)) in out.chunks_exact_mut(4).zip(l.iter().zip(r)) {
+        let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
+            let (l, r) = eyes(y, out.len());
+            for (out, (l, r)) in out.iter_mut().zip(l.iter().zip(r)) {
                 let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
-                out.copy_from_slice(&[c[0], c[1], c[2], 255]);
+                out.write([c[0], c[1], c[2], 255]);
             }
-        });
+        };
+        // SAFETY: `fill` writes one pixel per pixel of the eyes' rows, which are as long as the
+        // output row (`check_same_size`: both color buffers hold width × height pixels).
+        unsafe { par_fill_rows(left.color.len(), w, 0, fill) }
     } else {
         #[cfg(target_arch = "x86_64")]
-        let simd = avx2::available();
-        rows.for_each(|(out, (l, r))| {
-            let (out, _) = out.as_chunks_mut::<4>();
+        let simd = simd && avx2::available();
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = simd;
+        let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
+            let (l, r) = eyes(y, out.len());
             #[cfg(target_arch = "x86_64")]
             if simd {
                 // SAFETY: `avx2::row` requires AVX2 (its only safety condition), which
@@ -319,9 +342,11 @@ pub fn anaglyph(
                 return;
             }
             for (out, (l, r)) in out.iter_mut().zip(l.iter().zip(r)) {
-                *out = anaglyph_pixel(&m, *l, *r, false);
+                out.write(anaglyph_pixel(&m, *l, *r, false));
             }
-        });
-    }
+        };
+        // SAFETY: as above; `avx2::row` writes every pixel of a row as long as its inputs.
+        unsafe { par_fill_rows(left.color.len(), w, 0, fill) }
+    };
     Ok(RgbaImage::from_raw(left.width, left.height, bytes).expect("4 bytes per pixel"))
 }
