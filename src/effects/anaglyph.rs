@@ -275,6 +275,9 @@ pub fn anaglyph_pixel(
     [to_u8(out[0]), to_u8(out[1]), to_u8(out[2]), 255]
 }
 
+/// A left and a right eye's pixel.
+type PixelPair = ([u8; 4], [u8; 4]);
+
 /// The anaglyph of two eye images (color only; depth is not read).
 ///
 /// # Errors
@@ -318,9 +321,20 @@ pub fn anaglyph_with(
         let lin = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| decode[v as usize]);
         let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
             let (l, r) = eyes(y, out.len());
+            // A pixel's result depends on its pair alone: a run of equal pairs (a flat
+            // background in both eyes) reuses the last result instead of three more `powf`.
+            let mut last: Option<(PixelPair, [u8; 4])> = None;
             for (out, (l, r)) in out.iter_mut().zip(l.iter().zip(r)) {
-                let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
-                out.write([c[0], c[1], c[2], 255]);
+                let px = match last {
+                    Some((pair, px)) if pair == (*l, *r) => px,
+                    _ => {
+                        let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
+                        let px = [c[0], c[1], c[2], 255];
+                        last = Some(((*l, *r), px));
+                        px
+                    }
+                };
+                out.write(px);
             }
         };
         // SAFETY: `fill` writes one pixel per pixel of the eyes' rows, which are as long as the
@@ -349,4 +363,50 @@ pub fn anaglyph_with(
         unsafe { par_fill_rows(left.color.len(), w, 0, fill) }
     };
     Ok(RgbaImage::from_raw(left.width, left.height, bytes).expect("4 bytes per pixel"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Both anaglyph loops (linear light, stored values on the AVX2 rows and on the scalar
+    /// loop) give `anaglyph_pixel`'s bytes on rows with runs of equal pixel pairs, where the
+    /// last result is reused, broken by a change in one eye only, and on an odd width.
+    #[test]
+    fn runs_of_equal_pixels_give_anaglyph_pixel() {
+        let (w, h) = (29, 3);
+        let mut left = Framebuffer::new(w, h, [24, 24, 24, 255]).unwrap();
+        let mut right = Framebuffer::new(w, h, [24, 24, 24, 255]).unwrap();
+        for (i, (l, r)) in left.color.iter_mut().zip(&mut right.color).enumerate() {
+            match i % 29 {
+                0..=9 => {}
+                10..=12 => r[0] = 200,
+                13..=20 => *l = [i as u8, 7, 99, 255],
+                _ => *r = [3, (i * 5) as u8, 250, 255],
+            }
+        }
+        for kind in AnaglyphKind::ALL {
+            for linear_light in [false, true] {
+                for simd in [true, false] {
+                    let options = AnaglyphOptions {
+                        linear_light,
+                        swap_eyes: false,
+                    };
+                    let img = anaglyph_with(&left, &right, kind, options, simd).unwrap();
+                    for (i, px) in img.pixels().enumerate() {
+                        let want = anaglyph_pixel(
+                            &kind.matrices(),
+                            left.color[i],
+                            right.color[i],
+                            linear_light,
+                        );
+                        assert_eq!(
+                            px.0, want,
+                            "{kind:?} linear {linear_light} simd {simd}: pixel {i}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }

@@ -80,6 +80,28 @@ fn first_outside_unit(depth: &[f32]) -> Option<usize> {
         .map(|i| start + i)
 }
 
+/// Whether every value of `c` lies in [0, 1] (NaN does not), with no early exit, compiled for
+/// AVX2 where the CPU has it, so the loop vectorizes eight wide.
+fn all_in_unit(c: &[f32]) -> bool {
+    #[inline(always)]
+    fn body(c: &[f32]) -> bool {
+        // An integer OR reduction: LLVM vectorizes it (a fold of `bool`s it does not).
+        c.iter()
+            .fold(0u32, |bad, d| bad | !((*d >= 0.0) & (*d <= 1.0)) as u32)
+            == 0
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        #[target_feature(enable = "avx2")]
+        fn avx2(c: &[f32]) -> bool {
+            body(c)
+        }
+        // SAFETY: the CPU has AVX2 (checked above), `avx2`'s only requirement.
+        return unsafe { avx2(c) };
+    }
+    body(c)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,26 +130,4 @@ mod tests {
         // -0.0 is a window depth (it compares equal to 0).
         assert_eq!(first_outside_unit(&[-0.0, 1.0]), None);
     }
-}
-
-/// Whether every value of `c` lies in [0, 1] (NaN does not), with no early exit, compiled for
-/// AVX2 where the CPU has it, so the loop vectorizes eight wide.
-fn all_in_unit(c: &[f32]) -> bool {
-    #[inline(always)]
-    fn body(c: &[f32]) -> bool {
-        // An integer OR reduction: LLVM vectorizes it (a fold of `bool`s it does not).
-        c.iter()
-            .fold(0u32, |bad, d| bad | !((*d >= 0.0) & (*d <= 1.0)) as u32)
-            == 0
-    }
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        #[target_feature(enable = "avx2")]
-        fn avx2(c: &[f32]) -> bool {
-            body(c)
-        }
-        // SAFETY: the CPU has AVX2 (checked above), `avx2`'s only requirement.
-        return unsafe { avx2(c) };
-    }
-    body(c)
 }
