@@ -2,13 +2,14 @@
 //! stored values, remap f32 vs f64, and throughput as a fraction of a plain memory copy.
 
 use glam::Mat4;
+use rayon::prelude::*;
 
 use super::{Row, median_ms};
-use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
+use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph, anaglyph_with};
 use crate::effects::occlusion::occlusion_image;
-use crate::effects::parallax::parallax_image;
+use crate::effects::parallax::parallax_image_with;
 use crate::effects::remap::{
-    Precision, Remapper, Visibility, remap_color, remap_coordinates, visibility_map,
+    Precision, Remapper, Visibility, remap_color_with, remap_coordinates, visibility_map,
 };
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
@@ -28,24 +29,50 @@ fn row(knob: &str, setting: impl Into<String>, error: Option<f64>, unit: &str, m
     }
 }
 
-/// Median ms of copying `bytes` bytes (`copy_from_slice`, one thread), the yardstick.
-fn memcpy_ms(bytes: usize, iters: usize) -> f64 {
-    let src = vec![7u8; bytes];
-    let mut dst = vec![0u8; bytes];
-    median_ms(iters, || {
-        dst.copy_from_slice(std::hint::black_box(&src));
-        dst[bytes / 2]
-    })
+/// The yardstick: median ms of copying `bytes` bytes between two buffers allocated once
+/// (`copy_from_slice`), on one thread and on every thread of the pool (the bytes split into one
+/// contiguous part per thread), as `[one thread, all threads]`. The finalize modes run on the
+/// pool's threads and allocate their output each call; the copy does neither on one thread.
+#[derive(Clone, Copy, Debug)]
+struct Memcpy {
+    bytes: usize,
+    one_thread_ms: f64,
+    all_threads_ms: f64,
 }
 
-/// Fills in the throughput note: the mode reads `bytes` of framebuffers; a plain copy of the
-/// same bytes takes `copy_ms`.
-fn with_throughput(mut r: Row, bytes: usize, copy_ms: f64) -> Row {
+fn memcpy_ms(bytes: usize, iters: usize) -> Memcpy {
+    let src = vec![7u8; bytes];
+    let mut dst = vec![0u8; bytes];
+    let one_thread_ms = median_ms(iters, || {
+        dst.copy_from_slice(std::hint::black_box(&src));
+        dst[bytes / 2]
+    });
+    let part = bytes.div_ceil(rayon::current_num_threads()).max(1);
+    let all_threads_ms = median_ms(iters, || {
+        dst.par_chunks_mut(part)
+            .zip(std::hint::black_box(&src).par_chunks(part))
+            .for_each(|(d, s)| d.copy_from_slice(s));
+        dst[bytes / 2]
+    });
+    Memcpy {
+        bytes,
+        one_thread_ms,
+        all_threads_ms,
+    }
+}
+
+/// Fills in the throughput note: the mode reads `copy.bytes` of framebuffers; a plain copy of
+/// the same bytes takes `copy.one_thread_ms` on one thread (the ratio the goal states)
+/// and `copy.all_threads_ms` on all of the pool's threads.
+fn with_throughput(mut r: Row, copy: Memcpy) -> Row {
     let t = format!(
-        "{:.3} of memcpy ({:.1} MB read; copy {:.3} ms)",
-        copy_ms / r.ms,
-        bytes as f64 / 1e6,
-        copy_ms
+        "{:.3} of memcpy ({:.1} MB read; copy {:.3} ms on 1 thread; {:.3} of the {}-thread copy, {:.3} ms)",
+        copy.one_thread_ms / r.ms,
+        copy.bytes as f64 / 1e6,
+        copy.one_thread_ms,
+        copy.all_threads_ms / r.ms,
+        rayon::current_num_threads(),
+        copy.all_threads_ms,
     );
     r.note = if r.note.is_empty() {
         t
@@ -55,7 +82,9 @@ fn with_throughput(mut r: Row, bytes: usize, copy_ms: f64) -> Row {
     r
 }
 
-/// Every finalize row on `scene` (its size; `stereolab bench` uses 1024×768). Single-threaded.
+/// Every finalize row on `scene` (its size; `stereolab bench` uses 1024×768), each mode on the
+/// thread pool it runs on in a render (rows in parallel), against a copy of the same bytes on
+/// one thread and on the pool's threads.
 ///
 /// # Errors
 /// The scene cannot be rendered, or a mode fails.
@@ -76,23 +105,43 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             }
         })
     };
-    let remap_ms =
-        time(&mut || remap_color(left, right, &mvp[0], &mvp[1], Precision::F64).map(drop));
-    let remap_right_ms =
-        time(&mut || remap_color(right, left, &mvp[1], &mvp[0], Precision::F64).map(drop));
+    // Each mode on the AVX2 rows (where the CPU has AVX2) and on the scalar loops, what a CPU
+    // without AVX2 runs; the bytes are the same (unit tests).
+    let remap = |simd: bool, right_eye: bool| {
+        let (this, other, k) = if right_eye {
+            (right, left, 1)
+        } else {
+            (left, right, 0)
+        };
+        move || remap_color_with(this, other, &mvp[k], &mvp[1 - k], Precision::F64, simd).map(drop)
+    };
+    let remap_ms = time(&mut remap(true, false));
+    let remap_right_ms = time(&mut remap(true, true));
+    let remap_scalar_ms = time(&mut remap(false, false));
+    let remap_f32_ms = time(&mut || {
+        remap_color_with(left, right, &mvp[0], &mvp[1], Precision::F32Composed, true).map(drop)
+    });
     let occlusion_ms =
         time(&mut || occlusion_image(left, right, [&mvp[0], &mvp[1]], Precision::F64).map(drop));
     let rig = scene.parallax_rig()?;
-    let parallax_ms = time(&mut || parallax_image(left, &rig).map(drop));
+    let parallax_ms = time(&mut || parallax_image_with(left, &rig, true).map(drop));
+    let parallax_scalar_ms = time(&mut || parallax_image_with(left, &rig, false).map(drop));
     if let Some(e) = err {
         return Err(e);
     }
-    for (name, ms) in [("remap_left", remap_ms), ("remap_right", remap_right_ms)] {
-        rows.push(with_throughput(
-            row("mode", name, None, "", ms),
-            px * 8,
-            copy_color_depth,
-        ));
+    let drawn_share = |fb: &Framebuffer| {
+        let drawn = fb.depth.iter().filter(|d| **d < 1.0).count();
+        format!("{:.0}% of pixels drawn", 100.0 * drawn as f64 / px as f64)
+    };
+    for (name, ms, eye) in [
+        ("remap_left", remap_ms, left),
+        ("remap_right", remap_right_ms, right),
+        ("remap_left scalar", remap_scalar_ms, left),
+        ("remap_left f32 composed", remap_f32_ms, left),
+    ] {
+        let mut r = row("mode", name, None, "", ms);
+        r.note = drawn_share(eye);
+        rows.push(with_throughput(r, copy_color_depth));
     }
     let map = visibility_map(left, right, &mvp[0], &mvp[1], Precision::F64)?;
     let n = |v: Visibility| map.iter().filter(|m| **m == v).count();
@@ -104,12 +153,16 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         n(Visibility::OutOfView),
         n(Visibility::Farther)
     );
-    rows.push(with_throughput(occlusion, px * 8, copy_color_depth));
-    rows.push(with_throughput(
-        row("mode", "parallax + legend", None, "", parallax_ms),
-        px * 4,
-        memcpy_ms(px * 4, iters),
-    ));
+    rows.push(with_throughput(occlusion, copy_color_depth));
+    let copy_depth = memcpy_ms(px * 4, iters);
+    for (name, ms) in [
+        ("parallax + legend", parallax_ms),
+        ("parallax + legend scalar", parallax_scalar_ms),
+    ] {
+        let mut r = row("mode", name, None, "", ms);
+        r.note = drawn_share(left);
+        rows.push(with_throughput(r, copy_depth));
+    }
     let (near, deep) = remap_precision(scene, iters)?;
     rows.extend(near);
     rows.extend(deep);
@@ -179,7 +232,6 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
                 "max levels vs stored",
                 stored_ms,
             ),
-            px * 8,
             copy,
         ));
         let mut r = row(
@@ -190,8 +242,53 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
             linear_ms,
         );
         r.note = format!("mean {mean:.2} levels");
-        rows.push(with_throughput(r, px * 8, copy));
+        rows.push(with_throughput(r, copy));
     }
+    // The frame's background is one color in both eyes, which the AVX2 rows compute once per
+    // run of equal pixels: the same kind on two eyes of pseudo-random colors (no two
+    // neighbours equal) shows the rate of the arithmetic itself.
+    let kind = AnaglyphKind::DuboisRedCyan;
+    let noise = |seed: u64| -> Result<Framebuffer> {
+        let mut fb = Framebuffer::new(left.width, left.height, [0, 0, 0, 255])?;
+        let mut state = seed;
+        for c in &mut fb.color {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let b = state.to_le_bytes();
+            *c = [b[0], b[1], b[2], 255];
+        }
+        Ok(fb)
+    };
+    let (noise_l, noise_r) = (noise(0x2545_f491_4f6c_dd1d)?, noise(0x9e37_79b9_7f4a_7c15)?);
+    for (simd, label) in [(true, ""), (false, " scalar")] {
+        let ms = median_ms(iters, || {
+            anaglyph_with(&noise_l, &noise_r, kind, AnaglyphOptions::default(), simd).is_ok()
+        });
+        let mut r = row(
+            "anaglyph",
+            format!("{} stored, noise{label}", kind.output_name()),
+            Some(0.0),
+            "max levels vs stored",
+            ms,
+        );
+        r.note = "random colors, no equal neighbours".into();
+        rows.push(with_throughput(r, copy));
+    }
+    // The scalar loop, what a CPU without AVX2 runs (the same bytes), on the kind goal 1 uses.
+    let scalar_ms = median_ms(iters, || {
+        anaglyph_with(left, right, kind, AnaglyphOptions::default(), false).is_ok()
+    });
+    rows.push(with_throughput(
+        row(
+            "anaglyph",
+            format!("{} stored scalar", kind.output_name()),
+            Some(0.0),
+            "max levels vs stored",
+            scalar_ms,
+        ),
+        copy,
+    ));
     Ok(rows)
 }
 

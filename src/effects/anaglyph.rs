@@ -6,13 +6,15 @@
 //! channel i (R, G, B), column j multiplies that eye's input channel j. Where each matrix comes
 //! from is said at [`AnaglyphKind::matrices`].
 
+use std::mem::MaybeUninit;
+
 use image::RgbaImage;
-use rayon::prelude::*;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 
 use super::eye_input::check_same_size;
+use super::par_fill_rows;
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
 
@@ -273,6 +275,9 @@ pub fn anaglyph_pixel(
     [to_u8(out[0]), to_u8(out[1]), to_u8(out[2]), 255]
 }
 
+/// A left and a right eye's pixel.
+type PixelPair = ([u8; 4], [u8; 4]);
+
 /// The anaglyph of two eye images (color only; depth is not read).
 ///
 /// # Errors
@@ -283,33 +288,65 @@ pub fn anaglyph(
     kind: AnaglyphKind,
     options: AnaglyphOptions,
 ) -> Result<RgbaImage> {
+    anaglyph_with(left, right, kind, options, true)
+}
+
+/// [`anaglyph`], on the AVX2 rows where `simd` and the CPU allow, else on the scalar loop (the
+/// bytes are the same; the benchmark times both).
+///
+/// # Errors
+/// As [`anaglyph`].
+pub fn anaglyph_with(
+    left: &Framebuffer,
+    right: &Framebuffer,
+    kind: AnaglyphKind,
+    options: AnaglyphOptions,
+    simd: bool,
+) -> Result<RgbaImage> {
     check_same_size(left, right)?;
     let (left, right) = options.eyes(left, right);
     let m = kind.matrices();
-    let mut bytes = vec![0u8; left.color.len() * 4];
     // Rows in parallel (every pixel is independent, so the bytes do not depend on the thread
     // count).
     let w = left.width.max(1) as usize;
-    let rows = bytes
-        .par_chunks_mut(4 * w)
-        .zip(left.color.par_chunks(w).zip(right.color.par_chunks(w)));
-    if options.linear_light {
+    let eyes = |y: usize, len: usize| {
+        let r = y * w..y * w + len;
+        (&left.color[r.clone()], &right.color[r])
+    };
+    let bytes = if options.linear_light {
         // A GPU decodes an sRGB texture in the sampler; a 256-entry table is the same thing.
         let decode: Vec<f32> = (0..=255u8)
             .map(|v| srgb_to_linear(v as f32 / 255.0))
             .collect();
         let lin = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| decode[v as usize]);
-        rows.for_each(|(out, (l, r))| {
-            for (out, (l, r)) in out.chunks_exact_mut(4).zip(l.iter().zip(r)) {
-                let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
-                out.copy_from_slice(&[c[0], c[1], c[2], 255]);
+        let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
+            let (l, r) = eyes(y, out.len());
+            // A pixel's result depends on its pair alone: a run of equal pairs (a flat
+            // background in both eyes) reuses the last result instead of three more `powf`.
+            let mut last: Option<(PixelPair, [u8; 4])> = None;
+            for (out, (l, r)) in out.iter_mut().zip(l.iter().zip(r)) {
+                let px = match last {
+                    Some((pair, px)) if pair == (*l, *r) => px,
+                    _ => {
+                        let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
+                        let px = [c[0], c[1], c[2], 255];
+                        last = Some(((*l, *r), px));
+                        px
+                    }
+                };
+                out.write(px);
             }
-        });
+        };
+        // SAFETY: `fill` writes one pixel per pixel of the eyes' rows, which are as long as the
+        // output row (`check_same_size`: both color buffers hold width × height pixels).
+        unsafe { par_fill_rows(left.color.len(), w, 0, fill) }
     } else {
         #[cfg(target_arch = "x86_64")]
-        let simd = avx2::available();
-        rows.for_each(|(out, (l, r))| {
-            let (out, _) = out.as_chunks_mut::<4>();
+        let simd = simd && avx2::available();
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = simd;
+        let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
+            let (l, r) = eyes(y, out.len());
             #[cfg(target_arch = "x86_64")]
             if simd {
                 // SAFETY: `avx2::row` requires AVX2 (its only safety condition), which
@@ -319,9 +356,57 @@ pub fn anaglyph(
                 return;
             }
             for (out, (l, r)) in out.iter_mut().zip(l.iter().zip(r)) {
-                *out = anaglyph_pixel(&m, *l, *r, false);
+                out.write(anaglyph_pixel(&m, *l, *r, false));
             }
-        });
-    }
+        };
+        // SAFETY: as above; `avx2::row` writes every pixel of a row as long as its inputs.
+        unsafe { par_fill_rows(left.color.len(), w, 0, fill) }
+    };
     Ok(RgbaImage::from_raw(left.width, left.height, bytes).expect("4 bytes per pixel"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Both anaglyph loops (linear light, stored values on the AVX2 rows and on the scalar
+    /// loop) give `anaglyph_pixel`'s bytes on rows with runs of equal pixel pairs, where the
+    /// last result is reused, broken by a change in one eye only, and on an odd width.
+    #[test]
+    fn runs_of_equal_pixels_give_anaglyph_pixel() {
+        let (w, h) = (29, 3);
+        let mut left = Framebuffer::new(w, h, [24, 24, 24, 255]).unwrap();
+        let mut right = Framebuffer::new(w, h, [24, 24, 24, 255]).unwrap();
+        for (i, (l, r)) in left.color.iter_mut().zip(&mut right.color).enumerate() {
+            match i % 29 {
+                0..=9 => {}
+                10..=12 => r[0] = 200,
+                13..=20 => *l = [i as u8, 7, 99, 255],
+                _ => *r = [3, (i * 5) as u8, 250, 255],
+            }
+        }
+        for kind in AnaglyphKind::ALL {
+            for linear_light in [false, true] {
+                for simd in [true, false] {
+                    let options = AnaglyphOptions {
+                        linear_light,
+                        swap_eyes: false,
+                    };
+                    let img = anaglyph_with(&left, &right, kind, options, simd).unwrap();
+                    for (i, px) in img.pixels().enumerate() {
+                        let want = anaglyph_pixel(
+                            &kind.matrices(),
+                            left.color[i],
+                            right.color[i],
+                            linear_light,
+                        );
+                        assert_eq!(
+                            px.0, want,
+                            "{kind:?} linear {linear_light} simd {simd}: pixel {i}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }

@@ -6,13 +6,20 @@
 //! (`× W / Xrange`, Xrange the view width at z0). Positive parallax lies behind the screen (the
 //! right eye's image of a point is right of the left eye's), as the StereoGraphics guide (Akka) defines it.
 
+use std::mem::MaybeUninit;
+
 use image::RgbaImage;
+use rayon::prelude::*;
 
 use super::eye_input::check_depth;
-use super::legend::draw_legend;
+use super::legend::{draw_legend, draw_legend_reference};
+use super::par_fill_rows;
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::math::{Camera, CameraMode, StereoRig};
+
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 
 /// The StereoGraphics guide (Akka): keep negative and positive parallax each within about 3% of the image width.
 pub const PARALLAX_BUDGET_PERCENT: f32 = 3.0;
@@ -91,6 +98,55 @@ impl ParallaxRig {
             .then(|| self.parallax(self.eye_distance(window_depth)) * self.pixels_per_unit)
     }
 
+    /// [`color_scale`] of the budget of a depth buffer (`width × height` values, any row
+    /// length): the largest |parallax| in pixels over the drawn pixels (depth < 1), at least
+    /// half a pixel, or ½ when nothing is drawn. Computed without the parallax map.
+    ///
+    /// Found from the two depth extremes alone. Every step of [`Self::parallax_pixels`] is
+    /// monotone in the window depth, rounding included (IEEE rounding is monotone): `d·(f−n)`
+    /// grows with d, `f − d(f−n)` shrinks and stays ≥ 0 (for d < 1 the product is at most
+    /// `fl(f−n) ≤ f`), `n f / (…)` grows (to +∞ at 0), `z0/z` moves one way, `b − z0/z` the
+    /// other, and the products with d and W/Xrange keep the order or reverse it throughout. So
+    /// p is monotone in d, and the extremes of p are at the nearest and the farthest drawn
+    /// depth (up to the sign of a zero, which |p| drops). That needs `0 < n < f` and finite
+    /// factors, which a resolved rig has; other values get the full scan, as [`budget`] does
+    /// it. `parallax_image_matches_reference` holds the result to the full map. The depths must
+    /// have passed `check_depth` (all in [0, 1]).
+    fn color_scale_of(&self, depth: &[f32]) -> f64 {
+        let monotone = self.near > 0.0
+            && self.far > self.near
+            && [
+                self.far,
+                self.zero_parallax_distance,
+                self.eye_separation,
+                self.balance,
+                self.pixels_per_unit,
+            ]
+            .iter()
+            .all(|v| v.is_finite());
+        let extremes = if monotone {
+            // The drawn depths' extremes, per block in parallel (min and max are exact, so the
+            // result does not depend on the split).
+            let (lo, hi) = depth
+                .par_chunks(1 << 14)
+                .map(drawn_extremes)
+                .reduce(|| (u32::MAX, 0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+            let p = |b: u32| self.parallax_pixels(f32::from_bits(b));
+            (lo != u32::MAX)
+                .then(|| p(lo).zip(p(hi)).map(|(a, b)| (a.min(b), a.max(b))))
+                .flatten()
+        } else {
+            depth
+                .iter()
+                .filter_map(|d| self.parallax_pixels(*d))
+                .fold(None, |e, p| {
+                    let (lo, hi) = e.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
+                    Some((lo.min(p), hi.max(p)))
+                })
+        };
+        extremes.map_or(0.5, |(lo, hi)| lo.abs().max(hi.abs()).max(0.5))
+    }
+
     fn check(&self, fb: &Framebuffer) -> Result<()> {
         if (fb.width, fb.height) != (self.width, self.height) {
             return Err(Error::invalid(
@@ -101,6 +157,33 @@ impl ParallaxRig {
         }
         check_depth("parallax", fb)
     }
+}
+
+/// The smallest and largest bit patterns of the drawn (< 1) depths of `c`, `(u32::MAX, 0)`
+/// when none is drawn. For depths in [0, 1] with the sign bit cleared (so −0 reads as 0) the
+/// order of the bits is the order of the values. Eight at a time on AVX2
+/// (`avx2::drawn_extremes`), else [`drawn_extremes_scalar`].
+fn drawn_extremes(c: &[f32]) -> (u32, u32) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2::available() {
+        // SAFETY: the CPU has AVX2 (checked above), the function's only requirement. The same
+        // result as the scalar fold (`avx2_drawn_extremes_match_scalar`).
+        return unsafe { avx2::drawn_extremes(c) };
+    }
+    drawn_extremes_scalar(c)
+}
+
+/// [`drawn_extremes`] one depth at a time, the reference.
+fn drawn_extremes_scalar(c: &[f32]) -> (u32, u32) {
+    const ONE: u32 = 0x3f80_0000;
+    c.iter().fold((u32::MAX, 0), |(lo, hi), d| {
+        let b = d.to_bits() & 0x7fff_ffff;
+        if b < ONE {
+            (lo.min(b), hi.max(b))
+        } else {
+            (lo, hi)
+        }
+    })
 }
 
 /// Parallax in pixels of every pixel of `fb` (row-major), `None` on the background.
@@ -250,11 +333,23 @@ pub fn violation_band(width: u32) -> u32 {
 /// the border (along its row at the left and right edges, its column at the top and bottom).
 /// Sorted and without repeats; empty when nothing violates the window.
 pub fn window_violation_marks(map: &[Option<f64>], width: u32, height: u32) -> Vec<usize> {
+    let w = width as usize;
+    violation_marks_where(width, height, |x, y| {
+        map[y * w + x].is_some_and(|p| p < 0.0)
+    })
+}
+
+/// [`window_violation_marks`] with `negative(x, y)` saying whether pixel (x, y) shows negative
+/// parallax; it is asked about border pixels only.
+fn violation_marks_where(
+    width: u32,
+    height: u32,
+    negative: impl Fn(usize, usize) -> bool,
+) -> Vec<usize> {
     let (w, h) = (width as usize, height as usize);
     if w == 0 || h == 0 {
         return Vec::new();
     }
-    let negative = |x: usize, y: usize| map[y * w + x].is_some_and(|p| p < 0.0);
     let band = (violation_band(width) as usize).min(w).min(h);
     let mut marks = Vec::new();
     for y in 0..h {
@@ -281,13 +376,82 @@ pub fn window_violation_marks(map: &[Option<f64>], width: u32, height: u32) -> V
 /// 003's ±3% budget, labels in pixels and percent of the width. Window violations are marked
 /// in [`VIOLATION_COLOR`] ([`window_violation_marks`]).
 ///
+/// The same bytes as [`parallax_image_reference`] (the readable program: the parallax map, its
+/// budget, the colors), computed without the map: S from the depth extremes
+/// (`ParallaxRig::color_scale_of`), each row's colors in parallel, four pixels at a time on
+/// AVX2 (`parallax/avx2.rs`, the scalar [`parallax_color`] elsewhere), the window violations
+/// from the border pixels alone.
+///
 /// # Errors
 /// As [`parallax_map`].
 pub fn parallax_image(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> {
+    parallax_image_with(fb, rig, true)
+}
+
+/// [`parallax_image`], on the AVX2 rows where `simd` and the CPU allow, else on the scalar rows
+/// (the bytes are the same; the benchmark times both).
+///
+/// # Errors
+/// As [`parallax_map`].
+pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> Result<RgbaImage> {
+    rig.check(fb)?;
+    let scale = rig.color_scale_of(&fb.depth);
+    let legend = draw_legend(fb.width, scale, &|p| parallax_color(p, scale))?;
+    let (w, n) = (fb.width as usize, fb.depth.len());
+    #[cfg(target_arch = "x86_64")]
+    let simd = simd && avx2::available();
+    #[cfg(not(target_arch = "x86_64"))]
+    let simd = simd && false;
+    // Rows in parallel: every pixel is independent, so the bytes do not depend on the threads.
+    let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
+        let depth = &fb.depth[y * w..y * w + out.len()];
+        #[cfg(target_arch = "x86_64")]
+        if simd {
+            // SAFETY: `simd` holds only where `avx2::available` found AVX2, the row's only
+            // safety condition. The same bytes as the loop below
+            // (`avx2_rows_match_parallax_color`).
+            unsafe { avx2::row(rig, scale, depth, out) };
+            return;
+        }
+        let _ = simd;
+        for (out, d) in out.iter_mut().zip(depth) {
+            out.write(parallax_pixel_color(rig, *d, scale));
+        }
+    };
+    // SAFETY: both row programs write one pixel per depth value, and the depth row is as long
+    // as the output row (`check_depth`: width × height values).
+    let mut bytes = unsafe { par_fill_rows(n, w, legend.data().len(), fill) };
+    let negative = |x: usize, y: usize| {
+        rig.parallax_pixels(fb.depth[y * w + x])
+            .is_some_and(|p| p < 0.0)
+    };
+    for i in violation_marks_where(fb.width, fb.height, negative) {
+        bytes[4 * i..4 * i + 4].copy_from_slice(&VIOLATION_COLOR);
+    }
+    bytes.extend_from_slice(legend.data());
+    let h = fb.height + legend.height();
+    Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))
+}
+
+/// One pixel of the parallax image before the window marks: the background color, or
+/// [`parallax_color`] of the pixel's parallax.
+#[inline]
+pub fn parallax_pixel_color(rig: &ParallaxRig, window_depth: f32, scale: f64) -> [u8; 4] {
+    rig.parallax_pixels(window_depth)
+        .map_or(PARALLAX_BACKGROUND, |p| parallax_color(p, scale))
+}
+
+/// [`parallax_image`] as the readable program it is held to (`parallax_image_matches_reference`):
+/// the parallax map, its budget, the color scale, the colors, the marks, the legend (drawn by
+/// tiny-skia, [`draw_legend_reference`]).
+///
+/// # Errors
+/// As [`parallax_map`].
+pub fn parallax_image_reference(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> {
     let map = parallax_map(fb, rig)?;
     let b = budget(&map, fb.width, fb.height);
     let scale = color_scale(&b);
-    let legend = draw_legend(fb.width, scale, &|p| parallax_color(p, scale))?;
+    let legend = draw_legend_reference(fb.width, scale, &|p| parallax_color(p, scale))?;
     let mut bytes: Vec<u8> = map
         .iter()
         .flat_map(|p| p.map_or(PARALLAX_BACKGROUND, |p| parallax_color(p, scale)))
@@ -298,4 +462,99 @@ pub fn parallax_image(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> 
     bytes.extend_from_slice(legend.data());
     let h = fb.height + legend.height();
     Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rig(near: f64, far: f64, z0: f64, balance: f64, width: u32, height: u32) -> ParallaxRig {
+        ParallaxRig {
+            eye_separation: 0.065,
+            zero_parallax_distance: z0,
+            balance,
+            near,
+            far,
+            pixels_per_unit: width as f64 / 1.7,
+            width,
+            height,
+        }
+    }
+
+    /// `parallax_image` (AVX2 rows where the CPU has them, and the scalar rows) gives
+    /// `parallax_image_reference`'s bytes: sizes from 1×1 (no legend bar) to odd widths, depth
+    /// buffers with nothing drawn, everything drawn, negative parallax at every border (window
+    /// marks), one drawn pixel, and rigs whose extremes cannot be read off the depth extremes
+    /// (far < near, a non-finite factor: the full scan).
+    #[test]
+    fn parallax_image_matches_reference() {
+        let mut state = 0x853c_49e6_748f_ea9b_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut cases = 0;
+        for (width, height) in [(1, 1), (2, 3), (13, 7), (37, 19), (130, 41)] {
+            let rigs = [
+                rig(0.1, 50.0, 4.0, 1.0, width, height),
+                rig(1.0, 20.0, 19.0, 0.0, width, height),
+                rig(1e-5, 1.0, 0.5, 0.5, width, height),
+                rig(3.0, 2.0, 2.5, 1.0, width, height),
+                rig(0.1, 50.0, f64::INFINITY, 1.0, width, height),
+            ];
+            for (k, r) in rigs.iter().enumerate() {
+                for pattern in 0..5 {
+                    let mut fb = Framebuffer::new(width, height, [0, 0, 0, 255]).unwrap();
+                    for (i, d) in fb.depth.iter_mut().enumerate() {
+                        *d = match pattern {
+                            0 => 1.0,
+                            1 => (next() % 1_000_000) as f32 / 1e6,
+                            2 => {
+                                // Near (negative parallax) along the borders, far inside.
+                                let (x, y) = (i as u32 % width, i as u32 / width);
+                                if x == 0 || y == 0 || x + 1 == width || y + 1 == height {
+                                    (next() % 1000) as f32 * 1e-5
+                                } else {
+                                    0.9 + (next() % 1000) as f32 * 1e-4
+                                }
+                            }
+                            3 if i == 0 => 0.25,
+                            3 => 1.0,
+                            _ if next() % 3 == 0 => 1.0,
+                            _ => (next() % 1_000_000) as f32 / 1e6,
+                        };
+                    }
+                    let want = parallax_image_reference(&fb, r).unwrap();
+                    for simd in [true, false] {
+                        let got = parallax_image_with(&fb, r, simd).unwrap();
+                        assert_eq!(got.dimensions(), want.dimensions());
+                        if let Some(i) = got
+                            .as_raw()
+                            .iter()
+                            .zip(want.as_raw())
+                            .position(|(a, b)| a != b)
+                        {
+                            panic!(
+                                "{width}x{height}, rig {k}, pattern {pattern}, simd {simd}: byte {i} \
+                                 (pixel {}) differs",
+                                i / 4
+                            );
+                        }
+                        cases += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(cases, 5 * 5 * 5 * 2);
+    }
+
+    /// Bad input is an error, not a panic: a framebuffer of another size than the rig's.
+    #[test]
+    fn parallax_image_rejects_a_size_mismatch() {
+        let fb = Framebuffer::new(4, 4, [0, 0, 0, 255]).unwrap();
+        let err = parallax_image(&fb, &rig(0.1, 50.0, 4.0, 1.0, 5, 4)).unwrap_err();
+        assert!(err.to_string().contains("5x4"), "{err}");
+    }
 }
