@@ -312,3 +312,69 @@ fn gpu_render_writes_the_wgsl_finalize_outputs() {
     );
     println!("outputs where the WGSL route differs from the CPU's: {differs_from_cpu:?}");
 }
+
+/// The texture-resident frame (`GpuRenderer::render_resident`: eyes drawn into textures, the
+/// WGSL pass reading them in the same submission, only the output read back) gives the bytes
+/// of the host route (`render`, readback of both eyes, upload, the same pass, readback), for
+/// every anaglyph kind on stored values and in linear light, with the eyes swapped, and for
+/// both remaps, several outputs in one frame; an output that needs the host is refused.
+#[test]
+fn resident_frames_equal_the_host_route_byte_for_byte() {
+    use stereolab::gpu::resident::is_resident;
+    use stereolab::gpu::{GpuScene, effects::produce_wgsl};
+    use stereolab::plan::{Output, Plan};
+    let Some(r) = gpu() else { return };
+    let fin = GpuFinalize::new(r).expect("compiles");
+    let mut scene = Scene::load(&common::asset("scenes/wuson.toml"), &[]).expect("scene");
+    scene.set_size(320, 240).expect("size");
+    let mut outputs: Vec<Output> = AnaglyphKind::ALL.map(Output::Anaglyph).to_vec();
+    outputs.extend([Output::RemapLeft, Output::RemapRight]);
+    let mut compared = 0;
+    for (linear_light, swap_eyes) in [(false, false), (true, false), (false, true)] {
+        scene.finalize.linear_light = linear_light;
+        scene.finalize.swap_eyes = swap_eyes;
+        let gpu_scene = GpuScene::upload(r, &scene).expect("upload");
+        let host = r.render(&gpu_scene, &Plan::new(&outputs)).expect("frame");
+        let resident = r
+            .render_resident(&gpu_scene, &fin, &outputs)
+            .expect("resident frame");
+        assert_eq!(resident.len(), outputs.len());
+        for (o, img) in outputs.iter().zip(&resident) {
+            let expected = produce_wgsl(r, &fin, *o, &host, &scene)
+                .expect("wgsl")
+                .expect("has a WGSL pass");
+            let (max, n) = diff(&expected, img);
+            assert_eq!(
+                (max, n),
+                (0, 0),
+                "{} (linear {linear_light}, swap {swap_eyes}): resident differs from the host \
+                 route in {n} pixels, by up to {max} levels",
+                o.name()
+            );
+            compared += 1;
+        }
+        // One output alone takes the same route (the plan has only its passes).
+        let alone = r
+            .render_resident(&gpu_scene, &fin, &[Output::RemapRight])
+            .expect("resident remap");
+        assert_eq!(alone[0], resident[resident.len() - 1], "remap_right alone");
+    }
+    assert_eq!(compared, 3 * 11);
+    // The images are not all one: the kinds and options do change the bytes compared above.
+    let gpu_scene = GpuScene::upload(r, &scene).expect("upload");
+    let two = r
+        .render_resident(
+            &gpu_scene,
+            &fin,
+            &[Output::Anaglyph(AnaglyphKind::True), Output::RemapLeft],
+        )
+        .expect("two outputs");
+    assert_ne!(two[0], two[1]);
+    for o in [Output::Occlusion, Output::Parallax, Output::SideBySide] {
+        assert!(!is_resident(o));
+        let e = r
+            .render_resident(&gpu_scene, &fin, &[o])
+            .expect_err("needs the host");
+        assert!(e.to_string().contains(o.name()), "{e}");
+    }
+}

@@ -174,9 +174,50 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// The stereo pair + Dubois anaglyph frame as each backend's `render` makes it: the CPU path
-/// (passes + `anaglyph`), and the GPU path (passes, readback, then the WGSL anaglyph pass with
-/// its upload and readback, as `render --backend gpu` does), as a ratio in the same run.
+/// Medians of `iters` runs of each of `fs` (after one warm-up run of each), the runs taken
+/// round-robin so that a slow spell of the shared machine falls on every row alike and the
+/// ratios between them stay fair.
+///
+/// # Errors
+/// The first error of any run.
+fn interleaved_medians(
+    iters: usize,
+    fs: &mut [&mut dyn FnMut() -> Result<()>],
+) -> Result<Vec<f64>> {
+    for f in fs.iter_mut() {
+        f()?;
+    }
+    let mut times = vec![Vec::with_capacity(iters); fs.len()];
+    for _ in 0..iters.max(1) {
+        for (f, t) in fs.iter_mut().zip(&mut times) {
+            let start = std::time::Instant::now();
+            f()?;
+            t.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    Ok(times
+        .into_iter()
+        .map(|mut v| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        })
+        .collect())
+}
+
+/// The stereo pair + Dubois anaglyph frame (issue 19, goal 2), timed round-robin in one run:
+/// - the CPU path (passes + `anaglyph`);
+/// - the GPU path through the host, as `render --backend gpu` makes it: passes, readback of
+///   both eyes (color and depth), then the WGSL anaglyph pass with its upload and readback;
+/// - the GPU path with the eyes on the GPU ([`GpuRenderer::render_resident`]): passes into
+///   textures, the anaglyph pass reading them in the same submission, one readback of the
+///   anaglyph's color;
+/// - the yardsticks: the GPU stereo pair alone (with its readback into framebuffers, the
+///   `backend` row), the same passes with no readback at all (the floor), the resident frame
+///   with the anaglyph made twice (the marginal cost of one finalize pass and its readback),
+///   and the plain wgpu program of [`super::gpu_oneshot`].
+///
+/// The goal rows' notes carry the ratios; the resident row's error is against the CPU and its
+/// note says whether its bytes equal the host route's.
 fn pair_and_anaglyph(
     r: &GpuRenderer,
     gpu_scene: &GpuScene,
@@ -185,31 +226,65 @@ fn pair_and_anaglyph(
 ) -> Result<Vec<Row>> {
     let output = Output::Anaglyph(AnaglyphKind::DuboisRedCyan);
     let plan = Plan::new(&[output]);
+    let pair = Plan::new(&[Output::Left, Output::Right]);
     let fin = GpuFinalize::new(r)?;
     let cpu_frame = || -> Result<Image> { produce(output, &render(scene, &plan)?, scene) };
-    let gpu_frame = || -> Result<Image> {
+    let host_frame = || -> Result<image::RgbaImage> {
         let frame = r.render(gpu_scene, &plan)?;
         crate::gpu::effects::produce_wgsl(r, &fin, output, &frame, scene)?
-            .map(Image::Rgba)
             .ok_or_else(|| crate::Error::internal("anaglyph", "no WGSL pass"))
     };
-    let rgba = |i: Image| match i {
-        Image::Rgba(img) => Ok(framebuffer_from_image(&img, scene.background)),
-        _ => Err(crate::Error::internal("anaglyph", "not an RGBA image")),
+    let resident_frame = || -> Result<image::RgbaImage> {
+        r.render_resident(gpu_scene, &fin, &[output])?
+            .pop()
+            .ok_or_else(|| crate::Error::internal("anaglyph", "no image came back"))
     };
-    let max_diff = compare(&rgba(cpu_frame()?)?, &rgba(gpu_frame()?)?)?.max_channel_diff;
-    let mut failed = None;
-    let cpu_ms = median_ms(iters, || cpu_frame().map_err(|e| failed = Some(e)));
-    let gpu_ms = median_ms(iters, || gpu_frame().map_err(|e| failed = Some(e)));
-    if let Some(e) = failed {
-        return Err(e);
-    }
+    let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
+    let oneshot = super::gpu_oneshot::OneShot::new(scene, &eyes)?;
+    let cpu = match cpu_frame()? {
+        Image::Rgba(img) => framebuffer_from_image(&img, scene.background),
+        _ => return Err(crate::Error::internal("anaglyph", "not an RGBA image")),
+    };
+    let host = host_frame()?;
+    let resident = resident_frame()?;
+    let identical = host == resident;
+    let fb = |img: &image::RgbaImage| framebuffer_from_image(img, scene.background);
+    let host_diff = compare(&cpu, &fb(&host))?.max_channel_diff;
+    let resident_diff = compare(&cpu, &fb(&resident))?.max_channel_diff;
+    let ms = interleaved_medians(
+        iters,
+        &mut [
+            &mut || cpu_frame().map(drop),
+            &mut || host_frame().map(drop),
+            &mut || resident_frame().map(drop),
+            &mut || r.render(gpu_scene, &pair).map(drop),
+            &mut || r.render_without_readback(gpu_scene, &pair),
+            &mut || oneshot.frame().map(drop),
+            &mut || {
+                r.render_resident(gpu_scene, &fin, &[output, output])
+                    .map(drop)
+            },
+        ],
+    )?;
+    let [
+        cpu_ms,
+        host_ms,
+        resident_ms,
+        pair_ms,
+        floor_ms,
+        oneshot_ms,
+        two_ms,
+    ] = ms[..]
+    else {
+        return Err(crate::Error::internal("bench", "seven timings expected"));
+    };
     let size = format!("{}x{}", scene.width, scene.height);
-    let row = |setting: String, ms: f64, note: String| Row {
+    let gpu = r.short_name();
+    let row = |setting: String, error: Option<u8>, ms: f64, note: String| Row {
         area: "gpu parity".into(),
         knob: "pair + anaglyph".into(),
         setting,
-        error: Some(f64::from(max_diff)),
+        error: error.map(f64::from),
         error_unit: "max level vs cpu".into(),
         ms,
         note,
@@ -217,16 +292,74 @@ fn pair_and_anaglyph(
     Ok(vec![
         row(
             "cpu".into(),
+            Some(0),
             cpu_ms,
             format!(
-                "stereo pair + Dubois anaglyph {size}; cpu/gpu time = {:.2}",
-                cpu_ms / gpu_ms
+                "stereo pair + Dubois anaglyph {size}; cpu/{gpu} resident time = {:.2}",
+                cpu_ms / resident_ms
             ),
         ),
         row(
-            r.short_name(),
-            gpu_ms,
-            format!("{size}: passes + readback + WGSL anaglyph (upload, pass, readback)"),
+            format!("{gpu}, eyes via host"),
+            Some(host_diff),
+            host_ms,
+            format!(
+                "{size}: passes + readback of both eyes + WGSL anaglyph (upload, pass, \
+                 readback); / pair alone = {:.2}",
+                host_ms / pair_ms
+            ),
+        ),
+        row(
+            format!("{gpu}, eyes on gpu"),
+            Some(resident_diff),
+            resident_ms,
+            format!(
+                "{size}: passes + WGSL anaglyph in 1 submission, 1 readback of the anaglyph; \
+                 / pair alone = {:.2} (goal <= 1.2), / wgpu one submission = {:.2} \
+                 (goal <= 1.1); bytes {} the host route's",
+                resident_ms / pair_ms,
+                resident_ms / oneshot_ms,
+                if identical {
+                    "identical to"
+                } else {
+                    "DIFFER from"
+                }
+            ),
+        ),
+        row(
+            format!("{gpu} pair alone"),
+            None,
+            pair_ms,
+            format!("{size}: both eye passes + readback of color and depth (the backend row)"),
+        ),
+        row(
+            format!("{gpu} pair, no readback"),
+            None,
+            floor_ms,
+            format!(
+                "{size}: both eye passes into textures, submitted and waited for: the floor; \
+                 eyes-on-gpu minus this = {:.2} ms of anaglyph pass + its readback",
+                resident_ms - floor_ms
+            ),
+        ),
+        row(
+            format!("{gpu}, eyes on gpu, 2 anaglyphs"),
+            None,
+            two_ms,
+            format!(
+                "{size}: the same frame with the anaglyph pass run twice, both read back: one \
+                 more pass + its readback costs {:.2} ms",
+                two_ms - resident_ms
+            ),
+        ),
+        row(
+            "wgpu one submission".into(),
+            None,
+            oneshot_ms,
+            format!(
+                "{size}: the plain wgpu program (gpu_oneshot), timed in this round-robin; {}",
+                oneshot.adapter()
+            ),
         ),
     ])
 }

@@ -32,9 +32,10 @@ const REMAP_WGSL: &str = include_str!("shaders/remap.wgsl");
 
 /// The compiled finalize passes. Build once, run on any framebuffers.
 pub struct GpuFinalize {
-    anaglyph: FullscreenPass,
+    /// The anaglyph on stored values, and in linear light (`LINEAR_LIGHT` false and true).
+    anaglyph: [FullscreenPass; 2],
     parallax: FullscreenPass,
-    remap: FullscreenPass,
+    pub(super) remap: FullscreenPass,
 }
 
 /// An 8-bit color as the shaders' 0..1 floats.
@@ -63,9 +64,9 @@ impl GpuFinalize {
     /// A shader that does not compile or validate (naga's message).
     pub fn new(r: &GpuRenderer) -> Result<GpuFinalize> {
         Ok(GpuFinalize {
-            anaglyph: FullscreenPass::new(r, "anaglyph.wgsl", ANAGLYPH_WGSL, 2)?,
+            anaglyph: [anaglyph_pass(r, false)?, anaglyph_pass(r, true)?],
             parallax: FullscreenPass::new(r, "parallax.wgsl", PARALLAX_WGSL, 1)?,
-            remap: FullscreenPass::new(r, "remap.wgsl", REMAP_WGSL, 2)?,
+            remap: FullscreenPass::new_color_only(r, "remap.wgsl", REMAP_WGSL, 2)?,
         })
     }
 
@@ -85,13 +86,14 @@ impl GpuFinalize {
     ) -> Result<RgbaImage> {
         check_same_size(left, right)?;
         let (left, right) = options.eyes(left, right);
-        let m = kind.matrices();
-        let mut params = Vec::with_capacity(28);
-        for row in m.left.iter().chain(&m.right) {
-            params.extend([row[0], row[1], row[2], 0.0]);
-        }
-        params.extend([f32::from(u8::from(options.linear_light)), 0.0, 0.0, 0.0]);
-        Ok(image_of(&self.anaglyph.run(r, &[left, right], &params)?))
+        let params = anaglyph_params(kind);
+        let pass = self.anaglyph_pass(options);
+        Ok(image_of(&pass.run(r, &[left, right], &params)?))
+    }
+
+    /// The anaglyph pass for `options`' mode (stored values or linear light).
+    pub(super) fn anaglyph_pass(&self, options: AnaglyphOptions) -> &FullscreenPass {
+        &self.anaglyph[usize::from(options.linear_light)]
     }
 
     /// Parallax in pixels per pixel of `fb` on the GPU (NaN on the background), and the image
@@ -182,6 +184,32 @@ impl GpuFinalize {
     }
 }
 
+/// anaglyph.wgsl's parameters: the kind's ML and MR rows.
+pub(super) fn anaglyph_params(kind: AnaglyphKind) -> Vec<f32> {
+    let m = kind.matrices();
+    let mut params = Vec::with_capacity(24);
+    for row in m.left.iter().chain(&m.right) {
+        params.extend([row[0], row[1], row[2], 0.0]);
+    }
+    params
+}
+
+/// anaglyph.wgsl compiled for one mode: `LINEAR_LIGHT` is a constant of the shader, so the
+/// stored-value pipeline has no sRGB curves in it at all (llvmpipe may run both sides of a
+/// uniform branch under an execution mask).
+///
+/// # Errors
+/// As [`FullscreenPass::new`].
+fn anaglyph_pass(r: &GpuRenderer, linear_light: bool) -> Result<FullscreenPass> {
+    let source = format!("const LINEAR_LIGHT: bool = {linear_light};\n{ANAGLYPH_WGSL}");
+    let label = if linear_light {
+        "anaglyph.wgsl (linear light)"
+    } else {
+        "anaglyph.wgsl"
+    };
+    FullscreenPass::new_color_only(r, label, &source, 2)
+}
+
 /// The output made by its WGSL mirror on the GPU, for the finalize outputs that have one
 /// (anaglyphs, remap, occlusion, parallax color; the parallax legend is tiny-skia's, drawn on
 /// the host at the GPU's color scale); `None` for every other output (layouts stay on the
@@ -259,7 +287,7 @@ fn parallax_scale(values: &[f32]) -> f32 {
 ///
 /// # Errors
 /// `this_mvp` not finite or singular.
-fn remap_params(
+pub(super) fn remap_params(
     this_mvp: &Mat4,
     other_mvp: &Mat4,
     mode: f32,

@@ -10,7 +10,7 @@ use crate::framebuffer::Framebuffer;
 
 use super::device::GpuRenderer;
 use super::gpu_error;
-use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
+use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read, submit_and_read_colors};
 use super::resources::{texture_2d, write_texels};
 
 /// Vertex stage and helpers every full-screen shader gets.
@@ -30,6 +30,8 @@ pub struct FullscreenPass {
     layout: wgpu::BindGroupLayout,
     inputs: usize,
     label: String,
+    /// The pass has the R32 depth target (else its shader's `depth` output is ignored).
+    writes_depth: bool,
 }
 
 impl FullscreenPass {
@@ -40,6 +42,32 @@ impl FullscreenPass {
     /// # Errors
     /// No inputs, or the shader does not compile or validate (the message is naga's).
     pub fn new(r: &GpuRenderer, label: &str, fragment_wgsl: &str, inputs: usize) -> Result<Self> {
+        FullscreenPass::build(r, label, fragment_wgsl, inputs, true)
+    }
+
+    /// As [`FullscreenPass::new`], for a pass whose output is its color alone: the pipeline
+    /// has no R32 depth target, so the shader's `depth` output is dropped instead of written
+    /// to (and cleared in) a second 4-byte-per-pixel texture. [`FullscreenPass::run`] then
+    /// returns depth 0 everywhere.
+    ///
+    /// # Errors
+    /// As [`FullscreenPass::new`].
+    pub fn new_color_only(
+        r: &GpuRenderer,
+        label: &str,
+        fragment_wgsl: &str,
+        inputs: usize,
+    ) -> Result<Self> {
+        FullscreenPass::build(r, label, fragment_wgsl, inputs, false)
+    }
+
+    fn build(
+        r: &GpuRenderer,
+        label: &str,
+        fragment_wgsl: &str,
+        inputs: usize,
+        writes_depth: bool,
+    ) -> Result<Self> {
         if inputs == 0 {
             return Err(Error::invalid(
                 "fullscreen pass inputs",
@@ -130,7 +158,8 @@ impl FullscreenPass {
                     module: &module,
                     entry_point: Some("fs_main"),
                     compilation_options: Default::default(),
-                    targets: &[target(COLOR_FORMAT), target(DepthKind::ColorR32.format())],
+                    targets: &[target(COLOR_FORMAT), target(DepthKind::ColorR32.format())]
+                        [..1 + usize::from(writes_depth)],
                 }),
                 multiview_mask: None,
                 cache: None,
@@ -146,6 +175,7 @@ impl FullscreenPass {
             layout,
             inputs,
             label: label.to_string(),
+            writes_depth,
         })
     }
 
@@ -193,17 +223,67 @@ impl FullscreenPass {
             ));
         }
         let target = Target::take(r, width, height, DepthKind::ColorR32)?;
-        let mut views = Vec::with_capacity(2 * inputs.len());
+        let mut views = Vec::with_capacity(inputs.len());
         for fb in inputs {
             let color: Vec<u8> = fb.color.iter().flatten().copied().collect();
             let depth: Vec<u8> = fb.depth.iter().flat_map(|d| d.to_ne_bytes()).collect();
-            views.push(upload_texture(r, COLOR_FORMAT, width, height, &color));
-            views.push(upload_texture(
-                r,
-                DepthKind::ColorR32.format(),
-                width,
-                height,
-                &depth,
+            views.push([
+                upload_texture(r, COLOR_FORMAT, width, height, &color),
+                upload_texture(r, DepthKind::ColorR32.format(), width, height, &depth),
+            ]);
+        }
+        let mut encoder = r
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        let refs: Vec<[&wgpu::TextureView; 2]> = views.iter().map(|[c, d]| [c, d]).collect();
+        self.encode(r, &mut encoder, &refs, params, &target)?;
+        let out = if self.writes_depth {
+            target.encode_copies(&mut encoder);
+            submit_and_read(r, encoder, &[&target])?.pop()
+        } else {
+            target.encode_color_copy(&mut encoder);
+            submit_and_read_colors(r, encoder, &[&target])?
+                .pop()
+                .map(|img| Framebuffer {
+                    width,
+                    height,
+                    color: img.pixels().map(|p| p.0).collect(),
+                    depth: vec![0.0; width as usize * height as usize],
+                })
+        };
+        Target::give_back(r, [target]);
+        out.ok_or_else(|| crate::Error::internal(&self.label, "no framebuffer came back"))
+    }
+
+    /// Records the pass into `encoder`, reading `inputs` (per input its color view and its
+    /// depth view, as textures where they lie: uploaded by [`FullscreenPass::run`], or the
+    /// eye targets a scene pass just drew, which are read without leaving the GPU) and
+    /// drawing into `target`'s color and R32 depth (color alone for a
+    /// [`FullscreenPass::new_color_only`] pass). The same shader, parameters and input
+    /// texels give the same bytes either way.
+    ///
+    /// # Errors
+    /// Wrong number of inputs or too many parameters.
+    pub(crate) fn encode(
+        &self,
+        r: &GpuRenderer,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &[[&wgpu::TextureView; 2]],
+        params: &[f32],
+        target: &Target,
+    ) -> Result<()> {
+        if inputs.len() != self.inputs {
+            return Err(Error::invalid(
+                format!("{} inputs", self.label),
+                inputs.len(),
+                format!("this pass takes {}", self.inputs),
+            ));
+        }
+        if params.len() > MAX_PARAMS {
+            return Err(Error::invalid(
+                format!("{} params", self.label),
+                params.len(),
+                format!("at most {MAX_PARAMS}"),
             ));
         }
         let mut param_bytes = vec![0u8; 4 * MAX_PARAMS];
@@ -217,8 +297,9 @@ impl FullscreenPass {
             mapped_at_creation: false,
         });
         r.queue.write_buffer(&param_buffer, 0, &param_bytes);
-        let mut entries: Vec<wgpu::BindGroupEntry> = views
+        let mut entries: Vec<wgpu::BindGroupEntry> = inputs
             .iter()
+            .flatten()
             .enumerate()
             .map(|(i, v)| wgpu::BindGroupEntry {
                 binding: i as u32,
@@ -226,7 +307,7 @@ impl FullscreenPass {
             })
             .collect();
         entries.push(wgpu::BindGroupEntry {
-            binding: views.len() as u32,
+            binding: 2 * inputs.len() as u32,
             resource: param_buffer.as_entire_binding(),
         });
         let bind_group = r.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -234,38 +315,30 @@ impl FullscreenPass {
             layout: &self.layout,
             entries: &entries,
         });
-        let mut encoder = r
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        {
-            let attachment = |view| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
-            };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&self.label),
-                color_attachments: &[
-                    attachment(&target.color_view),
-                    attachment(&target.depth_view),
-                ],
-                ..Default::default()
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.draw(0..3, 0..1);
-        }
-        target.encode_copies(&mut encoder);
-        let mut out = submit_and_read(r, encoder, &[&target])?;
-        Target::give_back(r, [target]);
-        out.pop()
-            .ok_or_else(|| crate::Error::internal(&self.label, "no framebuffer came back"))
+        let attachment = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let attachments = [
+            attachment(&target.color_view),
+            attachment(&target.depth_view),
+        ];
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&self.label),
+            color_attachments: &attachments[..1 + usize::from(self.writes_depth)],
+            ..Default::default()
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
     }
 }
 

@@ -14,9 +14,10 @@
 //!
 //! Layout: [`device`] (adapter, device, pipeline cache), [`raster`] (scene passes),
 //! [`fullscreen`] (the generic full-screen pass that effects mirror), [`effects`] (the finalize
-//! effects in WGSL), `readback` (textures to
-//! framebuffers), [`sirds`] (the SIRDS paper's strips as render-to-texture ping-pong), [`parity`]
-//! (render both paths and compare, and the benchmark row).
+//! effects in WGSL), `readback` (textures to framebuffers), [`resident`] (frames whose eyes
+//! stay on the GPU: the finalize passes read them there and only the outputs come back),
+//! [`sirds`] (the SIRDS paper's strips as render-to-texture ping-pong), [`parity`] (render both
+//! paths and compare, and the benchmark row).
 
 pub mod device;
 pub mod effects;
@@ -25,6 +26,7 @@ pub mod output;
 pub mod parity;
 pub mod raster;
 mod readback;
+pub mod resident;
 mod resources;
 pub mod sirds;
 pub mod sirds_frame;

@@ -107,6 +107,45 @@ impl<'a> GpuScene<'a> {
     }
 }
 
+/// The matrices and shading of every pass of a plan, with the matrices they were looked up
+/// in (as [`crate::render::render`] looks them up).
+pub(crate) struct PlannedViews {
+    /// The rig's eyes.
+    pub eyes: [EyeMatrices; 2],
+    /// The cyclopean eye.
+    pub center: EyeMatrices,
+    /// The shear and rotate rigs' eyes, when the plan has such passes.
+    pub shear_rotate: Option<[[EyeMatrices; 2]; 2]>,
+    /// Per pass of the plan, in order.
+    pub passes: Vec<(EyeMatrices, Shading)>,
+}
+
+/// The [`PlannedViews`] of `plan` on `s`.
+///
+/// # Errors
+/// Invalid camera or rig.
+pub(crate) fn plan_views(s: &Scene, plan: &Plan) -> Result<PlannedViews> {
+    let eyes = s.rig.eyes_for_image(&s.camera, s.width, s.height)?;
+    let center = StereoRig::center(&s.camera, s.aspect())?;
+    let shear_rotate = planned_shear_rotate_eyes(s, plan)?;
+    let passes = plan
+        .passes
+        .iter()
+        .map(|p| {
+            Ok((
+                Frame::lookup(&eyes, &center, &shear_rotate, p.view)?,
+                p.shading,
+            ))
+        })
+        .collect::<Result<_>>()?;
+    Ok(PlannedViews {
+        eyes,
+        center,
+        shear_rotate,
+        passes,
+    })
+}
+
 impl GpuRenderer {
     /// Renders every pass of `plan`, like [`crate::render::render`]: all passes go into one
     /// submission, so each [`PassResult::time`] is the whole frame's time including readback,
@@ -117,20 +156,13 @@ impl GpuRenderer {
     /// Invalid camera or rig, or a GPU failure.
     pub fn render(&self, scene: &GpuScene, plan: &Plan) -> Result<Frame> {
         let s = scene.scene;
-        let eyes = s.rig.eyes_for_image(&s.camera, s.width, s.height)?;
-        let center = StereoRig::center(&s.camera, s.aspect())?;
-        let shear_rotate = planned_shear_rotate_eyes(s, plan)?;
         let start = Instant::now();
-        let passes: Vec<(EyeMatrices, Shading)> = plan
-            .passes
-            .iter()
-            .map(|p| {
-                Ok((
-                    Frame::lookup(&eyes, &center, &shear_rotate, p.view)?,
-                    p.shading,
-                ))
-            })
-            .collect::<Result<_>>()?;
+        let PlannedViews {
+            eyes,
+            center,
+            shear_rotate,
+            passes,
+        } = plan_views(s, plan)?;
         let framebuffers = self.render_views(scene, &passes)?;
         let time = start.elapsed();
         let triangles: usize = s.objects.iter().map(|o| o.mesh.triangles.len()).sum();
@@ -181,6 +213,32 @@ impl GpuRenderer {
         scene: &GpuScene,
         views: &[(EyeMatrices, Shading)],
     ) -> Result<Vec<Framebuffer>> {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        let targets = self.encode_views(scene, views, &mut encoder)?;
+        for t in &targets {
+            t.encode_copies(&mut encoder);
+        }
+        let refs: Vec<&Target> = targets.iter().collect();
+        let framebuffers = submit_and_read(self, encoder, &refs)?;
+        // Only after a clean readback: a failed one may leave a buffer mapped.
+        Target::give_back(self, targets);
+        Ok(framebuffers)
+    }
+
+    /// Records one scene pass per view into `encoder`, each into a target of its own (color
+    /// and depth textures that stay on the GPU until a copy is recorded), in `views`' order.
+    /// Hand the targets back with `Target::give_back` once the submission has completed.
+    ///
+    /// # Errors
+    /// Resolving a ChromaDepth view's texgen or ramp fails, or a target cannot be made.
+    pub(crate) fn encode_views(
+        &self,
+        scene: &GpuScene,
+        views: &[(EyeMatrices, Shading)],
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<Vec<Target>> {
         let s = scene.scene;
         let align = self.device.limits().min_uniform_buffer_offset_alignment as u64;
         let slot = UNIFORM_BYTES.next_multiple_of(align);
@@ -245,9 +303,6 @@ impl GpuRenderer {
             .iter()
             .map(|_| Target::take(self, s.width, s.height, DepthKind::DepthBuffer))
             .collect::<Result<Vec<_>>>()?;
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
         let bg = s.background.map(|c| c as f64 / 255.0);
         let clear = wgpu::Color {
             r: bg[0],
@@ -313,14 +368,7 @@ impl GpuRenderer {
                 pass.draw_indexed(0..mesh.index_count, 0, 0..1);
             }
         }
-        for t in &targets {
-            t.encode_copies(&mut encoder);
-        }
-        let refs: Vec<&Target> = targets.iter().collect();
-        let framebuffers = submit_and_read(self, encoder, &refs)?;
-        // Only after a clean readback: a failed one may leave a buffer mapped.
-        Target::give_back(self, targets);
-        Ok(framebuffers)
+        Ok(targets)
     }
 
     /// The pipeline for `key`, built on first use.

@@ -3,6 +3,7 @@
 
 use std::sync::mpsc;
 
+use image::RgbaImage;
 use rayon::prelude::*;
 
 use crate::error::Result;
@@ -96,7 +97,11 @@ impl Target {
     /// A side the device does not support.
     fn new(r: &GpuRenderer, width: u32, height: u32, depth_kind: DepthKind) -> Result<Self> {
         r.check_target_size(width, height)?;
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        // TEXTURE_BINDING: a finalize pass may read the target where it lies
+        // (`FullscreenPass::encode`), without a readback and a re-upload.
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::TEXTURE_BINDING;
         let texture = |label, format| texture_2d(r, label, width, height, format, usage);
         let color = texture("color target", COLOR_FORMAT);
         let depth = texture("depth target", depth_kind.format());
@@ -125,15 +130,27 @@ impl Target {
 
     /// Records the copies of both textures into the readback buffers.
     pub(crate) fn encode_copies(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.encode(encoder, true);
+    }
+
+    /// Records the copy of the color texture alone (for [`submit_and_read_colors`]): what an
+    /// output image needs, a quarter or half of [`Target::encode_copies`]'s bytes.
+    pub(crate) fn encode_color_copy(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.encode(encoder, false);
+    }
+
+    fn encode(&self, encoder: &mut wgpu::CommandEncoder, with_depth: bool) {
         let size = wgpu::Extent3d {
             width: self.width,
             height: self.height,
             depth_or_array_layers: 1,
         };
-        for (texture, aspect, buffer) in [
+        let copies = [
             (&self.color, wgpu::TextureAspect::All, &self.color_buffer),
             (&self.depth, self.depth_kind.aspect(), &self.depth_buffer),
-        ] {
+        ];
+        for (texture, aspect, buffer) in &copies[..1 + usize::from(with_depth)] {
+            let (texture, aspect, buffer) = (*texture, *aspect, *buffer);
             encoder.copy_texture_to_buffer(
                 wgpu::TexelCopyTextureInfo {
                     texture,
@@ -165,15 +182,52 @@ pub(crate) fn submit_and_read(
     encoder: wgpu::CommandEncoder,
     targets: &[&Target],
 ) -> Result<Vec<Framebuffer>> {
+    let buffers: Vec<&wgpu::Buffer> = targets
+        .iter()
+        .flat_map(|t| [&t.color_buffer, &t.depth_buffer])
+        .collect();
+    submit_and_map(r, encoder, &buffers)?;
+    // One target per thread: unpadding a 1024×768 pair takes 2–6 ms on one thread.
+    targets.par_iter().map(|t| read_target(t)).collect()
+}
+
+/// Submits `encoder` (which must have recorded [`Target::encode_color_copy`] for every
+/// target), waits, and reads every target's color back as an image, in order. The images'
+/// bytes are those [`submit_and_read`] would give as `Framebuffer::to_rgba_image`.
+///
+/// # Errors
+/// The device was lost, or a buffer could not be mapped.
+pub(crate) fn submit_and_read_colors(
+    r: &GpuRenderer,
+    encoder: wgpu::CommandEncoder,
+    targets: &[&Target],
+) -> Result<Vec<RgbaImage>> {
+    let buffers: Vec<&wgpu::Buffer> = targets.iter().map(|t| &t.color_buffer).collect();
+    submit_and_map(r, encoder, &buffers)?;
+    targets.iter().map(|t| read_color(t)).collect()
+}
+
+/// Submits `encoder` and nothing else, and waits until the GPU has done it (no readback).
+///
+/// # Errors
+/// The device was lost.
+pub(crate) fn submit_and_wait(r: &GpuRenderer, encoder: wgpu::CommandEncoder) -> Result<()> {
+    submit_and_map(r, encoder, &[])
+}
+
+/// Submits `encoder`, maps `buffers` for reading and waits for both.
+fn submit_and_map(
+    r: &GpuRenderer,
+    encoder: wgpu::CommandEncoder,
+    buffers: &[&wgpu::Buffer],
+) -> Result<()> {
     r.queue.submit([encoder.finish()]);
     let (tx, rx) = mpsc::channel();
-    for t in targets {
-        for b in [&t.color_buffer, &t.depth_buffer] {
-            let tx = tx.clone();
-            b.map_async(wgpu::MapMode::Read, .., move |res| {
-                let _ = tx.send(res);
-            });
-        }
+    for b in buffers {
+        let tx = tx.clone();
+        b.map_async(wgpu::MapMode::Read, .., move |res| {
+            let _ = tx.send(res);
+        });
     }
     drop(tx);
     r.device
@@ -182,8 +236,25 @@ pub(crate) fn submit_and_read(
     for res in rx.iter() {
         res.map_err(|e| gpu_error("readback", format!("cannot map a buffer: {e}")))?;
     }
-    // One target per thread: unpadding a 1024×768 pair takes 2–6 ms on one thread.
-    targets.par_iter().map(|t| read_target(t)).collect()
+    Ok(())
+}
+
+/// Unpads the mapped color buffer of `t` into an image, then unmaps it.
+fn read_color(t: &Target) -> Result<RgbaImage> {
+    let (w, row) = (4 * t.width as usize, t.padded_row as usize);
+    let mut bytes = Vec::with_capacity(w * t.height as usize);
+    {
+        let c = t
+            .color_buffer
+            .get_mapped_range(..)
+            .map_err(|e| gpu_error("readback", format!("buffer not mapped: {e}")))?;
+        for c in c.chunks_exact(row) {
+            bytes.extend_from_slice(&c[..w]);
+        }
+    }
+    t.color_buffer.unmap();
+    RgbaImage::from_raw(t.width, t.height, bytes)
+        .ok_or_else(|| crate::Error::internal("readback", "color buffer size mismatch"))
 }
 
 /// Unpads the mapped buffers of `t` into a framebuffer, then unmaps them.

@@ -1,6 +1,9 @@
 // The anaglyph family: a mirror of `anaglyph::anaglyph` in src/effects/anaglyph.rs.
 // input0 = the eye ML reads, input1 = the eye MR reads (the host swaps them for `swap_eyes`).
-// params[0..3]: ML rows (xyz), params[3..6]: MR rows (xyz), params[6].x: 1 for linear light.
+// params[0..3]: ML rows (xyz), params[3..6]: MR rows (xyz). Linear light is `LINEAR_LIGHT`,
+// a constant the host prepends (one pipeline per mode, src/gpu/effects.rs): llvmpipe may run
+// both sides of a branch under an execution mask, and a uniform flag would then pay for the
+// sRGB curves on every pixel of a stored-value anaglyph too.
 // The matrices come from `AnaglyphKind::matrices` on the host; none is written here.
 
 // IEC 61966-2-1 decoding, as `srgb_to_linear`.
@@ -35,7 +38,7 @@ fn mix_row(i: i32, a: vec3<f32>, b: vec3<f32>) -> f32 {
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4<f32>) -> FullscreenOut {
-    let linear_light = params[6].x > 0.5;
+    let linear_light = LINEAR_LIGHT;
     var a = textureLoad(input0_color, texel(pos), 0).rgb;
     var b = textureLoad(input1_color, texel(pos), 0).rgb;
     if linear_light {
