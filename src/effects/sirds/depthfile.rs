@@ -350,3 +350,155 @@ fn load_pfm(path: &Path, head: &[u8], near: Near) -> Result<DepthSamples> {
         },
     })
 }
+
+/// A binary PGM (P5) with maxval 255 or 65535 read a run of rows at a time, as 16-bit nearness
+/// with [`DepthSamples::load`]'s mapping and the same numbers: `stereolab sirds --depth` into a
+/// netpbm file streams it, so a 4096×3072 map is never held whole (its 25 MB buffer and the
+/// image crate's copy cost more page faults than the reading).
+#[derive(Debug)]
+pub struct PgmRows {
+    reader: std::io::BufReader<std::fs::File>,
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    wide: bool,
+    near: Near,
+    found: (u16, u16),
+    ext: String,
+    bytes: Vec<u8>,
+    path: std::path::PathBuf,
+}
+
+/// The header of a binary PGM: width, height, maxval and its length in bytes; `None` for
+/// anything else (another magic, a malformed or over-long header).
+fn pgm_header(head: &[u8]) -> Option<(u32, u32, u32, usize)> {
+    if !head.starts_with(b"P5") {
+        return None;
+    }
+    let mut pos = 2;
+    let mut numbers = [0u32; 3];
+    for n in &mut numbers {
+        // Whitespace and `#` comments (to the end of the line) before each number.
+        loop {
+            match head.get(pos)? {
+                c if c.is_ascii_whitespace() => pos += 1,
+                b'#' => {
+                    while *head.get(pos)? != b'\n' {
+                        pos += 1;
+                    }
+                }
+                _ => break,
+            }
+        }
+        let start = pos;
+        while head.get(pos)?.is_ascii_digit() {
+            pos += 1;
+        }
+        *n = std::str::from_utf8(&head[start..pos]).ok()?.parse().ok()?;
+    }
+    // Exactly one whitespace byte ends the header.
+    head.get(pos)?.is_ascii_whitespace().then_some(())?;
+    Some((numbers[0], numbers[1], numbers[2], pos + 1))
+}
+
+impl PgmRows {
+    /// Opens `path` when it is a binary PGM of maxval 255 or 65535 whose size is exactly its
+    /// header and samples; `Ok(None)` for any other file (read it with
+    /// [`DepthSamples::load`], which also gives the errors).
+    ///
+    /// # Errors
+    /// `Io` when the file cannot be opened or read, or is not a regular file.
+    pub fn open(path: &Path, near: Near) -> Result<Option<PgmRows>> {
+        let size = crate::files::check_input(path)?;
+        let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+        let mut head = Vec::with_capacity(MAX_PFM_HEADER);
+        (&mut file)
+            .take(MAX_PFM_HEADER as u64)
+            .read_to_end(&mut head)
+            .map_err(|e| Error::io(path, e))?;
+        let Some((width, height, maxval, body)) = pgm_header(&head) else {
+            return Ok(None);
+        };
+        let wide = match maxval {
+            255 => false,
+            65535 => true,
+            _ => return Ok(None),
+        };
+        let samples = u64::from(width) * u64::from(height);
+        if check_size(width, height).is_err()
+            || size != body as u64 + samples * if wide { 2 } else { 1 }
+        {
+            return Ok(None);
+        }
+        use std::io::Seek as _;
+        file.seek(std::io::SeekFrom::Start(body as u64))
+            .map_err(|e| Error::io(path, e))?;
+        Ok(Some(PgmRows {
+            reader: std::io::BufReader::with_capacity(1 << 20, file),
+            width,
+            height,
+            wide,
+            near,
+            found: (u16::MAX, 0),
+            ext: path
+                .extension()
+                .and_then(|e| e.to_str())
+                .unwrap_or("image")
+                .to_ascii_uppercase(),
+            bytes: Vec::new(),
+            path: path.to_path_buf(),
+        }))
+    }
+
+    /// The next `out.len()` samples (whole rows, in file order) as 16-bit nearness: `v · 257`
+    /// (8-bit) or `v` (16-bit), `65535 −` that with `--near black`, as [`DepthSamples::load`]
+    /// maps them.
+    ///
+    /// # Errors
+    /// `Io` when the read fails (the file shrank since it was opened).
+    pub fn read(&mut self, out: &mut [u16]) -> Result<()> {
+        let per = if self.wide { 2 } else { 1 };
+        self.bytes.resize(out.len() * per, 0);
+        self.reader
+            .read_exact(&mut self.bytes)
+            .map_err(|e| Error::io(&self.path, e))?;
+        let (mut lo, mut hi) = self.found;
+        let black = self.near == Near::Black;
+        let mut put = |o: &mut u16, v: u16, scale: u16| {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            let z = v * scale;
+            *o = if black { 65535 - z } else { z };
+        };
+        if self.wide {
+            for (o, b) in out.iter_mut().zip(self.bytes.chunks_exact(2)) {
+                put(o, u16::from_be_bytes([b[0], b[1]]), 1);
+            }
+        } else {
+            for (o, &b) in out.iter_mut().zip(&self.bytes) {
+                put(o, u16::from(b), 257);
+            }
+        }
+        self.found = (lo, hi);
+        Ok(())
+    }
+
+    /// How the values became nearness, `found` over the samples read so far (all of them
+    /// once the image has been read): what [`DepthSamples::load`] reports for the same file.
+    pub fn mapping(&self) -> DepthMapping {
+        let max = if self.wide { 65535.0 } else { 255.0 };
+        let (far_value, near_value) = match self.near {
+            Near::White => (0.0, max),
+            Near::Black => (max, 0.0),
+        };
+        DepthMapping {
+            format: format!("{}-bit gray {}", if self.wide { 16 } else { 8 }, self.ext),
+            far_value,
+            near_value,
+            full_scale: true,
+            found: (f64::from(self.found.0), f64::from(self.found.1)),
+            non_finite: 0,
+        }
+    }
+}
