@@ -351,7 +351,8 @@ fn load_pfm(path: &Path, head: &[u8], near: Near) -> Result<DepthSamples> {
     })
 }
 
-/// A binary PGM (P5) with maxval 255 or 65535 read a run of rows at a time, as 16-bit nearness
+/// A binary PGM (P5) or one-channel PAM (P7, DEPTH 1) with maxval 255 or 65535 read a run of
+/// rows at a time, as 16-bit nearness
 /// with [`DepthSamples::load`]'s mapping and the same numbers: `stereolab sirds --depth` into a
 /// netpbm file streams it, so a 4096×3072 map is never held whole (its 25 MB buffer and the
 /// image crate's copy cost more page faults than the reading).
@@ -370,9 +371,13 @@ pub struct PgmRows {
     path: std::path::PathBuf,
 }
 
-/// The header of a binary PGM: width, height, maxval and its length in bytes; `None` for
-/// anything else (another magic, a malformed or over-long header).
+/// The header of a binary PGM (P5) or a one-channel PAM (P7 with DEPTH 1, what the image
+/// crate writes for `.pgm`): width, height, maxval and its length in bytes; `None` for
+/// anything else (another magic or depth, a malformed or over-long header).
 fn pgm_header(head: &[u8]) -> Option<(u32, u32, u32, usize)> {
+    if head.starts_with(b"P7") {
+        return pam_header(head);
+    }
     if !head.starts_with(b"P5") {
         return None;
     }
@@ -402,9 +407,38 @@ fn pgm_header(head: &[u8]) -> Option<(u32, u32, u32, usize)> {
     Some((numbers[0], numbers[1], numbers[2], pos + 1))
 }
 
+/// A PAM header (`P7`, then `KEYWORD value` lines and `#` comments up to `ENDHDR`): width,
+/// height, maxval and its length, for DEPTH 1 and TUPLTYPE GRAYSCALE only (anything else
+/// goes to the image crate, which decides what it means).
+fn pam_header(head: &[u8]) -> Option<(u32, u32, u32, usize)> {
+    let (mut width, mut height, mut depth, mut maxval) = (None, None, None, None);
+    let mut gray = false;
+    let mut pos = head.iter().position(|&b| b == b'\n')? + 1;
+    loop {
+        let end = pos + head[pos..].iter().position(|&b| b == b'\n')?;
+        let line = std::str::from_utf8(&head[pos..end]).ok()?.trim();
+        pos = end + 1;
+        let mut words = line.split_ascii_whitespace();
+        let number = |w: Option<&str>| w.and_then(|v| v.parse::<u32>().ok());
+        match words.next() {
+            Some("ENDHDR") => break,
+            Some("WIDTH") => width = number(words.next()),
+            Some("HEIGHT") => height = number(words.next()),
+            Some("DEPTH") => depth = number(words.next()),
+            Some("MAXVAL") => maxval = number(words.next()),
+            Some("TUPLTYPE") => gray = words.next() == Some("GRAYSCALE"),
+            Some(w) if w.starts_with('#') => {}
+            None => {}
+            Some(_) => return None,
+        }
+    }
+    (depth? == 1 && gray).then_some(())?;
+    Some((width?, height?, maxval?, pos))
+}
+
 impl PgmRows {
-    /// Opens `path` when it is a binary PGM of maxval 255 or 65535 whose size is exactly its
-    /// header and samples; `Ok(None)` for any other file (read it with
+    /// Opens `path` when it is a binary PGM or one-channel PAM of maxval 255 or 65535 whose
+    /// size is exactly its header and samples; `Ok(None)` for any other file (read it with
     /// [`DepthSamples::load`], which also gives the errors).
     ///
     /// # Errors
@@ -500,5 +534,72 @@ impl PgmRows {
             found: (f64::from(self.found.0), f64::from(self.found.1)),
             non_finite: 0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stream opens the PGMs it knows (the image crate's one-channel PAM at 8 and 16 bits,
+    /// a hand-written P5 with a comment) and reads, in runs of rows, the samples and mapping
+    /// that [`DepthSamples::load`] gives for the same file, near white and black; anything
+    /// else (a PNG, an RGB PAM, a truncated P5, maxval 1000) is left to `load`.
+    #[test]
+    fn pgm_rows_read_what_load_reads() {
+        let dir = std::env::temp_dir().join(format!("stereolab-pgm-rows-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let (w, h) = (37u32, 11u32);
+        let values: Vec<u16> = (0..w * h)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 16) as u16)
+            .collect();
+        let img16 = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, values.clone())
+            .expect("size");
+        let (pam16, pam8, p5) = (dir.join("a.pgm"), dir.join("b.pgm"), dir.join("c.pgm"));
+        img16.save(&pam16).expect("pam16");
+        image::DynamicImage::ImageLuma16(img16.clone())
+            .to_luma8()
+            .save(&pam8)
+            .expect("pam8");
+        let mut bytes = format!("P5\n# a comment\n{w} {h}\n65535\n").into_bytes();
+        bytes.extend(values.iter().flat_map(|v| v.to_be_bytes()));
+        std::fs::write(&p5, &bytes).expect("p5");
+        for path in [&pam16, &pam8, &p5] {
+            for near in [Near::White, Near::Black] {
+                let mut rows = PgmRows::open(path, near)
+                    .expect("opens")
+                    .unwrap_or_else(|| panic!("{} not streamed", path.display()));
+                let whole = DepthSamples::load(path, near).expect("loads");
+                assert_eq!((rows.width, rows.height), (whole.width, whole.height));
+                let mut got = vec![0u16; whole.samples.len()];
+                for run in got.chunks_mut(3 * w as usize) {
+                    rows.read(run).expect("reads");
+                }
+                assert!(got == whole.samples, "{} {near:?}: samples", path.display());
+                assert_eq!(rows.mapping(), whole.mapping, "{} {near:?}", path.display());
+            }
+        }
+        // Left to `load`: a PNG, an RGB PAM, a truncated P5, a maxval the stream does not map.
+        let png = dir.join("d.png");
+        img16.save(&png).expect("png");
+        let rgb = dir.join("e.pam");
+        image::DynamicImage::ImageLuma16(img16.clone())
+            .to_rgb8()
+            .save(&rgb)
+            .expect("rgb pam");
+        let short = dir.join("f.pgm");
+        std::fs::write(&short, &bytes[..bytes.len() - 1]).expect("short");
+        let odd = dir.join("g.pgm");
+        let mut odd_bytes = format!("P5 {w} {h} 1000\n").into_bytes();
+        odd_bytes.extend(values.iter().flat_map(|v| (v % 1000).to_be_bytes()));
+        std::fs::write(&odd, odd_bytes).expect("odd");
+        for path in [&png, &rgb, &short, &odd] {
+            assert!(
+                PgmRows::open(path, Near::White).expect("opens").is_none(),
+                "{} streamed",
+                path.display()
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
