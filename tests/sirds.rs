@@ -502,6 +502,125 @@ fn same_scene_same_bytes() {
     assert_eq!(a.pixels, b.pixels);
 }
 
+/// `sirds --depth` streams a binary PGM (8- or 16-bit) row by row and writes `.pgm` (one byte
+/// a pixel) as well as `.ppm`: the same image as from the same map in PNG (read whole), the
+/// same mapping reported, the PGM the PPM's gray; a color SIRDS refused as PGM, nothing
+/// written; near black and cross-eyed through the same streamed path.
+#[test]
+fn cli_depth_map_streams_pgm_in_and_out() {
+    let dir = common::out_dir("sirds_pgm");
+    let bin = env!("CARGO_BIN_EXE_stereolab");
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(bin)
+            .args(args)
+            .output()
+            .expect("runs");
+        let text = String::from_utf8_lossy(&out.stdout).to_string()
+            + &String::from_utf8_lossy(&out.stderr);
+        (out.status.success(), text)
+    };
+    let body = |path: &Path, channels: usize| {
+        let bytes = std::fs::read(path).expect("written");
+        let (w, h) = (300usize, 70usize);
+        bytes[bytes.len() - w * h * channels..].to_vec()
+    };
+    let map = sphere_over_ramp(300, 70);
+    let map16 = map.to_image();
+    let map8 = image::DynamicImage::ImageLuma16(map16.clone()).to_luma8();
+    // The image crate writes `.pgm` as a one-channel PAM (P7); a P5 written by hand, with a
+    // comment in its header, is the other kind the stream reads.
+    let p5 = |path: &Path| {
+        let mut bytes = b"P5\n# depth\n300 70\n65535\n".to_vec();
+        bytes.extend(map16.as_raw().iter().flat_map(|v| v.to_be_bytes()));
+        std::fs::write(path, bytes).expect("p5");
+    };
+    for (kind, extra) in [
+        ("16", &[][..]),
+        ("8", &[][..]),
+        ("p5", &[][..]),
+        ("16", &["--near", "black"][..]),
+        ("16", &["--set", "sirds.cross_eyed=true"][..]),
+    ] {
+        let (pgm, png) = (
+            dir.join(format!("map{kind}.pgm")),
+            dir.join(format!("map{kind}.png")),
+        );
+        match kind {
+            "16" => {
+                map16.save(&pgm).expect("pgm");
+                map16.save(&png).expect("png");
+            }
+            "8" => {
+                map8.save(&pgm).expect("pgm");
+                map8.save(&png).expect("png");
+            }
+            _ => {
+                p5(&pgm);
+                map16.save(&png).expect("png");
+            }
+        }
+        let bits = if kind == "8" { "8" } else { "16" };
+        let mut outputs = Vec::new();
+        for (input, out) in [
+            (&pgm, "from_pgm.ppm"),
+            (&png, "from_png.ppm"),
+            (&pgm, "from_pgm.pgm"),
+        ] {
+            let out = dir.join(out);
+            let mut args = vec![
+                "sirds",
+                "--depth",
+                input.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ];
+            args.extend_from_slice(extra);
+            let (ok, text) = run(&args);
+            assert!(ok, "{text}");
+            let mapping = text
+                .lines()
+                .find(|l| l.contains("depth map"))
+                .expect("mapping line")
+                .replace("PNG", "PGM");
+            outputs.push((out, mapping));
+        }
+        let what = format!("{kind} {extra:?}");
+        assert!(
+            outputs[0].1.contains(&format!("{bits}-bit gray PGM")),
+            "{what}: {}",
+            outputs[0].1
+        );
+        assert_eq!(outputs[0].1, outputs[1].1, "{what}: mapping");
+        let ppm = body(&outputs[0].0, 3);
+        assert!(
+            ppm == body(&outputs[1].0, 3),
+            "{what}: streamed PGM and PNG differ"
+        );
+        let gray: Vec<u8> = ppm.chunks_exact(3).map(|p| p[0]).collect();
+        assert!(
+            ppm.chunks_exact(3).all(|p| p[0] == p[1] && p[1] == p[2]),
+            "{what}: not gray"
+        );
+        assert!(
+            gray == body(&outputs[2].0, 1),
+            "{what}: PGM is not the PPM's gray"
+        );
+        assert!(gray.contains(&0) && gray.contains(&255), "{what}: no dots");
+    }
+    let color = dir.join("color.pgm");
+    let (ok, text) = run(&[
+        "sirds",
+        "--depth",
+        dir.join("map16.pgm").to_str().unwrap(),
+        "--out",
+        color.to_str().unwrap(),
+        "--set",
+        "sirds.dots=color",
+    ]);
+    assert!(!ok && text.contains("a PGM holds gray levels"), "{text}");
+    assert!(!color.exists(), "a refused PGM was left behind");
+}
+
 #[test]
 fn cli_depth_map_decode_and_animation() {
     let dir = common::out_dir("sirds_cli");

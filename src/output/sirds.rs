@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::effects::sirds::depthfile::{DepthMapping, DepthSamples, Near};
+use crate::effects::sirds::depthfile::{DepthMapping, DepthSamples, Near, PgmRows};
 use crate::effects::sirds::{
     Algorithm, DepthMap, DepthRange, Disparity, DisparityModel, Filter, Settings, Sirds,
     depth_range, pattern, per_pixel,
@@ -139,30 +139,89 @@ pub(crate) fn from_frame_with(
     })
 }
 
-/// Writes RGBA pixels as PNG, or as binary PPM (P6, no compression) for `.ppm`/`.pnm`, all or
-/// nothing ([`files::write_atomic`]).
+/// The uncompressed netpbm kinds a SIRDS is written as: binary PPM (P6, three bytes a pixel)
+/// for `.ppm`/`.pnm`, binary PGM (P5, one byte a pixel: gray patterns only) for `.pgm`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Netpbm {
+    /// P6, RGB.
+    Ppm,
+    /// P5, gray (`pgm_bytes` refuses a pixel whose channels differ).
+    Pgm,
+}
+
+impl Netpbm {
+    /// The kind `path`'s extension names (ASCII case ignored), `None` for anything else.
+    pub fn of(path: &Path) -> Option<Netpbm> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "ppm" | "pnm" => Some(Netpbm::Ppm),
+            "pgm" => Some(Netpbm::Pgm),
+            _ => None,
+        }
+    }
+
+    /// The header of a `width`×`height` image of this kind, maxval 255.
+    fn header(self, width: u32, height: u32) -> String {
+        let magic = match self {
+            Netpbm::Ppm => "P6",
+            Netpbm::Pgm => "P5",
+        };
+        format!("{magic}\n{width} {height}\n255\n")
+    }
+
+    /// `pixels` as this kind's bytes, appended to `out` (cleared first).
+    ///
+    /// # Errors
+    /// `Invalid` naming `--out` for PGM when a pixel is not gray (its R, G and B differ): a
+    /// color SIRDS needs `.ppm` or `.png`.
+    fn bytes(self, pixels: &[[u8; 4]], out: &mut Vec<u8>, path: &Path) -> Result<()> {
+        out.clear();
+        match self {
+            Netpbm::Ppm => out.extend(pixels.iter().flat_map(|p| [p[0], p[1], p[2]])),
+            Netpbm::Pgm => {
+                // One pass that vectorizes: the gray level, and whether any channel differed.
+                out.resize(pixels.len(), 0);
+                let mut differ = 0;
+                for (o, p) in out.iter_mut().zip(pixels) {
+                    *o = p[0];
+                    differ |= (p[0] ^ p[1]) | (p[1] ^ p[2]);
+                }
+                if differ == 0 {
+                    return Ok(());
+                }
+                if let Some(p) = pixels.iter().find(|p| p[0] != p[1] || p[1] != p[2]) {
+                    return Err(Error::invalid(
+                        "--out",
+                        path.display(),
+                        format!(
+                            "a PGM holds gray levels, and this SIRDS has colors (e.g. {:?}): name the file .ppm or .png",
+                            &p[..3]
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes RGBA pixels as PNG, or uncompressed as binary PPM (`.ppm`/`.pnm`) or PGM (`.pgm`,
+/// gray SIRDS only, see [`Netpbm`]), all or nothing ([`files::write_atomic`]).
 ///
 /// # Errors
-/// The file cannot be written, or its name is a link or a special file.
+/// The file cannot be written, or its name is a link or a special file; a `.pgm` of a color
+/// SIRDS.
 pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<()> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    if ext == "ppm" || ext == "pnm" {
+    if let Some(kind) = Netpbm::of(path) {
         files::write_atomic(path, |w| {
-            let mut ppm = || -> std::io::Result<()> {
-                write!(w, "P6\n{width} {height}\n255\n")?;
-                let mut row = Vec::with_capacity(width as usize * 3);
-                for line in pixels.chunks_exact(width.max(1) as usize) {
-                    row.clear();
-                    row.extend(line.iter().flat_map(|p| [p[0], p[1], p[2]]));
-                    w.write_all(&row)?;
-                }
-                Ok(())
-            };
-            ppm().map_err(|e| Error::io(path, e))
+            w.write_all(kind.header(width, height).as_bytes())
+                .map_err(|e| Error::io(path, e))?;
+            let mut row = Vec::with_capacity(width as usize * 3);
+            for line in pixels.chunks_exact(width.max(1) as usize) {
+                kind.bytes(line, &mut row, path)?;
+                w.write_all(&row).map_err(|e| Error::io(path, e))?;
+            }
+            Ok(())
         })
     } else {
         let bytes = pixels.iter().flatten().copied().collect();
@@ -176,53 +235,68 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
     }
 }
 
-/// TIW from a depth-map file straight into a PPM, a chunk of rows at a time: the depth map is
-/// never held as floats, nor the image as RGBA (a 4096×3072 map would need 100 MB for both).
+/// TIW from a depth-map file straight into a PPM or PGM (`out`'s extension, see [`Netpbm`];
+/// anything else is written as PPM), a chunk of rows at a time: the depth map is never held as
+/// floats, nor the image as RGBA (a 4096×3072 map would need 100 MB for both).
 ///
 /// # Errors
-/// The depth map cannot be read or is too large, or the file cannot be written.
+/// The depth map cannot be read or is too large, or the file cannot be written; a `.pgm` of
+/// a color SIRDS.
 pub fn stream_depth_map(
     depth: &Path,
     near: Near,
     settings: &Settings,
     out: &Path,
 ) -> Result<(u32, u32, DepthMapping)> {
-    let DepthSamples {
-        width,
-        height,
-        samples,
-        mapping,
-    } = DepthSamples::load(depth, near)?;
+    // A binary PGM is read as it is used; anything else whole first.
+    let mut source = match PgmRows::open(depth, near)? {
+        Some(rows) => Ok(rows),
+        None => Err(DepthSamples::load(depth, near)?),
+    };
+    let (width, height) = match &source {
+        Ok(rows) => (rows.width, rows.height),
+        Err(whole) => (whole.width, whole.height),
+    };
+    let mut taken = 0;
+    let read = |buf: &mut [u16]| match &mut source {
+        Ok(rows) => rows.read(buf),
+        Err(whole) => {
+            buf.copy_from_slice(&whole.samples[taken..taken + buf.len()]);
+            taken += buf.len();
+            Ok(())
+        }
+    };
     let invert = settings.cross_eyed;
-    let w = width as usize;
-    let depth_row = |y: u32, row: &mut Vec<f32>| {
-        let line = &samples[y as usize * w..(y as usize + 1) * w];
-        row.extend(line.iter().map(|&v| {
-            let z = v as f32 / 65535.0;
-            if invert { 1.0 - z } else { z }
-        }));
+    let z_of = |v: u16| {
+        let z = v as f32 / 65535.0;
+        if invert { 1.0 - z } else { z }
     };
     let d = settings.geometry.to_pixels()?;
     // The rows stream into a temporary file: a failure in TIW or in the writing leaves `out`
     // as it was.
     files::write_atomic(out, |writer| {
-        write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| Error::io(out, e))?;
+        let kind = Netpbm::of(out).unwrap_or(Netpbm::Ppm);
+        writer
+            .write_all(kind.header(width, height).as_bytes())
+            .map_err(|e| Error::io(out, e))?;
         let mut bytes = Vec::new();
-        crate::effects::sirds::per_pixel::per_pixel_streamed(
+        crate::effects::sirds::per_pixel::per_pixel_samples(
             width,
             height,
-            depth_row,
+            read,
+            z_of,
             &d,
             &settings.pattern,
             &settings.per_pixel,
             |rows| {
-                bytes.resize(rows.len() * 3, 0);
-                for (b, p) in bytes.chunks_exact_mut(3).zip(rows) {
-                    b.copy_from_slice(&p[..3]);
-                }
+                kind.bytes(rows, &mut bytes, out)?;
                 writer.write_all(&bytes).map_err(|e| Error::io(out, e))
             },
         )
     })?;
+    let mapping = match &source {
+        Ok(rows) => rows.mapping(),
+        Err(whole) => whole.mapping.clone(),
+    };
     Ok((width, height, mapping))
 }

@@ -31,8 +31,8 @@ pub struct SirdsArgs {
     /// wall- or cross-eyed) instead of searching for them.
     #[arg(long, conflicts_with_all = ["depth", "frames"])]
     pub decode: Option<PathBuf>,
-    /// Output file: .png, or .ppm (uncompressed); with --frames a .gif. Default sirds.png, or
-    /// sirds.gif with --frames.
+    /// Output file: .png, or .ppm / .pgm (uncompressed; .pgm for gray patterns, one byte a
+    /// pixel); with --frames a .gif. Default sirds.png, or sirds.gif with --frames.
     #[arg(long, short)]
     pub out: Option<PathBuf>,
     /// Override a `[sirds]` field, e.g. --set sirds.dpi=100 (repeatable; with a scene any
@@ -116,12 +116,9 @@ fn report(args: &SirdsArgs) -> Result<String> {
         let settings = settings_from_sets(&args.sets)?;
         let near = Near::parse(&args.near)?;
         let d = settings.geometry.to_pixels()?;
-        let is_ppm = matches!(
-            out.extension().and_then(|e| e.to_str()),
-            Some("ppm" | "pnm")
-        );
+        let netpbm = stereolab::output::sirds::Netpbm::of(&out).is_some();
         let (w, h, mapping) = super::with_spinner("making the autostereogram", || {
-            if is_ppm && !settings.guide_dots {
+            if netpbm && !settings.guide_dots {
                 stream_depth_map(path, near, &settings, &out)
             } else {
                 let (map, mapping) = DepthMap::load_with(path, near)?;

@@ -350,3 +350,256 @@ fn load_pfm(path: &Path, head: &[u8], near: Near) -> Result<DepthSamples> {
         },
     })
 }
+
+/// A binary PGM (P5) or one-channel PAM (P7, DEPTH 1) with maxval 255 or 65535 read a run of
+/// rows at a time, as 16-bit nearness
+/// with [`DepthSamples::load`]'s mapping and the same numbers: `stereolab sirds --depth` into a
+/// netpbm file streams it, so a 4096×3072 map is never held whole (its 25 MB buffer and the
+/// image crate's copy cost more page faults than the reading).
+#[derive(Debug)]
+pub struct PgmRows {
+    reader: std::io::BufReader<std::fs::File>,
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    wide: bool,
+    near: Near,
+    found: (u16, u16),
+    ext: String,
+    bytes: Vec<u8>,
+    path: std::path::PathBuf,
+}
+
+/// The header of a binary PGM (P5) or a one-channel PAM (P7 with DEPTH 1, what the image
+/// crate writes for `.pgm`): width, height, maxval and its length in bytes; `None` for
+/// anything else (another magic or depth, a malformed or over-long header).
+fn pgm_header(head: &[u8]) -> Option<(u32, u32, u32, usize)> {
+    if head.starts_with(b"P7") {
+        return pam_header(head);
+    }
+    if !head.starts_with(b"P5") {
+        return None;
+    }
+    let mut pos = 2;
+    let mut numbers = [0u32; 3];
+    for n in &mut numbers {
+        // Whitespace and `#` comments (to the end of the line) before each number.
+        loop {
+            match head.get(pos)? {
+                c if c.is_ascii_whitespace() => pos += 1,
+                b'#' => {
+                    while *head.get(pos)? != b'\n' {
+                        pos += 1;
+                    }
+                }
+                _ => break,
+            }
+        }
+        let start = pos;
+        while head.get(pos)?.is_ascii_digit() {
+            pos += 1;
+        }
+        *n = std::str::from_utf8(&head[start..pos]).ok()?.parse().ok()?;
+    }
+    // Exactly one whitespace byte ends the header.
+    head.get(pos)?.is_ascii_whitespace().then_some(())?;
+    Some((numbers[0], numbers[1], numbers[2], pos + 1))
+}
+
+/// A PAM header (`P7`, then `KEYWORD value` lines and `#` comments up to `ENDHDR`): width,
+/// height, maxval and its length, for DEPTH 1 and TUPLTYPE GRAYSCALE only (anything else
+/// goes to the image crate, which decides what it means).
+fn pam_header(head: &[u8]) -> Option<(u32, u32, u32, usize)> {
+    let (mut width, mut height, mut depth, mut maxval) = (None, None, None, None);
+    let mut gray = false;
+    let mut pos = head.iter().position(|&b| b == b'\n')? + 1;
+    loop {
+        let end = pos + head[pos..].iter().position(|&b| b == b'\n')?;
+        let line = std::str::from_utf8(&head[pos..end]).ok()?.trim();
+        pos = end + 1;
+        let mut words = line.split_ascii_whitespace();
+        let number = |w: Option<&str>| w.and_then(|v| v.parse::<u32>().ok());
+        match words.next() {
+            Some("ENDHDR") => break,
+            Some("WIDTH") => width = number(words.next()),
+            Some("HEIGHT") => height = number(words.next()),
+            Some("DEPTH") => depth = number(words.next()),
+            Some("MAXVAL") => maxval = number(words.next()),
+            Some("TUPLTYPE") => gray = words.next() == Some("GRAYSCALE"),
+            Some(w) if w.starts_with('#') => {}
+            None => {}
+            Some(_) => return None,
+        }
+    }
+    (depth? == 1 && gray).then_some(())?;
+    Some((width?, height?, maxval?, pos))
+}
+
+impl PgmRows {
+    /// Opens `path` when it is a binary PGM or one-channel PAM of maxval 255 or 65535 whose
+    /// size is exactly its header and samples; `Ok(None)` for any other file (read it with
+    /// [`DepthSamples::load`], which also gives the errors).
+    ///
+    /// # Errors
+    /// `Io` when the file cannot be opened or read, or is not a regular file.
+    pub fn open(path: &Path, near: Near) -> Result<Option<PgmRows>> {
+        let size = crate::files::check_input(path)?;
+        let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+        let mut head = Vec::with_capacity(MAX_PFM_HEADER);
+        (&mut file)
+            .take(MAX_PFM_HEADER as u64)
+            .read_to_end(&mut head)
+            .map_err(|e| Error::io(path, e))?;
+        let Some((width, height, maxval, body)) = pgm_header(&head) else {
+            return Ok(None);
+        };
+        let wide = match maxval {
+            255 => false,
+            65535 => true,
+            _ => return Ok(None),
+        };
+        let samples = u64::from(width) * u64::from(height);
+        if check_size(width, height).is_err()
+            || size != body as u64 + samples * if wide { 2 } else { 1 }
+        {
+            return Ok(None);
+        }
+        use std::io::Seek as _;
+        file.seek(std::io::SeekFrom::Start(body as u64))
+            .map_err(|e| Error::io(path, e))?;
+        Ok(Some(PgmRows {
+            reader: std::io::BufReader::with_capacity(1 << 20, file),
+            width,
+            height,
+            wide,
+            near,
+            found: (u16::MAX, 0),
+            ext: path
+                .extension()
+                .and_then(|e| e.to_str())
+                .unwrap_or("image")
+                .to_ascii_uppercase(),
+            bytes: Vec::new(),
+            path: path.to_path_buf(),
+        }))
+    }
+
+    /// The next `out.len()` samples (whole rows, in file order) as 16-bit nearness: `v · 257`
+    /// (8-bit) or `v` (16-bit), `65535 −` that with `--near black`, as [`DepthSamples::load`]
+    /// maps them.
+    ///
+    /// # Errors
+    /// `Io` when the read fails (the file shrank since it was opened).
+    pub fn read(&mut self, out: &mut [u16]) -> Result<()> {
+        let per = if self.wide { 2 } else { 1 };
+        self.bytes.resize(out.len() * per, 0);
+        self.reader
+            .read_exact(&mut self.bytes)
+            .map_err(|e| Error::io(&self.path, e))?;
+        let (mut lo, mut hi) = self.found;
+        let black = self.near == Near::Black;
+        let mut put = |o: &mut u16, v: u16, scale: u16| {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            let z = v * scale;
+            *o = if black { 65535 - z } else { z };
+        };
+        if self.wide {
+            for (o, b) in out.iter_mut().zip(self.bytes.chunks_exact(2)) {
+                put(o, u16::from_be_bytes([b[0], b[1]]), 1);
+            }
+        } else {
+            for (o, &b) in out.iter_mut().zip(&self.bytes) {
+                put(o, u16::from(b), 257);
+            }
+        }
+        self.found = (lo, hi);
+        Ok(())
+    }
+
+    /// How the values became nearness, `found` over the samples read so far (all of them
+    /// once the image has been read): what [`DepthSamples::load`] reports for the same file.
+    pub fn mapping(&self) -> DepthMapping {
+        let max = if self.wide { 65535.0 } else { 255.0 };
+        let (far_value, near_value) = match self.near {
+            Near::White => (0.0, max),
+            Near::Black => (max, 0.0),
+        };
+        DepthMapping {
+            format: format!("{}-bit gray {}", if self.wide { 16 } else { 8 }, self.ext),
+            far_value,
+            near_value,
+            full_scale: true,
+            found: (f64::from(self.found.0), f64::from(self.found.1)),
+            non_finite: 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stream opens the PGMs it knows (the image crate's one-channel PAM at 8 and 16 bits,
+    /// a hand-written P5 with a comment) and reads, in runs of rows, the samples and mapping
+    /// that [`DepthSamples::load`] gives for the same file, near white and black; anything
+    /// else (a PNG, an RGB PAM, a truncated P5, maxval 1000) is left to `load`.
+    #[test]
+    fn pgm_rows_read_what_load_reads() {
+        let dir = std::env::temp_dir().join(format!("stereolab-pgm-rows-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let (w, h) = (37u32, 11u32);
+        let values: Vec<u16> = (0..w * h)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 16) as u16)
+            .collect();
+        let img16 = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, values.clone())
+            .expect("size");
+        let (pam16, pam8, p5) = (dir.join("a.pgm"), dir.join("b.pgm"), dir.join("c.pgm"));
+        img16.save(&pam16).expect("pam16");
+        image::DynamicImage::ImageLuma16(img16.clone())
+            .to_luma8()
+            .save(&pam8)
+            .expect("pam8");
+        let mut bytes = format!("P5\n# a comment\n{w} {h}\n65535\n").into_bytes();
+        bytes.extend(values.iter().flat_map(|v| v.to_be_bytes()));
+        std::fs::write(&p5, &bytes).expect("p5");
+        for path in [&pam16, &pam8, &p5] {
+            for near in [Near::White, Near::Black] {
+                let mut rows = PgmRows::open(path, near)
+                    .expect("opens")
+                    .unwrap_or_else(|| panic!("{} not streamed", path.display()));
+                let whole = DepthSamples::load(path, near).expect("loads");
+                assert_eq!((rows.width, rows.height), (whole.width, whole.height));
+                let mut got = vec![0u16; whole.samples.len()];
+                for run in got.chunks_mut(3 * w as usize) {
+                    rows.read(run).expect("reads");
+                }
+                assert!(got == whole.samples, "{} {near:?}: samples", path.display());
+                assert_eq!(rows.mapping(), whole.mapping, "{} {near:?}", path.display());
+            }
+        }
+        // Left to `load`: a PNG, an RGB PAM, a truncated P5, a maxval the stream does not map.
+        let png = dir.join("d.png");
+        img16.save(&png).expect("png");
+        let rgb = dir.join("e.pam");
+        image::DynamicImage::ImageLuma16(img16.clone())
+            .to_rgb8()
+            .save(&rgb)
+            .expect("rgb pam");
+        let short = dir.join("f.pgm");
+        std::fs::write(&short, &bytes[..bytes.len() - 1]).expect("short");
+        let odd = dir.join("g.pgm");
+        let mut odd_bytes = format!("P5 {w} {h} 1000\n").into_bytes();
+        odd_bytes.extend(values.iter().flat_map(|v| (v % 1000).to_be_bytes()));
+        std::fs::write(&odd, odd_bytes).expect("odd");
+        for path in [&png, &rgb, &short, &odd] {
+            assert!(
+                PgmRows::open(path, Near::White).expect("opens").is_none(),
+                "{} streamed",
+                path.display()
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

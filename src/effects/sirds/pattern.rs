@@ -82,6 +82,12 @@ impl Pattern {
         Ok(())
     }
 
+    /// Whether every color of the pattern is a gray (R = G = B): black-white and gray dots.
+    /// (A pattern image is not asked; it may hold colors.)
+    pub fn is_gray(&self) -> bool {
+        matches!(self, Pattern::BlackWhite { .. } | Pattern::Gray { .. })
+    }
+
     /// Color of pattern pixel (x, y).
     #[inline]
     pub fn color(&self, x: u32, y: u32) -> [u8; 4] {

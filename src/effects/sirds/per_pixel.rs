@@ -39,6 +39,47 @@ fn round_half_up(v: f32) -> usize {
     (v + 0.5).max(0.0) as usize
 }
 
+/// Depth per lateral step of `scale` samples a pixel, in nearness units: `1 / (scale (t_far −
+/// t_near))`.
+#[inline]
+fn step_scale(d: &Disparity, scale: u32) -> f32 {
+    1.0 / (scale as f32 * (d.t_far - d.t_near))
+}
+
+/// What TIW needs of a point of nearness `z` on a grid of `scale` samples a pixel: its
+/// separation in whole samples, and how far its rays to the eyes rise per sample
+/// (`step_scale` from [`step_scale`]).
+#[inline]
+fn pair_params(d: &Disparity, z: f32, scale: u32, step_scale: f32) -> (usize, f32) {
+    (
+        round_half_up(d.separation(z) * scale as f32),
+        d.ray_slope(d.depth_of(z)) * step_scale,
+    )
+}
+
+/// [`pair_params`] of every 16-bit sample value of a depth-map file, for
+/// [`RowLinker::link_row_keyed`]: one table per image instead of a division and two f64
+/// depth conversions per pixel (the samples of a smooth 16-bit map differ from pixel to pixel).
+pub struct SampleTable {
+    /// Separation and rise of each sample value, by value.
+    params: Vec<(u32, f32)>,
+}
+
+impl SampleTable {
+    /// The table for samples whose nearness is `z_of(sample)`, at one sample a pixel.
+    pub fn new(d: &Disparity, z_of: impl Fn(u16) -> f32 + Sync) -> SampleTable {
+        let step_scale = step_scale(d, 1);
+        let params = (0..=u16::MAX)
+            .into_par_iter()
+            .map(|v| {
+                let (s, rise) = pair_params(d, z_of(v), 1, step_scale);
+                (s as u32, rise)
+            })
+            .collect();
+        SampleTable { params }
+    }
+}
+
 /// The left pixel of the pair that a point at `x` with separation `s` links. TIW: "left =
 /// x − s/2"; for odd `s` the extra pixel goes left on odd rows and right on even rows, so the
 /// half-pixel bias cancels between rows (the symmetric assignment).
@@ -66,39 +107,83 @@ impl RowLinker {
     /// range. Block maxima over the longest such walk skip the walk where nothing around can
     /// block (the result is the same).
     pub fn link_row(&mut self, z: &[f32], y: u32, d: &Disparity, scale: u32, hidden: bool) {
+        let step_scale = step_scale(d, scale);
+        // Depth maps repeat values (flat regions, 8-bit files): reuse the last separation.
+        let (mut last_z, mut params) = (f32::NAN, (0, 0.0));
+        self.link_with(z, y, d, scale, hidden, |x| {
+            if z[x] != last_z {
+                last_z = z[x];
+                params = pair_params(d, z[x], scale, step_scale);
+            }
+            params
+        });
+    }
+
+    /// [`Self::link_row`] (scale 1) for a row of 16-bit samples `keys` whose nearness is `z`
+    /// (`z[x] = table`'s `z_of(keys[x])`): each pixel's separation and ray rise are looked up
+    /// in `table` instead of computed, the same numbers (`table` holds [`pair_params`] of every
+    /// sample value), so the same links. `link_row_keyed_matches_link_row` holds them equal.
+    pub fn link_row_keyed(
+        &mut self,
+        z: &[f32],
+        keys: &[u16],
+        table: &SampleTable,
+        y: u32,
+        d: &Disparity,
+        hidden: bool,
+    ) {
+        assert_eq!(z.len(), keys.len(), "one key per pixel");
+        self.link_with(z, y, d, 1, hidden, |x| {
+            let (s, rise) = table.params[usize::from(keys[x])];
+            (s as usize, rise)
+        });
+    }
+
+    /// TIW's linking of one row with `params(x)` giving pixel x's separation (whole samples)
+    /// and ray rise per step.
+    fn link_with(
+        &mut self,
+        z: &[f32],
+        y: u32,
+        d: &Disparity,
+        scale: u32,
+        hidden: bool,
+        mut params: impl FnMut(usize) -> (usize, f32),
+    ) {
         let n = z.len();
         self.same.clear();
         self.same.extend(0..n as u32);
-        let depth_span = d.t_far - d.t_near;
-        let step_scale = 1.0 / (scale as f32 * depth_span);
+        let step_scale = step_scale(d, scale);
         // Longest walk: the smallest rise per step is at the front of the range.
         let min_rise = d.ray_slope(d.t_near).min(d.ray_slope(d.t_far)) * step_scale;
         let reach = ((1.0 / min_rise).ceil() as usize + 1).min(n);
         if hidden {
             self.block_max(z, reach);
         }
-        // Depth maps repeat values (flat regions, 8-bit files): reuse the last separation.
-        let (mut last_z, mut s, mut rise) = (f32::NAN, 0, 0.0);
+        // x's block `x / reach`, kept without dividing: `block` and `x − block · reach`.
+        let (mut block, mut in_block) = (0usize, 0usize);
         for x in 0..n {
-            let zx = z[x];
-            if zx != last_z {
-                last_z = zx;
-                s = round_half_up(d.separation(zx) * scale as f32);
-                rise = d.ray_slope(d.depth_of(zx)) * step_scale;
+            let bx = block;
+            in_block += 1;
+            if in_block == reach {
+                (block, in_block) = (block + 1, 0);
             }
+            let zx = z[x];
+            let (s, rise) = params(x);
             let left = left_of_pair(x, s, y);
             let right = left + s as isize;
             if left < 0 || right >= n as isize {
                 continue;
             }
             if hidden {
-                // The maximum of the ≤ 3 blocks around x bounds everything the walk can meet.
+                // The maximum of the ≤ 3 blocks around x bounds everything the walk can meet:
+                // blocks (x − reach) / reach = bx − 1 (or 0) to (x + reach) / reach = bx + 1.
                 let (b0, b2) = (
-                    x.saturating_sub(reach) / reach,
-                    ((x + reach) / reach).min(self.window_max.len() - 1),
+                    bx.saturating_sub(1),
+                    (bx + 1).min(self.window_max.len() - 1),
                 );
                 let around = self.window_max[b0]
-                    .max(self.window_max[x / reach])
+                    .max(self.window_max[bx])
                     .max(self.window_max[b2]);
                 if around >= zx + rise && !ray_clear(z, x, zx, rise) {
                     continue;
@@ -202,36 +287,16 @@ pub fn per_pixel_streamed(
     opts: &PerPixelOptions,
     mut sink: impl FnMut(&[[u8; 4]]) -> Result<()> + Send,
 ) -> Result<()> {
-    check_inputs(width, d, pattern)?;
-    let o = opts.oversample;
-    if !(1..=MAX_OVERSAMPLE).contains(&o) {
-        return Err(Error::invalid(
-            "sirds.oversample",
-            o,
-            format!("must lie in 1..={MAX_OVERSAMPLE}"),
-        ));
-    }
+    check_options(width, d, pattern, opts)?;
     let w = width as usize;
     let compute = |y0: usize, chunk: &mut [[u8; 4]]| {
         chunk.par_chunks_mut(w).enumerate().for_each_init(
-            || (RowLinker::default(), Vec::new(), Vec::new(), Vec::new()),
-            |(linker, row, fine, colors), (dy, row_out)| {
+            || (RowWork::default(), Vec::new()),
+            |(work, row), (dy, row_out)| {
                 let y = (y0 + dy) as u32;
                 row.clear();
                 depth_row(y, row);
-                let z: &[f32] = if o == 1 {
-                    row
-                } else {
-                    oversample_row(row, o, fine);
-                    fine
-                };
-                linker.link_row(z, y, d, o, opts.hidden_surface);
-                color_row(&linker.same, y, o, pattern, colors);
-                if o == 1 {
-                    row_out.copy_from_slice(colors);
-                } else {
-                    average_subpixels(colors, o, row_out);
-                }
+                work.row(row, None, y, d, pattern, opts, row_out);
             },
         );
     };
@@ -260,6 +325,149 @@ pub fn per_pixel_streamed(
     Ok(())
 }
 
+/// As [`check_inputs`], and an oversampling factor in 1..=[`MAX_OVERSAMPLE`].
+fn check_options(
+    width: u32,
+    d: &Disparity,
+    pattern: &Pattern,
+    opts: &PerPixelOptions,
+) -> Result<()> {
+    check_inputs(width, d, pattern)?;
+    let o = opts.oversample;
+    if !(1..=MAX_OVERSAMPLE).contains(&o) {
+        return Err(Error::invalid(
+            "sirds.oversample",
+            o,
+            format!("must lie in 1..={MAX_OVERSAMPLE}"),
+        ));
+    }
+    Ok(())
+}
+
+/// One thread's working memory for TIW rows, reused from row to row.
+#[derive(Default)]
+struct RowWork {
+    linker: RowLinker,
+    fine: Vec<f32>,
+    colors: Vec<[u8; 4]>,
+}
+
+impl RowWork {
+    /// TIW on image row `y` of nearness `z` into `row_out`; with `keys` (the row's 16-bit
+    /// samples and their table, one sample a pixel only) the links come from
+    /// [`RowLinker::link_row_keyed`], the same as [`RowLinker::link_row`]'s.
+    #[allow(clippy::too_many_arguments)]
+    fn row(
+        &mut self,
+        z: &[f32],
+        keys: Option<(&[u16], &SampleTable)>,
+        y: u32,
+        d: &Disparity,
+        pattern: &Pattern,
+        opts: &PerPixelOptions,
+        row_out: &mut [[u8; 4]],
+    ) {
+        let o = opts.oversample;
+        match keys {
+            Some((keys, table)) if o == 1 => {
+                self.linker
+                    .link_row_keyed(z, keys, table, y, d, opts.hidden_surface);
+            }
+            _ if o == 1 => self.linker.link_row(z, y, d, 1, opts.hidden_surface),
+            _ => {
+                oversample_row(z, o, &mut self.fine);
+                self.linker
+                    .link_row(&self.fine, y, d, o, opts.hidden_surface);
+            }
+        }
+        if o == 1 {
+            color_row(&self.linker.same, y, o, pattern, row_out);
+        } else {
+            self.colors.resize(self.linker.same.len(), [0; 4]);
+            color_row(&self.linker.same, y, o, pattern, &mut self.colors);
+            average_subpixels(&self.colors, o, row_out);
+        }
+    }
+}
+
+/// Images of at least this many pixels look separations up in a [`SampleTable`] (65 536
+/// entries) in [`per_pixel_samples`]; smaller ones compute them.
+const TABLE_FROM_PIXELS: u64 = 1 << 20;
+
+/// TIW streamed from 16-bit samples (a depth-map file) to `sink`: `read(buf)` fills `buf` with
+/// the next whole rows' samples, in order, and runs while the chunk before is computed, so the
+/// map is never held whole; `z_of(sample)` is a sample's nearness. With one sample a pixel and
+/// a large image, each pixel's separation and ray rise come from a [`SampleTable`]: the same
+/// numbers as computing them, so the same bytes as [`per_pixel_streamed`] on the same nearness
+/// (`per_pixel_samples_matches_per_pixel`). The bytes do not depend on the thread count.
+///
+/// # Errors
+/// As [`per_pixel_streamed`], or whatever `read` returns.
+#[allow(clippy::too_many_arguments)]
+pub fn per_pixel_samples(
+    width: u32,
+    height: u32,
+    mut read: impl FnMut(&mut [u16]) -> Result<()> + Send,
+    z_of: impl Fn(u16) -> f32 + Sync,
+    d: &Disparity,
+    pattern: &Pattern,
+    opts: &PerPixelOptions,
+    mut sink: impl FnMut(&[[u8; 4]]) -> Result<()> + Send,
+) -> Result<()> {
+    check_options(width, d, pattern, opts)?;
+    let w = width as usize;
+    let big = u64::from(width) * u64::from(height) >= TABLE_FROM_PIXELS;
+    let table = (big && opts.oversample == 1).then(|| SampleTable::new(d, &z_of));
+    let compute = |y0: usize, input: &[u16], chunk: &mut [[u8; 4]]| {
+        chunk
+            .par_chunks_mut(w)
+            .zip(input.par_chunks(w))
+            .enumerate()
+            .for_each_init(
+                || (RowWork::default(), Vec::new()),
+                |(work, row), (dy, (row_out, keys))| {
+                    row.clear();
+                    row.extend(keys.iter().map(|&v| z_of(v)));
+                    let keys = table.as_ref().map(|t| (keys, t));
+                    work.row(row, keys, (y0 + dy) as u32, d, pattern, opts, row_out);
+                },
+            );
+    };
+    let chunk_rows = |y0: usize| CHUNK_ROWS.min((height as usize).saturating_sub(y0));
+    // Double-buffered both ways: chunk i is computed while chunk i − 1 is written and chunk
+    // i + 1 read.
+    let (mut input, mut input_next) = (vec![0u16; w * CHUNK_ROWS], vec![0u16; w * CHUNK_ROWS]);
+    let (mut next, mut done) = (
+        vec![[0u8; 4]; w * CHUNK_ROWS],
+        vec![[0u8; 4]; w * CHUNK_ROWS],
+    );
+    read(&mut input[..chunk_rows(0) * w])?;
+    let mut done_rows = 0;
+    for y0 in (0..height as usize).step_by(CHUNK_ROWS) {
+        let (rows, after) = (chunk_rows(y0), chunk_rows(y0 + CHUNK_ROWS));
+        let (_, io) = rayon::join(
+            || compute(y0, &input[..rows * w], &mut next[..rows * w]),
+            || -> Result<()> {
+                if done_rows > 0 {
+                    sink(&done[..done_rows * w])?;
+                }
+                if after > 0 {
+                    read(&mut input_next[..after * w])?;
+                }
+                Ok(())
+            },
+        );
+        io?;
+        std::mem::swap(&mut next, &mut done);
+        std::mem::swap(&mut input, &mut input_next);
+        done_rows = rows;
+    }
+    if done_rows > 0 {
+        sink(&done[..done_rows * w])?;
+    }
+    Ok(())
+}
+
 /// Samples a row `o` times per pixel, linearly between pixel centers (clamped at the ends).
 fn oversample_row(row: &[f32], o: u32, fine: &mut Vec<f32>) {
     fine.clear();
@@ -274,9 +482,8 @@ fn oversample_row(row: &[f32], o: u32, fine: &mut Vec<f32>) {
 }
 
 /// TIW's coloring, right to left: a free pixel takes the pattern, a linked one its partner's.
-fn color_row(same: &[u32], y: u32, o: u32, pattern: &Pattern, colors: &mut Vec<[u8; 4]>) {
-    colors.clear();
-    colors.resize(same.len(), [0; 4]);
+fn color_row(same: &[u32], y: u32, o: u32, pattern: &Pattern, colors: &mut [[u8; 4]]) {
+    assert_eq!(colors.len(), same.len(), "one color per sample");
     for x in (0..same.len()).rev() {
         let s = same[x] as usize;
         colors[x] = if s == x {
@@ -294,6 +501,144 @@ fn average_subpixels(colors: &[[u8; 4]], o: u32, row_out: &mut [[u8; 4]]) {
         for c in 0..4 {
             let sum: usize = sub.iter().map(|p| p[c] as usize).sum();
             px[c] = ((sum + o / 2) / o) as u8;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::sirds::{DisparityModel, Geometry};
+
+    /// Rows of 16-bit samples with smooth runs, flat runs and steps, from a fixed LCG.
+    fn sample_rows(width: usize, height: usize) -> Vec<u16> {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as u32
+        };
+        let mut v = Vec::with_capacity(width * height);
+        for _ in 0..height {
+            let mut level = next() % 65536;
+            for _ in 0..width {
+                level = match next() % 64 {
+                    0 => next() % 65536,                            // a step
+                    1..=20 => level,                                // flat
+                    _ => (level + next() % 200).saturating_sub(99), // smooth
+                }
+                .min(65535);
+                v.push(level as u16);
+            }
+        }
+        v
+    }
+
+    fn disparities() -> Vec<Disparity> {
+        let view_angle = Geometry {
+            model: DisparityModel::ViewAngle,
+            ..Geometry::default()
+        };
+        let deep = Geometry {
+            depth_near_in: 2.0,
+            depth_far_in: 30.0,
+            dpi: 40.0,
+            ..Geometry::default()
+        };
+        [Geometry::default(), view_angle, deep]
+            .iter()
+            .map(|g| g.to_pixels().expect("valid set-up"))
+            .collect()
+    }
+
+    /// The table's separations and rises are the computed ones: the same links for 8- and
+    /// 16-bit-like rows, nearness straight and inverted, with and without hidden-surface
+    /// removal, on even and odd rows (the odd-separation split), under both models.
+    #[test]
+    fn link_row_keyed_matches_link_row() {
+        let width = 900;
+        let rows = sample_rows(width, 6);
+        for d in disparities() {
+            for invert in [false, true] {
+                let z_of = |v: u16| {
+                    let z = v as f32 / 65535.0;
+                    if invert { 1.0 - z } else { z }
+                };
+                let table = SampleTable::new(&d, z_of);
+                for (y, keys) in rows.chunks_exact(width).enumerate() {
+                    let z: Vec<f32> = keys.iter().map(|&v| z_of(v)).collect();
+                    for hidden in [false, true] {
+                        let (mut a, mut b) = (RowLinker::default(), RowLinker::default());
+                        a.link_row(&z, y as u32, &d, 1, hidden);
+                        b.link_row_keyed(&z, keys, &table, y as u32, &d, hidden);
+                        let linked = a.same.iter().enumerate().filter(|&(x, &s)| s as usize != x);
+                        // Rough rows: hidden-surface removal leaves many points unlinked, not all.
+                        assert!(
+                            linked.count() > width / 8,
+                            "row {y}, hidden {hidden}: too few links to compare"
+                        );
+                        assert_eq!(
+                            a.same, b.same,
+                            "row {y}, hidden {hidden}, invert {invert}, {d:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// TIW streamed from samples gives [`per_pixel`]'s bytes on the same nearness: a small
+    /// map (computed separations, a last chunk of 7 rows) and one of 2^20 pixels (the table),
+    /// hidden-surface removal on and off, with oversampling (no table), and reads of
+    /// arbitrary sizes come in whole rows, in order.
+    #[test]
+    fn per_pixel_samples_matches_per_pixel() {
+        let d = Geometry::default().to_pixels().expect("valid set-up");
+        let pattern = Pattern::Gray { seed: 3 };
+        for (width, height) in [(400, 2 * CHUNK_ROWS + 7), (1024, 1024)] {
+            let samples = sample_rows(width, height);
+            let z_of = |v: u16| v as f32 / 65535.0;
+            let map = DepthMap {
+                width: width as u32,
+                height: height as u32,
+                z: samples.iter().map(|&v| z_of(v)).collect(),
+            };
+            for opts in [
+                PerPixelOptions::default(),
+                PerPixelOptions {
+                    hidden_surface: false,
+                    oversample: 1,
+                },
+                PerPixelOptions {
+                    hidden_surface: true,
+                    oversample: 3,
+                },
+            ] {
+                let want = per_pixel(&map, &d, &pattern, &opts).expect("tiw");
+                let (mut got, mut taken) = (Vec::new(), 0);
+                per_pixel_samples(
+                    width as u32,
+                    height as u32,
+                    |buf| {
+                        assert_eq!(buf.len() % width, 0, "whole rows");
+                        buf.copy_from_slice(&samples[taken..taken + buf.len()]);
+                        taken += buf.len();
+                        Ok(())
+                    },
+                    z_of,
+                    &d,
+                    &pattern,
+                    &opts,
+                    |rows| {
+                        got.extend_from_slice(rows);
+                        Ok(())
+                    },
+                )
+                .expect("streamed tiw");
+                assert_eq!(taken, samples.len(), "every sample read once");
+                assert!(got == want, "{width}x{height} {opts:?}: bytes differ");
+            }
         }
     }
 }

@@ -148,6 +148,10 @@ unsafe fn fetch_pair(row: &[[u8; 4]], i0: __m256i, i1: __m256i) -> (__m256i, __m
 /// Lanes without a source, or reading a pixel that is not final yet, go through
 /// [`super::resolve_pixel`] (the pattern answers for those).
 ///
+/// With `gray` (the pattern's colors, hence every pixel `row` holds or the pattern answers,
+/// have R = G = B), a bilinear mix is computed for one channel and copied to the other two:
+/// the same bytes, as the three channels' mixes are the same operations on the same values.
+///
 /// # Safety
 /// The CPU must support AVX2; every source in `sources` is NaN or inside `row` (as
 /// [`super::in_bounds`] ensured).
@@ -156,7 +160,7 @@ pub(super) unsafe fn resolve_row(
     row: &mut [[u8; 4]],
     sources: &[f32],
     strip: &Strip,
-    bilinear: bool,
+    (bilinear, gray): (bool, bool),
     pattern: impl Fn(usize) -> [u8; 4],
 ) {
     let (x0, n) = (strip.x0 as usize, strip.width as usize);
@@ -188,10 +192,22 @@ pub(super) unsafe fn resolve_row(
                     );
                     _mm256_sll_epi32(_mm256_cvttps_epi32(m), shift)
                 };
-                let rgb = _mm256_or_si256(
-                    _mm256_or_si256(channel(_mm_cvtsi32_si128(0)), channel(_mm_cvtsi32_si128(8))),
-                    channel(_mm_cvtsi32_si128(16)),
-                );
+                let rgb = if gray {
+                    // R = G = B in every pixel read: one channel's mix, copied to the others.
+                    let c = channel(_mm_cvtsi32_si128(0));
+                    _mm256_or_si256(
+                        _mm256_or_si256(c, _mm256_slli_epi32::<8>(c)),
+                        _mm256_slli_epi32::<16>(c),
+                    )
+                } else {
+                    _mm256_or_si256(
+                        _mm256_or_si256(
+                            channel(_mm_cvtsi32_si128(0)),
+                            channel(_mm_cvtsi32_si128(8)),
+                        ),
+                        channel(_mm_cvtsi32_si128(16)),
+                    )
+                };
                 let mixed = _mm256_or_si256(rgb, _mm256_set1_epi32(0xff00_0000u32 as i32));
                 // A whole-pixel source copies that pixel, alpha included.
                 let color = _mm256_blendv_epi8(a, mixed, _mm256_castps_si256(mixes));

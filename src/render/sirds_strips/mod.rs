@@ -359,13 +359,15 @@ fn resolve_strip(
     let rows = image
         .chunks_exact_mut(width)
         .zip(sources.chunks_exact(width));
+    #[cfg(target_arch = "x86_64")]
+    let gray = pattern.is_gray();
     for (y, (row, src)) in (y0..).zip(rows) {
         let pattern = |x: usize| pattern.color(x as u32, y);
         #[cfg(target_arch = "x86_64")]
         if simd {
             // SAFETY: `simd` is only set where `avx2_available()` said so; `band_sources`
             // stored only NaN or in-bounds sources.
-            unsafe { avx2::resolve_row(row, src, strip, bilinear, pattern) };
+            unsafe { avx2::resolve_row(row, src, strip, (bilinear, gray), pattern) };
             continue;
         }
         let _ = simd;

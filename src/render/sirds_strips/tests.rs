@@ -15,10 +15,15 @@ use crate::render::render_view;
 #[test]
 fn reads_of_unfinished_pixels_see_the_pattern() {
     let (w, sw) = (64usize, 8u32);
-    let pattern = Pattern::Gray { seed: 3 };
     let y = 5;
-    let start: Vec<[u8; 4]> = (0..w as u32).map(|x| pattern.color(x, y)).collect();
-    for bilinear in [false, true] {
+    // Gray (the one-channel mix) and color.
+    for (bilinear, pattern) in [false, true].into_iter().flat_map(|b| {
+        [
+            (b, Pattern::Gray { seed: 3 }),
+            (b, Pattern::Color { seed: 4 }),
+        ]
+    }) {
+        let start: Vec<[u8; 4]> = (0..w as u32).map(|x| pattern.color(x, y)).collect();
         for toward in [1.0f32, -1.0] {
             // Pseudo-random sources over the whole row, every fifth pixel without one.
             let sources: Vec<f32> = (0..w)
@@ -70,23 +75,24 @@ fn reads_of_unfinished_pixels_see_the_pattern() {
                     let pat = |x: usize| pattern.color(x as u32, y);
                     #[cfg(target_arch = "x86_64")]
                     if simd {
-                        unsafe { avx2::resolve_row(&mut row, &sources, strip, bilinear, pat) };
+                        let filter = (bilinear, pattern.is_gray());
+                        unsafe { avx2::resolve_row(&mut row, &sources, strip, filter, pat) };
                         continue;
                     }
                     resolve_row(&mut row, &sources, strip, bilinear, pat);
                 }
                 assert!(
                     row == a,
-                    "bilinear {bilinear}, toward {toward}, simd {simd}"
+                    "bilinear {bilinear}, toward {toward}, simd {simd}, {pattern:?}"
                 );
             }
         }
     }
 }
 
-/// The AVX2 loops only change the speed: for both starts and both filters, on an even and
-/// an odd size (spans and strips that end mid-vector), they give the scalar loops' pixels
-/// and links, byte for byte.
+/// The AVX2 loops only change the speed: for both starts and both filters, black-white and
+/// color dots (the gray and the three-channel mix), on an even and an odd size (spans and
+/// strips that end mid-vector), they give the scalar loops' pixels and links, byte for byte.
 #[test]
 fn avx2_strips_match_scalar_strips() {
     if !crate::raster::avx2_to_compare("avx2_strips_match_scalar_strips") {
@@ -99,7 +105,11 @@ fn avx2_strips_match_scalar_strips() {
         let (fb, _) = render_view(&s, &center, Shading::DepthOnly).expect("depth pass");
         let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far).expect("range");
         let g = StripGeometry::new(&s, &center, &range, &d, false);
-        for start in [Start::Left, Start::Center] {
+        let patterns = [s.sirds.pattern.clone(), Pattern::Color { seed: 9 }];
+        for (pattern, start) in patterns
+            .iter()
+            .flat_map(|p| [(p, Start::Left), (p, Start::Center)])
+        {
             for filter in [Filter::Nearest, Filter::Bilinear] {
                 let opts = PerVertexOptions {
                     start,
@@ -113,7 +123,7 @@ fn avx2_strips_match_scalar_strips() {
                         w,
                         h,
                         &d,
-                        &s.sirds.pattern,
+                        pattern,
                         &PerVertexOptions { simd, ..opts },
                         true,
                     )
@@ -128,7 +138,7 @@ fn avx2_strips_match_scalar_strips() {
                 assert_eq!(
                     differ.count(),
                     0,
-                    "{w}x{h} {start:?} {filter:?}: pixels differ"
+                    "{w}x{h} {start:?} {filter:?} {pattern:?}: pixels differ"
                 );
                 assert_eq!(
                     fast.links, plain.links,
