@@ -64,6 +64,7 @@ pub(crate) const HANDOUT_PROFILE: &str = "\
 [profile.dev]
 opt-level = 0
 debug = false
+incremental = false
 
 [profile.dev.package.\"*\"]
 opt-level = 0
