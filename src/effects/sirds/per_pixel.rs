@@ -57,7 +57,7 @@ fn pair_params(d: &Disparity, z: f32, scale: u32, step_scale: f32) -> (usize, f3
     )
 }
 
-/// [`pair_params`] of every 16-bit sample value of a depth-map file, for
+/// `pair_params` of every 16-bit sample value of a depth-map file, for
 /// [`RowLinker::link_row_keyed`]: one table per image instead of a division and two f64
 /// depth conversions per pixel (the samples of a smooth 16-bit map differ from pixel to pixel).
 pub struct SampleTable {
@@ -121,7 +121,7 @@ impl RowLinker {
 
     /// [`Self::link_row`] (scale 1) for a row of 16-bit samples `keys` whose nearness is `z`
     /// (`z[x] = table`'s `z_of(keys[x])`): each pixel's separation and ray rise are looked up
-    /// in `table` instead of computed, the same numbers (`table` holds [`pair_params`] of every
+    /// in `table` instead of computed, the same numbers (`table` holds `pair_params` of every
     /// sample value), so the same links. `link_row_keyed_matches_link_row` holds them equal.
     pub fn link_row_keyed(
         &mut self,
