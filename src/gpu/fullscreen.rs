@@ -35,6 +35,26 @@ pub struct FullscreenPass {
 }
 
 impl FullscreenPass {
+    /// `inputs` textures and `params` as this pass takes them: its number of inputs, at most
+    /// [`MAX_PARAMS`] parameters.
+    fn check_arguments(&self, inputs: usize, params: &[f32]) -> Result<()> {
+        if inputs != self.inputs {
+            return Err(Error::invalid(
+                format!("{} inputs", self.label),
+                inputs,
+                format!("this pass takes {}", self.inputs),
+            ));
+        }
+        if params.len() > MAX_PARAMS {
+            return Err(Error::invalid(
+                format!("{} params", self.label),
+                params.len(),
+                format!("at most {MAX_PARAMS}"),
+            ));
+        }
+        Ok(())
+    }
+
     /// Compiles `fragment_wgsl`, which defines `fs_main(@builtin(position) pos: vec4<f32>) ->
     /// FullscreenOut` and may read `input0_color` … `input{n−1}_depth` and `params`
     /// (see shaders/fullscreen.wgsl).
@@ -197,20 +217,7 @@ impl FullscreenPass {
         inputs: &[&Framebuffer],
         params: &[f32],
     ) -> Result<Framebuffer> {
-        if inputs.len() != self.inputs {
-            return Err(Error::invalid(
-                format!("{} inputs", self.label),
-                inputs.len(),
-                format!("this pass takes {}", self.inputs),
-            ));
-        }
-        if params.len() > MAX_PARAMS {
-            return Err(Error::invalid(
-                format!("{} params", self.label),
-                params.len(),
-                format!("at most {MAX_PARAMS}"),
-            ));
-        }
+        self.check_arguments(inputs.len(), params)?;
         let (width, height) = (inputs[0].width, inputs[0].height);
         if let Some(f) = inputs
             .iter()
@@ -272,20 +279,7 @@ impl FullscreenPass {
         params: &[f32],
         target: &Target,
     ) -> Result<()> {
-        if inputs.len() != self.inputs {
-            return Err(Error::invalid(
-                format!("{} inputs", self.label),
-                inputs.len(),
-                format!("this pass takes {}", self.inputs),
-            ));
-        }
-        if params.len() > MAX_PARAMS {
-            return Err(Error::invalid(
-                format!("{} params", self.label),
-                params.len(),
-                format!("at most {MAX_PARAMS}"),
-            ));
-        }
+        self.check_arguments(inputs.len(), params)?;
         let mut param_bytes = vec![0u8; 4 * MAX_PARAMS];
         for (i, p) in params.iter().enumerate() {
             param_bytes[4 * i..4 * i + 4].copy_from_slice(&p.to_ne_bytes());
