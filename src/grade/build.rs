@@ -60,6 +60,14 @@ const LOCK: &str = include_str!("../../Cargo.lock");
 /// stereolab's manifest: its build profiles apply to the student's build too.
 const STEREOLAB_MANIFEST: &str = include_str!("../../Cargo.toml");
 
+/// stereolab's build profiles from its manifest: `Some` in the repository, `None` in a
+/// student's handout, whose copy of the manifest has none (`export::library_manifest`).
+fn repository_profile() -> Result<Option<toml::Value>, String> {
+    let stereolab: toml::Table =
+        toml::from_str(STEREOLAB_MANIFEST).map_err(|e| format!("stereolab's manifest: {e}"))?;
+    Ok(stereolab.get("profile").cloned())
+}
+
 /// Where `exercise-api` lives (the build's only dependency besides glam and serde).
 pub(crate) fn exercise_api_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("exercises/exercise-api")
@@ -83,14 +91,16 @@ fn manifest(ex: Exercise) -> Result<String, String> {
         toml::Value::String(api.to_string_lossy().into_owned()),
     );
     table.insert("workspace".into(), toml::Value::Table(toml::Table::new()));
-    let stereolab: toml::Table =
-        toml::from_str(STEREOLAB_MANIFEST).map_err(|e| format!("stereolab's manifest: {e}"))?;
-    // The repository's profiles; in a student's handout, whose copy of the manifest has none,
-    // the handout's (no optimization, no debug info: the exercise crates compile fastest).
-    let handout: toml::Table = toml::from_str(super::export::HANDOUT_PROFILE)
-        .map_err(|e| format!("the handout's profile: {e}"))?;
-    if let Some(p) = stereolab.get("profile").or_else(|| handout.get("profile")) {
-        table.insert("profile".into(), p.clone());
+    // The repository's profiles; in a student's handout, the handout's (no optimization, no
+    // debug info: the exercise crates compile fastest).
+    let profile = match repository_profile()? {
+        Some(p) => Some(p),
+        None => toml::from_str::<toml::Table>(super::export::HANDOUT_PROFILE)
+            .map_err(|e| format!("the handout's profile: {e}"))?
+            .remove("profile"),
+    };
+    if let Some(p) = profile {
+        table.insert("profile".into(), p);
     }
     toml::to_string(&table).map_err(|e| format!("the build's manifest: {e}"))
 }
@@ -184,8 +194,7 @@ pub(crate) fn build(ex: Exercise, sources: &Sources, work: &Path) -> Result<Path
 /// there (glam; 7 of the first grade's 18 CPU-s). `cargo run` holds no lock on it while the
 /// grader runs. `None` in the repository: `work/target`.
 fn handout_target() -> Option<PathBuf> {
-    let stereolab: toml::Table = toml::from_str(STEREOLAB_MANIFEST).ok()?;
-    if stereolab.contains_key("profile") {
+    if !matches!(repository_profile(), Ok(None)) {
         return None;
     }
     Some(

@@ -359,11 +359,7 @@ pub(super) fn rds_task(fx: &Fixture) -> TaskSpec {
         },
     ];
     let first = cases[0].clone();
-    let like = {
-        let mut fb = fx.canvas([0, 0, 0, 255]);
-        fb.depth.fill(0.0);
-        fb
-    };
+    let like = fx.canvas([0, 0, 0, 255]);
     let reference_dots = reference(&first, Variant::default());
     let build = move |answers: &[Option<Vec<f64>>]| {
         let got = answers
