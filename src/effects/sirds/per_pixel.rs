@@ -285,11 +285,11 @@ pub fn per_pixel_streamed(
     d: &Disparity,
     pattern: &Pattern,
     opts: &PerPixelOptions,
-    mut sink: impl FnMut(&[[u8; 4]]) -> Result<()> + Send,
+    sink: impl FnMut(&[[u8; 4]]) -> Result<()> + Send,
 ) -> Result<()> {
     check_options(width, d, pattern, opts)?;
     let w = width as usize;
-    let compute = |y0: usize, chunk: &mut [[u8; 4]]| {
+    let compute = |y0: usize, _: &[()], chunk: &mut [[u8; 4]]| {
         chunk.par_chunks_mut(w).enumerate().for_each_init(
             || (RowWork::default(), Vec::new()),
             |(work, row), (dy, row_out)| {
@@ -300,29 +300,7 @@ pub fn per_pixel_streamed(
             },
         );
     };
-    // Double-buffered: the sink writes chunk i − 1 while chunk i is computed.
-    let (mut next, mut done) = (
-        vec![[0u8; 4]; w * CHUNK_ROWS],
-        vec![[0u8; 4]; w * CHUNK_ROWS],
-    );
-    let mut done_rows = 0;
-    for y0 in (0..height as usize).step_by(CHUNK_ROWS) {
-        let rows = CHUNK_ROWS.min(height as usize - y0);
-        let (_, written) = rayon::join(
-            || compute(y0, &mut next[..rows * w]),
-            || match done_rows {
-                0 => Ok(()),
-                n => sink(&done[..n * w]),
-            },
-        );
-        written?;
-        std::mem::swap(&mut next, &mut done);
-        done_rows = rows;
-    }
-    if done_rows > 0 {
-        sink(&done[..done_rows * w])?;
-    }
-    Ok(())
+    pipelined(width, height, |_: &mut [()]| Ok(()), compute, sink)
 }
 
 /// As [`check_inputs`], and an oversampling factor in 1..=[`MAX_OVERSAMPLE`].
@@ -407,12 +385,12 @@ const TABLE_FROM_PIXELS: u64 = 1 << 20;
 pub fn per_pixel_samples(
     width: u32,
     height: u32,
-    mut read: impl FnMut(&mut [u16]) -> Result<()> + Send,
+    read: impl FnMut(&mut [u16]) -> Result<()> + Send,
     z_of: impl Fn(u16) -> f32 + Sync,
     d: &Disparity,
     pattern: &Pattern,
     opts: &PerPixelOptions,
-    mut sink: impl FnMut(&[[u8; 4]]) -> Result<()> + Send,
+    sink: impl FnMut(&[[u8; 4]]) -> Result<()> + Send,
 ) -> Result<()> {
     check_options(width, d, pattern, opts)?;
     let w = width as usize;
@@ -433,10 +411,25 @@ pub fn per_pixel_samples(
                 },
             );
     };
+    pipelined(width, height, read, compute, sink)
+}
+
+/// Rows in chunks of `CHUNK_ROWS`, double-buffered both ways: chunk i is computed from its
+/// input while chunk i − 1 goes to `sink` and chunk i + 1's input is `read` (`I = ()`: there
+/// is nothing to read).
+fn pipelined<I: Copy + Default + Send + Sync>(
+    width: u32,
+    height: u32,
+    mut read: impl FnMut(&mut [I]) -> Result<()> + Send,
+    compute: impl Fn(usize, &[I], &mut [[u8; 4]]) + Sync,
+    mut sink: impl FnMut(&[[u8; 4]]) -> Result<()> + Send,
+) -> Result<()> {
+    let w = width as usize;
     let chunk_rows = |y0: usize| CHUNK_ROWS.min((height as usize).saturating_sub(y0));
-    // Double-buffered both ways: chunk i is computed while chunk i − 1 is written and chunk
-    // i + 1 read.
-    let (mut input, mut input_next) = (vec![0u16; w * CHUNK_ROWS], vec![0u16; w * CHUNK_ROWS]);
+    let (mut input, mut input_next) = (
+        vec![I::default(); w * CHUNK_ROWS],
+        vec![I::default(); w * CHUNK_ROWS],
+    );
     let (mut next, mut done) = (
         vec![[0u8; 4]; w * CHUNK_ROWS],
         vec![[0u8; 4]; w * CHUNK_ROWS],
