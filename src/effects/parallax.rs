@@ -11,7 +11,7 @@ use std::mem::MaybeUninit;
 use image::RgbaImage;
 use rayon::prelude::*;
 
-use super::eye_input::check_depth;
+use super::eye_input::{check_depth, check_depth_len, depth_row_in_unit};
 use super::legend::{draw_legend, draw_legend_reference};
 use super::par_fill_rows;
 use crate::error::{Error, Result};
@@ -110,9 +110,11 @@ impl ParallaxRig {
     /// p is monotone in d, and the extremes of p are at the nearest and the farthest drawn
     /// depth (up to the sign of a zero, which |p| drops). That needs `0 < n < f` and finite
     /// factors, which a resolved rig has; other values get the full scan, as [`budget`] does
-    /// it. `parallax_image_matches_reference` holds the result to the full map. The depths must
-    /// have passed `check_depth` (all in [0, 1]).
-    fn color_scale_of(&self, depth: &[f32]) -> f64 {
+    /// it. `parallax_image_matches_reference` holds the result to the full map.
+    ///
+    /// The second value says whether every depth lies in [0, 1]: `check_depth`'s test, made in
+    /// the same pass over the buffer as the extremes. The scale means nothing when it is false.
+    fn color_scale_checked(&self, depth: &[f32]) -> (f64, bool) {
         let monotone = self.near > 0.0
             && self.far > self.near
             && [
@@ -127,27 +129,37 @@ impl ParallaxRig {
         let extremes = if monotone {
             // The drawn depths' extremes, per block in parallel (min and max are exact, so the
             // result does not depend on the split).
-            let (lo, hi) = depth
-                .par_chunks(1 << 14)
-                .map(drawn_extremes)
-                .reduce(|| (u32::MAX, 0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+            let (lo, hi, in_unit) = depth.par_chunks(1 << 14).map(drawn_extremes).reduce(
+                || (u32::MAX, 0, true),
+                |a, b| (a.0.min(b.0), a.1.max(b.1), a.2 & b.2),
+            );
             let p = |b: u32| self.parallax_pixels(f32::from_bits(b));
-            (lo != u32::MAX)
+            let extremes = (lo != u32::MAX)
                 .then(|| p(lo).zip(p(hi)).map(|(a, b)| (a.min(b), a.max(b))))
-                .flatten()
+                .flatten();
+            (extremes, in_unit)
         } else {
-            depth
+            let extremes = depth
                 .iter()
                 .filter_map(|d| self.parallax_pixels(*d))
                 .fold(None, |e, p| {
                     let (lo, hi) = e.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
                     Some((lo.min(p), hi.max(p)))
-                })
+                });
+            (extremes, depth_row_in_unit(depth))
         };
-        extremes.map_or(0.5, |(lo, hi)| lo.abs().max(hi.abs()).max(0.5))
+        let (extremes, in_unit) = extremes;
+        let scale = extremes.map_or(0.5, |(lo, hi)| lo.abs().max(hi.abs()).max(0.5));
+        (scale, in_unit)
     }
 
     fn check(&self, fb: &Framebuffer) -> Result<()> {
+        self.check_size(fb)?;
+        check_depth("parallax", fb)
+    }
+
+    /// [`Self::check`] without reading the depth values (their length only).
+    fn check_size(&self, fb: &Framebuffer) -> Result<()> {
         if (fb.width, fb.height) != (self.width, self.height) {
             return Err(Error::invalid(
                 "parallax framebuffer",
@@ -155,15 +167,15 @@ impl ParallaxRig {
                 format!("the rig was resolved for {}x{}", self.width, self.height),
             ));
         }
-        check_depth("parallax", fb)
+        check_depth_len("parallax", fb)
     }
 }
 
 /// The smallest and largest bit patterns of the drawn (< 1) depths of `c`, `(u32::MAX, 0)`
-/// when none is drawn. For depths in [0, 1] with the sign bit cleared (so −0 reads as 0) the
-/// order of the bits is the order of the values. Eight at a time on AVX2
-/// (`avx2::drawn_extremes`), else [`drawn_extremes_scalar`].
-fn drawn_extremes(c: &[f32]) -> (u32, u32) {
+/// when none is drawn, and whether every value lies in [0, 1] (NaN does not). For depths in
+/// [0, 1] with the sign bit cleared (so −0 reads as 0) the order of the bits is the order of
+/// the values. Eight at a time on AVX2 (`avx2::drawn_extremes`), else [`drawn_extremes_scalar`].
+fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
     #[cfg(target_arch = "x86_64")]
     if avx2::available() {
         // SAFETY: the CPU has AVX2 (checked above), the function's only requirement. The same
@@ -174,14 +186,15 @@ fn drawn_extremes(c: &[f32]) -> (u32, u32) {
 }
 
 /// [`drawn_extremes`] one depth at a time, the reference.
-fn drawn_extremes_scalar(c: &[f32]) -> (u32, u32) {
+fn drawn_extremes_scalar(c: &[f32]) -> (u32, u32, bool) {
     const ONE: u32 = 0x3f80_0000;
-    c.iter().fold((u32::MAX, 0), |(lo, hi), d| {
+    c.iter().fold((u32::MAX, 0, true), |(lo, hi, ok), d| {
+        let ok = ok & (*d >= 0.0) & (*d <= 1.0);
         let b = d.to_bits() & 0x7fff_ffff;
         if b < ONE {
-            (lo.min(b), hi.max(b))
+            (lo.min(b), hi.max(b), ok)
         } else {
-            (lo, hi)
+            (lo, hi, ok)
         }
     })
 }
@@ -378,7 +391,7 @@ fn violation_marks_where(
 ///
 /// The same bytes as [`parallax_image_reference`] (the readable program: the parallax map, its
 /// budget, the colors), computed without the map: S from the depth extremes
-/// (`ParallaxRig::color_scale_of`), each row's colors in parallel, four pixels at a time on
+/// (`ParallaxRig::color_scale_checked`), each row's colors in parallel, four pixels at a time on
 /// AVX2 (`parallax/avx2.rs`, the scalar [`parallax_color`] elsewhere), the window violations
 /// from the border pixels alone.
 ///
@@ -394,8 +407,12 @@ pub fn parallax_image(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> 
 /// # Errors
 /// As [`parallax_map`].
 pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> Result<RgbaImage> {
-    rig.check(fb)?;
-    let scale = rig.color_scale_of(&fb.depth);
+    rig.check_size(fb)?;
+    // The depth check in the extremes' pass; the error names the first bad pixel, as before.
+    let (scale, in_unit) = rig.color_scale_checked(&fb.depth);
+    if !in_unit {
+        check_depth("parallax", fb)?;
+    }
     let legend = draw_legend(fb.width, scale, &|p| parallax_color(p, scale))?;
     let (w, n) = (fb.width as usize, fb.depth.len());
     #[cfg(target_arch = "x86_64")]

@@ -16,12 +16,13 @@
 //! functions below it only loop.
 
 use std::mem::MaybeUninit;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::{DMat4, DVec4, Mat4, Vec4};
 use image::RgbaImage;
 use rayon::prelude::*;
 
-use super::eye_input::{check_depth, check_same_size};
+use super::eye_input::{check_depth, check_depth_len, check_same_size, depth_row_in_unit};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 
@@ -234,19 +235,29 @@ pub fn remap_color_with(
     simd: bool,
 ) -> Result<RgbaImage> {
     check_same_size(this, other)?;
-    check_depth("this", this)?;
+    check_depth_len("this", this)?;
     let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
     let (w, h) = (this.width, this.height);
     let rows = RowProgram::new(&r, simd);
     // Rows in parallel: every pixel is independent, so the bytes do not depend on the threads.
+    // Each depth row is checked as it is read (in cache), not in a pass of its own; a row
+    // program is safe on any value (NaN and out-of-range depths fail its bounds test).
     let wu = w.max(1) as usize;
+    let bad = AtomicBool::new(false);
     let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
         let depth = &this.depth[y * wu..y * wu + out.len()];
+        if !depth_row_in_unit(depth) {
+            bad.store(true, Ordering::Relaxed);
+        }
         rows.run(other, y as u32, depth, out);
     };
     // SAFETY: `RowProgram::run` writes one pixel per depth value of the row, and the depth row
-    // is as long as the output row (`check_depth`: width × height values).
+    // is as long as the output row (`check_depth_len`: width × height values).
     let bytes = unsafe { super::par_fill_rows(this.depth.len(), wu, 0, fill) };
+    if bad.into_inner() {
+        // The error `check_depth` gives, naming the first bad pixel; the image is dropped.
+        check_depth("this", this)?;
+    }
     Ok(RgbaImage::from_raw(w, h, bytes).expect("4 bytes per pixel"))
 }
 

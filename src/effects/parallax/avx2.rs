@@ -42,19 +42,30 @@ fn round_to_byte(v: __m256d) -> __m128i {
 }
 
 /// `super::drawn_extremes_scalar(c)`: the smallest and largest bits (sign cleared) of the
-/// depths below 1, `(u32::MAX, 0)` when there are none; eight depths per step.
+/// depths below 1, `(u32::MAX, 0)` when there are none, and whether all lie in [0, 1]; eight
+/// depths per step.
 ///
 /// # Safety
 /// The CPU must support AVX2 ([`available`]).
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32) {
+pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
     let abs = _mm256_set1_epi32(0x7fff_ffff);
     let one = _mm256_set1_epi32(0x3f80_0000);
+    let negative_zero = _mm256_set1_epi32(i32::MIN);
     let (mut lo, mut hi) = (_mm256_set1_epi32(-1), _mm256_setzero_si256());
+    let mut outside = _mm256_setzero_si256();
     let (blocks, rest) = c.as_chunks::<8>();
     for block in blocks {
         // SAFETY: a block is eight f32 (32 bytes); the unaligned load needs no alignment.
-        let v = _mm256_and_si256(unsafe { _mm256_loadu_si256(block.as_ptr().cast()) }, abs);
+        let bits = unsafe { _mm256_loadu_si256(block.as_ptr().cast()) };
+        // In [0, 1]: the bits at most 1.0's as unsigned (+0 .. 1), or −0's. Negative values,
+        // NaN and values above 1 have larger bits.
+        let in_unit = _mm256_or_si256(
+            _mm256_cmpeq_epi32(_mm256_min_epu32(bits, one), bits),
+            _mm256_cmpeq_epi32(bits, negative_zero),
+        );
+        outside = _mm256_or_si256(outside, _mm256_xor_si256(in_unit, _mm256_set1_epi32(-1)));
+        let v = _mm256_and_si256(bits, abs);
         // Signed compare: with the sign cleared every value is non-negative.
         let drawn = _mm256_cmpgt_epi32(one, v);
         // Not drawn: u32::MAX for the minimum, 0 for the maximum.
@@ -70,10 +81,11 @@ pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32) {
         _mm256_storeu_si256(l.as_mut_ptr().cast(), lo);
         _mm256_storeu_si256(h.as_mut_ptr().cast(), hi);
     }
-    let (rl, rh) = super::drawn_extremes_scalar(rest);
+    let (rl, rh, rest_in_unit) = super::drawn_extremes_scalar(rest);
     (
         l.into_iter().fold(rl, u32::min),
         h.into_iter().fold(rh, u32::max),
+        rest_in_unit && _mm256_testz_si256(outside, outside) == 1,
     )
 }
 
@@ -222,7 +234,8 @@ mod tests {
     }
 
     /// The AVX2 extremes are the scalar fold's on depths with and without drawn values, −0,
-    /// exact 1s, and lengths that end mid-vector.
+    /// exact 1s, and lengths that end mid-vector; both find a value outside [0, 1] (NaN, a
+    /// negative, just above 1, +∞) wherever it lies.
     #[test]
     fn avx2_drawn_extremes_match_scalar() {
         if !available() {
@@ -248,6 +261,21 @@ mod tests {
                 // SAFETY: AVX2 is available (checked above).
                 let fast = unsafe { drawn_extremes(&c) };
                 assert_eq!(fast, super::super::drawn_extremes_scalar(&c), "len {len}");
+                assert!(fast.2, "len {len}: all in [0, 1]");
+                // One value outside [0, 1] anywhere (in a block or the scalar rest) is found.
+                for bad in [f32::NAN, -f32::MIN_POSITIVE, 1.0f32.next_up(), f32::INFINITY] {
+                    for at in [0, len / 2, len.saturating_sub(1)] {
+                        if len == 0 {
+                            continue;
+                        }
+                        let mut d = c.clone();
+                        d[at] = bad;
+                        // SAFETY: AVX2 is available (checked above).
+                        let fast = unsafe { drawn_extremes(&d) };
+                        assert!(!fast.2, "len {len}: {bad} at {at}");
+                        assert_eq!(fast, super::super::drawn_extremes_scalar(&d), "len {len}");
+                    }
+                }
             }
         }
     }

@@ -146,7 +146,8 @@ unsafe fn fetch_pair(row: &[[u8; 4]], i0: __m256i, i1: __m256i) -> (__m256i, __m
 /// [`super::resolve_row`] eight pixels at a time: each pixel of `strip` with a source takes
 /// `row`'s color there (bilinear: the two neighbors mixed per channel and rounded), in place.
 /// Lanes without a source, or reading a pixel that is not final yet, go through
-/// [`super::resolve_pixel`] (the pattern answers for those).
+/// [`super::resolve_pixel`] (the pattern answers for those); a vector with no source at all
+/// takes the pattern without the rest (the columns left of the nearest separation).
 ///
 /// With `gray` (the pattern's colors, hence every pixel `row` holds or the pattern answers,
 /// have R = G = B), a bilinear mix is computed for one channel and copied to the other two:
@@ -170,11 +171,21 @@ pub(super) unsafe fn resolve_row(
     let mut k = 0;
     while k < n {
         let mask = tail_mask(n - k);
+        // SAFETY: the mask covers lanes k .. min(k + 8, n), inside `sources` (asserted).
+        let p = unsafe { _mm256_maskload_ps(sources.as_ptr().add(x0 + k), mask) };
+        let has = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_ORD_Q>(p, p));
+        if _mm256_movemask_ps(_mm256_castsi256_ps(has)) == 0 {
+            // No lane has a source (the columns left of the nearest separation): the pattern,
+            // as `resolve_pixel` answers for a NaN source.
+            for x in x0 + k..x0 + (k + 8).min(n) {
+                row[x] = pattern(x);
+            }
+            k += 8;
+            continue;
+        }
         // SAFETY: the mask covers lanes k .. min(k + 8, n), inside `row` and `sources`
         // (asserted); gathered indices are in bounds (NaN lanes gather pixel 0).
-        let (color, i0, i1, has) = unsafe {
-            let p = _mm256_maskload_ps(sources.as_ptr().add(x0 + k), mask);
-            let has = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_ORD_Q>(p, p));
+        let (color, i0, i1) = unsafe {
             let base = row.as_ptr() as *const i32;
             if bilinear {
                 let i0 = _mm256_and_si256(floor_i32(p), has);
@@ -211,10 +222,10 @@ pub(super) unsafe fn resolve_row(
                 let mixed = _mm256_or_si256(rgb, _mm256_set1_epi32(0xff00_0000u32 as i32));
                 // A whole-pixel source copies that pixel, alpha included.
                 let color = _mm256_blendv_epi8(a, mixed, _mm256_castps_si256(mixes));
-                (color, i0, i1, has)
+                (color, i0, i1)
             } else {
                 let i = _mm256_and_si256(floor_i32(_mm256_add_ps(p, half)), has);
-                (_mm256_i32gather_epi32::<4>(base, i), i, i, has)
+                (_mm256_i32gather_epi32::<4>(base, i), i, i)
             }
         };
         // Reads of pixels not final yet: at or right of x0 going right, left of the strip's
