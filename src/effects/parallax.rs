@@ -139,13 +139,14 @@ impl ParallaxRig {
                 .flatten();
             (extremes, in_unit)
         } else {
-            let extremes = depth
-                .iter()
-                .filter_map(|d| self.parallax_pixels(*d))
-                .fold(None, |e, p| {
-                    let (lo, hi) = e.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
-                    Some((lo.min(p), hi.max(p)))
-                });
+            let extremes =
+                depth
+                    .iter()
+                    .filter_map(|d| self.parallax_pixels(*d))
+                    .fold(None, |e, p| {
+                        let (lo, hi) = e.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
+                        Some((lo.min(p), hi.max(p)))
+                    });
             (extremes, depth_row_in_unit(depth))
         };
         let (extremes, in_unit) = extremes;

@@ -96,9 +96,12 @@ pub(crate) fn floor_i32(v: __m256) -> __m256i {
 /// Calls `f(y, x, mask)` for every vector of eight pixels (`x .. x + 8` of row `y`) holding
 /// pixels of `t` covered within the tile (columns `x0 .. x0 + width`, rows `y0 .. y0 + rows`),
 /// `mask` marking the covered lanes. A triangle at most eight columns wide there takes one
-/// vector per row, its coverage from the edge functions in `i32` lanes ([`SmallBox`]: the
-/// per-row span search and its branches cost more than the pixels of a small triangle);
-/// larger ones go span by span ([`SetupTriangle::spans`]). Both give the same coverage.
+/// vector per row, at most sixteen two (the left eight columns' rows, then the right eight's),
+/// its coverage from the edge functions in `i32` lanes ([`SmallBox`]: the per-row span search
+/// and its branches cost more than the pixels of a small triangle); larger ones go span by
+/// span ([`SetupTriangle::spans`]). Both give the same coverage; each covered pixel is passed
+/// once, so a pass whose pixels do not interact within one triangle (the depth test, the strip
+/// sources) does not depend on the order.
 ///
 /// [`SmallBox`]: super::SmallBox
 #[target_feature(enable = "avx2,fma")]
@@ -108,34 +111,42 @@ pub(crate) fn covered_vectors(
     (x0, y0, width, rows): (u32, u32, u32, u32),
     mut f: impl FnMut(u32, u32, __m256i),
 ) {
-    if let Some(b) = t.small_box(x0, y0, width, rows, 8) {
+    // One vector per row for boxes up to eight columns, two up to sixteen. (Four up to 32 was
+    // measured too: the SIRDS paper's Table 1 row 4, triangles ~38 columns wide, took 13% more
+    // time, half of each box's vectors empty.)
+    let small = [1, 2]
+        .into_iter()
+        .find_map(|v| t.small_box(x0, y0, width, rows, 8 * v).map(|b| (b, v)));
+    if let Some((b, vectors)) = small {
         let lanes = lane_ids();
-        let in_box = _mm256_cmpgt_epi32(_mm256_set1_epi32(b.columns as i32), lanes);
-        let edge = |i: usize| {
-            _mm256_add_epi32(
-                _mm256_set1_epi32(b.e[i]),
-                _mm256_mullo_epi32(_mm256_set1_epi32(b.dx[i]), lanes),
-            )
-        };
-        let (mut e0, mut e1, mut e2) = (edge(0), edge(1), edge(2));
-        let (d0, d1, d2) = (
-            _mm256_set1_epi32(b.dy[0]),
-            _mm256_set1_epi32(b.dy[1]),
-            _mm256_set1_epi32(b.dy[2]),
-        );
         let below = _mm256_set1_epi32(-1);
-        for y in b.y0..=b.y1 {
-            let inside = _mm256_and_si256(
-                _mm256_cmpgt_epi32(e0, below),
-                _mm256_and_si256(_mm256_cmpgt_epi32(e1, below), _mm256_cmpgt_epi32(e2, below)),
-            );
-            let covered = _mm256_and_si256(inside, in_box);
-            if _mm256_movemask_ps(_mm256_castsi256_ps(covered)) != 0 {
-                f(y, b.x, covered);
+        let dy = b.dy.map(|d| _mm256_set1_epi32(d));
+        for v in 0..vectors {
+            // Lanes 8v .. 8v + 8 of the box: the edge values there fit in i32, as every lane's
+            // do (`small_box` checked the corners of all `8 · vectors` lanes).
+            let first = _mm256_add_epi32(lanes, _mm256_set1_epi32(8 * v as i32));
+            let in_box = _mm256_cmpgt_epi32(_mm256_set1_epi32(b.columns as i32), first);
+            let mut e = [0, 1, 2].map(|i| {
+                _mm256_add_epi32(
+                    _mm256_set1_epi32(b.e[i]),
+                    _mm256_mullo_epi32(_mm256_set1_epi32(b.dx[i]), first),
+                )
+            });
+            let x = b.x + 8 * v;
+            for y in b.y0..=b.y1 {
+                let inside = _mm256_and_si256(
+                    _mm256_cmpgt_epi32(e[0], below),
+                    _mm256_and_si256(
+                        _mm256_cmpgt_epi32(e[1], below),
+                        _mm256_cmpgt_epi32(e[2], below),
+                    ),
+                );
+                let covered = _mm256_and_si256(inside, in_box);
+                if _mm256_movemask_ps(_mm256_castsi256_ps(covered)) != 0 {
+                    f(y, x, covered);
+                }
+                e = [0, 1, 2].map(|i| _mm256_add_epi32(e[i], dy[i]));
             }
-            e0 = _mm256_add_epi32(e0, d0);
-            e1 = _mm256_add_epi32(e1, d1);
-            e2 = _mm256_add_epi32(e2, d2);
         }
         return;
     }

@@ -4,8 +4,8 @@ use glam::Mat4;
 use stereolab::Framebuffer;
 use stereolab::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
 use stereolab::effects::occlusion::occlusion_image;
-use stereolab::effects::parallax::{ParallaxRig, parallax_image};
-use stereolab::effects::remap::{Precision, remap_color, visibility_map};
+use stereolab::effects::parallax::{ParallaxRig, parallax_image, parallax_image_with};
+use stereolab::effects::remap::{Precision, remap_color, remap_color_with, visibility_map};
 use stereolab::math::{Camera, StereoRig};
 
 fn fb(w: u32, h: u32) -> Framebuffer {
@@ -97,6 +97,49 @@ fn nan_depth_is_refused_naming_the_pixel() {
         .expect_err("depth > 1")
         .to_string();
     assert!(msg.contains("1.5"), "{msg}");
+}
+
+/// The remap and the parallax image test the depth values inside a pass they make anyway (a
+/// row at a time, or the extremes' scan in blocks): on an image of several rows and blocks, on
+/// the AVX2 and the scalar loops, the first bad pixel is the one named, wherever it lies, and
+/// every kind of bad value is found.
+#[test]
+fn a_bad_depth_anywhere_is_refused_naming_the_first() {
+    let (w, h) = (1030u32, 40u32);
+    let mut a = fb(w, h);
+    // Something drawn, so the modes do real work around the bad value.
+    for (k, d) in a.depth.iter_mut().enumerate() {
+        if k % 3 == 0 {
+            *d = 0.25 + (k % 1000) as f32 / 4000.0;
+        }
+    }
+    let b = fb(w, h);
+    let m = mvps();
+    let rig = parallax_rig(w, h);
+    for (x, y) in [(0, 0), (1029, 0), (517, 16), (7, 39), (1029, 39)] {
+        for bad in [f32::NAN, -0.25, 1.0f32.next_up(), f32::NEG_INFINITY] {
+            let mut a = a.clone();
+            let i = a.index(x, y);
+            a.depth[i] = bad;
+            // A later bad value must not be named instead.
+            let last = a.depth.len() - 1;
+            if i != last {
+                a.depth[last] = 2.0;
+            }
+            for simd in [true, false] {
+                for e in [
+                    remap_color_with(&a, &b, &m[0], &m[1], Precision::F64, simd).map(drop),
+                    parallax_image_with(&a, &rig, simd).map(drop),
+                ] {
+                    let msg = e.expect_err("bad depth").to_string();
+                    assert!(
+                        msg.contains(&format!("pixel ({x}, {y})")),
+                        "{bad} at ({x}, {y}), simd {simd}: {msg}"
+                    );
+                }
+            }
+        }
+    }
 }
 
 #[test]

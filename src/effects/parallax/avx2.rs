@@ -263,7 +263,12 @@ mod tests {
                 assert_eq!(fast, super::super::drawn_extremes_scalar(&c), "len {len}");
                 assert!(fast.2, "len {len}: all in [0, 1]");
                 // One value outside [0, 1] anywhere (in a block or the scalar rest) is found.
-                for bad in [f32::NAN, -f32::MIN_POSITIVE, 1.0f32.next_up(), f32::INFINITY] {
+                for bad in [
+                    f32::NAN,
+                    -f32::MIN_POSITIVE,
+                    1.0f32.next_up(),
+                    f32::INFINITY,
+                ] {
                     for at in [0, len / 2, len.saturating_sub(1)] {
                         if len == 0 {
                             continue;
