@@ -43,50 +43,169 @@ fn round_to_byte(v: __m256d) -> __m128i {
 
 /// `super::drawn_extremes_scalar(c)`: the smallest and largest bits (sign cleared) of the
 /// depths below 1, `(u32::MAX, 0)` when there are none, and whether all lie in [0, 1]; eight
-/// depths per step.
+/// depths per step, six instructions each.
+///
+/// On values in [0, 1] the float minimum of all of them is the smallest drawn one when any is
+/// drawn (the background's 1.0 is larger), and the float maximum of the drawn ones (the others
+/// masked to 0) the largest; for non-negative floats the order of the bits is the order of the
+/// values, and −0 (equal to 0) reads as 0 once the sign is cleared. Whether all lie in [0, 1]:
+/// their largest bits as unsigned are at most 1.0's (a negative value, NaN and anything above 1
+/// have larger ones). −0 fails that test too although it is a window depth: a block with any
+/// value that fails it is answered by the scalar fold, exactly, so the result is always the
+/// fold's.
 ///
 /// # Safety
 /// The CPU must support AVX2 ([`available`]).
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
-    let abs = _mm256_set1_epi32(0x7fff_ffff);
-    let one = _mm256_set1_epi32(0x3f80_0000);
-    let negative_zero = _mm256_set1_epi32(i32::MIN);
-    let (mut lo, mut hi) = (_mm256_set1_epi32(-1), _mm256_setzero_si256());
-    let mut outside = _mm256_setzero_si256();
+    let one = _mm256_set1_ps(1.0);
+    let (mut lo, mut hi) = (one, _mm256_setzero_ps());
+    let mut bits_max = _mm256_setzero_si256();
     let (blocks, rest) = c.as_chunks::<8>();
     for block in blocks {
         // SAFETY: a block is eight f32 (32 bytes); the unaligned load needs no alignment.
-        let bits = unsafe { _mm256_loadu_si256(block.as_ptr().cast()) };
-        // In [0, 1]: the bits at most 1.0's as unsigned (+0 .. 1), or −0's. Negative values,
-        // NaN and values above 1 have larger bits.
-        let in_unit = _mm256_or_si256(
-            _mm256_cmpeq_epi32(_mm256_min_epu32(bits, one), bits),
-            _mm256_cmpeq_epi32(bits, negative_zero),
-        );
-        outside = _mm256_or_si256(outside, _mm256_xor_si256(in_unit, _mm256_set1_epi32(-1)));
-        let v = _mm256_and_si256(bits, abs);
-        // Signed compare: with the sign cleared every value is non-negative.
-        let drawn = _mm256_cmpgt_epi32(one, v);
-        // Not drawn: u32::MAX for the minimum, 0 for the maximum.
-        lo = _mm256_min_epu32(
-            lo,
-            _mm256_or_si256(v, _mm256_xor_si256(drawn, _mm256_set1_epi32(-1))),
-        );
-        hi = _mm256_max_epu32(hi, _mm256_and_si256(v, drawn));
+        let d = unsafe { _mm256_loadu_ps(block.as_ptr()) };
+        lo = _mm256_min_ps(lo, d);
+        let drawn = _mm256_cmp_ps::<_CMP_LT_OQ>(d, one);
+        hi = _mm256_max_ps(hi, _mm256_and_ps(d, drawn));
+        bits_max = _mm256_max_epu32(bits_max, _mm256_castps_si256(d));
     }
-    let (mut l, mut h) = ([0u32; 8], [0u32; 8]);
+    let most = _mm256_set1_epi32(0x3f80_0000);
+    // All lanes' largest bits at most 1.0's: max(bits_max, 1.0's) == 1.0's in every lane.
+    let in_unit = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
+        _mm256_max_epu32(bits_max, most),
+        most,
+    ))) == 0xff;
+    if !in_unit {
+        return super::drawn_extremes_scalar(c);
+    }
+    let (mut l, mut h) = ([0f32; 8], [0f32; 8]);
     // SAFETY: each array holds 32 bytes; the unaligned stores need no alignment.
     unsafe {
-        _mm256_storeu_si256(l.as_mut_ptr().cast(), lo);
-        _mm256_storeu_si256(h.as_mut_ptr().cast(), hi);
+        _mm256_storeu_ps(l.as_mut_ptr(), lo);
+        _mm256_storeu_ps(h.as_mut_ptr(), hi);
     }
+    let (lo, hi) = (
+        l.into_iter().fold(1.0, f32::min),
+        h.into_iter().fold(0.0, f32::max),
+    );
+    let (blocks_lo, blocks_hi) = if lo < 1.0 {
+        ((lo.abs()).to_bits(), (hi.abs()).to_bits())
+    } else {
+        (u32::MAX, 0)
+    };
     let (rl, rh, rest_in_unit) = super::drawn_extremes_scalar(rest);
-    (
-        l.into_iter().fold(rl, u32::min),
-        h.into_iter().fold(rh, u32::max),
-        rest_in_unit && _mm256_testz_si256(outside, outside) == 1,
-    )
+    (blocks_lo.min(rl), blocks_hi.max(rh), rest_in_unit)
+}
+
+/// The color-scale position of a drawn pixel as an affine function of its window depth, with
+/// a bound on how far it can be from `parallax_color`'s, for the eight-wide fast path of
+/// [`row`].
+///
+/// `parallax_color` takes `t = clamp(p(d)/scale, −1, 1)` with `p = S·(b − z0/z)`, `S` the eye
+/// separation times pixels per unit, and `z = n f/(f − d(f − n))`. As `1/z` is affine in the
+/// window depth d, so is t before the clamp: `t(d) = α + β·d` with `α = c(b − z0/n)`,
+/// `β = c·z0(f − n)/(n f)`, `c = S/scale` — in exact arithmetic. The reference computes it with
+/// three divisions in f64; this computes it with one multiply and one add in f64 (α and β
+/// nearly cancel where the scene lies far from the near plane, so f32 would lose too much),
+/// takes the result to f32 and does the rest eight lanes wide in f32. A pixel's color is taken
+/// from that only where no rounding can make the two differ:
+/// - `|t̃ − t| ≤ δ`, where t is the reference's f64 value: the affine form's roundings (α, β,
+///   the product and the sum: within `2⁻⁵⁰·m`, `m ≥ |α|, |β|`), the reference's own (its
+///   subtraction `f − d(f − n)` loses up to `f/n` ulps to cancellation, the rest a few ulps:
+///   within `2⁻⁵³(f/n + 10)·m`), and the step to f32 (within `2⁻²⁴|t|`, which matters only
+///   for `|t| < 2`: `2⁻²³`). `δ = m·(2⁻⁴⁸ + (f/n + 16)·2⁻⁴⁵) + 2⁻²²` is at least twice that
+///   sum.
+/// - The sign of t (which end of the scale) is certain where `|t̃| > δ`, the clamp where
+///   `||t̃| − 1| > δ` (beyond it both give s = 1 exactly).
+/// - Each channel `round(255 + e·s)` (`e ≥ −255`) is the same where the f32 value is more than
+///   `255·δ + 2⁻¹²` from a half-integer: the reference's value lies within `255·δ` plus its own
+///   rounding (≤ 2⁻⁴⁴), the f32 evaluation's within 2⁻¹⁴ of the exact one.
+///
+/// A vector with a lane that fails any test is colored by the division chain, exactly as
+/// before.
+struct Affine {
+    alpha: __m256d,
+    beta: __m256d,
+    delta: __m256,
+    margin: __m256,
+}
+
+impl Affine {
+    /// The affine form for `rig` at `scale`, or `None` where the bound is unusable (a rig
+    /// outside `0 < n < f`, non-finite factors, or δ above 10⁻³, where nearly every pixel would
+    /// fall back anyway).
+    #[target_feature(enable = "avx2")]
+    fn of(rig: &ParallaxRig, scale: f64) -> Option<Affine> {
+        let (n, f, z0, b) = (rig.near, rig.far, rig.zero_parallax_distance, rig.balance);
+        let c = rig.eye_separation * rig.pixels_per_unit / scale;
+        let slope = z0 * (f - n) / (n * f);
+        let (alpha, beta) = (c * (b - z0 / n), c * slope);
+        let m = c.abs() * (b.abs() + (z0 / n).abs() + slope.abs()) + 1.0;
+        let delta = m * (2f64.powi(-48) + (f / n + 16.0) * 2f64.powi(-45)) + 2f64.powi(-22);
+        let usable = n > 0.0
+            && f > n
+            && [alpha, beta, m, delta].iter().all(|v| v.is_finite())
+            && delta < 1e-3;
+        usable.then(|| Affine {
+            alpha: _mm256_set1_pd(alpha),
+            beta: _mm256_set1_pd(beta),
+            // Rounded up to f32, so never below the bound.
+            delta: _mm256_set1_ps(round_up_f32(delta)),
+            margin: _mm256_set1_ps(round_up_f32(255.0 * delta + 2f64.powi(-12))),
+        })
+    }
+
+    /// The eight pixels' colors (alpha opaque) where every `drawn` lane passes the tests in the
+    /// type's notes; `None` when one does not. Lanes not drawn are meaningless.
+    #[target_feature(enable = "avx2")]
+    fn colors(&self, d: __m256, drawn: __m256) -> Option<__m256i> {
+        let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
+        let sign = _mm256_set1_ps(-0.0);
+        let t = |d: __m128| {
+            _mm256_cvtpd_ps(_mm256_add_pd(
+                _mm256_mul_pd(self.beta, _mm256_cvtps_pd(d)),
+                self.alpha,
+            ))
+        };
+        let t = _mm256_set_m128(
+            t(_mm256_extractf128_ps::<1>(d)),
+            t(_mm256_castps256_ps128(d)),
+        );
+        let a = _mm256_andnot_ps(sign, t);
+        let neg = _mm256_cmp_ps::<_CMP_LT_OQ>(t, zero);
+        let s = _mm256_min_ps(a, one);
+        let mut ok = _mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_GT_OQ>(a, self.delta),
+            _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_andnot_ps(sign, _mm256_sub_ps(a, one)), self.delta),
+        );
+        let half = _mm256_set1_ps(0.5);
+        let mut rgba = _mm256_set1_epi32(0xff00_0000_u32 as i32);
+        // `parallax_color`'s `end[k] − 255` for t < 0 and for t ≥ 0.
+        for (k, (negative, positive)) in [(-255.0f32, 0.0f32), (-191.0, -223.0), (0.0, -255.0)]
+            .into_iter()
+            .enumerate()
+        {
+            let e = _mm256_blendv_ps(_mm256_set1_ps(positive), _mm256_set1_ps(negative), neg);
+            let v = _mm256_add_ps(_mm256_set1_ps(255.0), _mm256_mul_ps(e, s));
+            let whole = _mm256_floor_ps(v);
+            let frac = _mm256_sub_ps(v, whole);
+            let off_half = _mm256_andnot_ps(sign, _mm256_sub_ps(frac, half));
+            ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(off_half, self.margin));
+            let up = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(frac, half), one);
+            let byte = _mm256_cvttps_epi32(_mm256_add_ps(whole, up));
+            let shift = _mm256_set1_epi32(8 * k as i32);
+            rgba = _mm256_or_si256(rgba, _mm256_sllv_epi32(byte, shift));
+        }
+        let uncertain = _mm256_andnot_ps(ok, drawn);
+        (_mm256_movemask_ps(uncertain) == 0).then_some(rgba)
+    }
+}
+
+/// The smallest f32 at or above `v` (v finite and positive).
+fn round_up_f32(v: f64) -> f32 {
+    let r = v as f32;
+    if (r as f64) < v { r.next_up() } else { r }
 }
 
 /// One row of the parallax image before the window marks: `out[k] =
@@ -119,6 +238,7 @@ pub(super) unsafe fn row(
     let background = _mm_set1_epi32(i32::from_le_bytes(PARALLAX_BACKGROUND));
     let alpha = _mm_set1_epi32(0xff00_0000_u32 as i32);
     let len = out.len().min(depth.len());
+    let affine = Affine::of(rig, scale);
     // Four pixels from their depths and `drawn` mask (lanes with d < 1 set).
     let four = |d32: __m128, drawn: __m128| {
         let d = _mm256_cvtps_pd(d32);
@@ -150,6 +270,10 @@ pub(super) unsafe fn row(
             let dst = out.as_mut_ptr().add(k);
             if _mm256_movemask_ps(drawn) == 0 {
                 _mm256_storeu_si256(dst.cast(), _mm256_set_m128i(background, background));
+            } else if let Some(rgba) = affine.as_ref().and_then(|a| a.colors(d8, drawn)) {
+                let bg = _mm256_set_m128i(background, background);
+                let px = _mm256_blendv_epi8(bg, rgba, _mm256_castps_si256(drawn));
+                _mm256_storeu_si256(dst.cast(), px);
             } else {
                 let lo = four(_mm256_castps256_ps128(d8), _mm256_castps256_ps128(drawn));
                 let hi = four(
@@ -231,6 +355,94 @@ mod tests {
             }
         }
         assert!(checked > 10_000, "{checked} pixels compared");
+    }
+
+    /// The affine fast path gives `parallax_pixel_color`'s bytes on every float of dense
+    /// intervals of window depth (each 2¹⁶ consecutive f32 values, so every color step inside
+    /// them is crossed, rounding boundaries included), for rigs near and far from their near
+    /// plane and scales that clamp much or nothing; and it is taken for nearly every vector of
+    /// an ordinary rig, and declined near color steps (both counted, so a path that never ran
+    /// cannot pass).
+    #[test]
+    fn affine_colors_match_parallax_color_on_dense_intervals() {
+        if !available() {
+            eprintln!("affine_colors_match_parallax_color_on_dense_intervals: NOT RUN: no AVX2");
+            return;
+        }
+        let (mut fast, mut declined) = (0usize, 0usize);
+        let mut ordinary_fast = (0usize, 0usize);
+        for (near, far, z0, balance, ordinary) in [
+            (1.0, 20.0, 4.0, 1.0, true),
+            (0.1, 50.0, 4.0, 1.0, false),
+            (1e-5, 1.0, 0.5, 0.5, false),
+            (0.5, 1e5, 2.0, 0.0, false),
+        ] {
+            let rig = ParallaxRig {
+                eye_separation: 0.065,
+                zero_parallax_distance: z0,
+                balance,
+                near,
+                far,
+                pixels_per_unit: 731.3,
+                width: 1024,
+                height: 768,
+            };
+            for scale in [0.5, 3.7, 40.0, 1e4] {
+                // SAFETY: AVX2 is available (checked above).
+                let Some(affine) = (unsafe { Affine::of(&rig, scale) }) else {
+                    continue;
+                };
+                for start in [0.0f32, 0.5, 0.9, 0.99, 0.999_9] {
+                    let mut d = [0f32; 8];
+                    let mut bits = start.to_bits();
+                    for _ in 0..(1 << 16) / 8 {
+                        for v in &mut d {
+                            *v = f32::from_bits(bits);
+                            bits += 1;
+                        }
+                        // SAFETY: AVX2 is available; `d` holds eight floats.
+                        let got = unsafe {
+                            let d8 = _mm256_loadu_ps(d.as_ptr());
+                            let drawn = _mm256_cmp_ps::<_CMP_LT_OQ>(d8, _mm256_set1_ps(1.0));
+                            affine.colors(d8, drawn).map(|v| {
+                                let mut out = [[0u8; 4]; 8];
+                                _mm256_storeu_si256(out.as_mut_ptr().cast(), v);
+                                out
+                            })
+                        };
+                        if ordinary && scale == 40.0 {
+                            ordinary_fast.1 += 1;
+                        }
+                        let Some(got) = got else {
+                            declined += 1;
+                            continue;
+                        };
+                        fast += 1;
+                        if ordinary && scale == 40.0 {
+                            ordinary_fast.0 += 1;
+                        }
+                        for (g, v) in got.iter().zip(&d) {
+                            if *v < 1.0 {
+                                assert_eq!(
+                                    *g,
+                                    parallax_pixel_color(&rig, *v, scale),
+                                    "near {near} far {far} z0 {z0} scale {scale}: depth {v}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            fast > 10_000 && declined > 100,
+            "{fast} fast, {declined} declined"
+        );
+        let (taken, all) = ordinary_fast;
+        assert!(
+            taken * 10 >= all * 9,
+            "ordinary rig: {taken} of {all} vectors fast"
+        );
     }
 
     /// The AVX2 extremes are the scalar fold's on depths with and without drawn values, −0,
