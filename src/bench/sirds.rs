@@ -7,11 +7,11 @@ use super::{Row, median_ms};
 use crate::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
 use crate::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
 use crate::effects::sirds::{
-    Algorithm, DepthRange, Filter, Pattern, PerVertexOptions, Start, depth_range,
+    Algorithm, DepthRange, Disparity, Filter, Pattern, PerVertexOptions, Start, depth_range,
 };
 use crate::error::Result;
 use crate::fixtures::{TABLE_1, scene_from_text, sphere_over_ramp, table_scene};
-use crate::math::StereoRig;
+use crate::math::{EyeMatrices, StereoRig};
 use crate::output::sirds::{from_frame, scene_depth};
 use crate::plan::{Output, Plan, Shading};
 use crate::render::sirds_strips::{StripGeometry, per_vertex};
@@ -29,42 +29,99 @@ use crate::scene::Scene;
 ///   textured passes. Here the depth range is found once before timing and the frame is the
 ///   strip geometry (the vertex program) and the strips. Its image is checked against the
 ///   full frame's, byte for byte (the same range, so the same bytes).
+///
+/// The rows are timed in turns, blocks of 20 frames each, every row once per round, until each
+/// has at least 300 frames: a slow spell of this shared VM (they last seconds and move a frame's
+/// time by up to 40%) then falls on every row alike instead of on whichever was being timed.
 fn table_1(iters: usize) -> Result<Vec<Row>> {
-    let mut rows = Vec::new();
     // Row 1 once more with the scalar loops: what the AVX2 loops bring (same bytes).
     let scalar_row = TABLE_1[0];
-    let runs = TABLE_1
+    let runs: Vec<_> = TABLE_1
         .into_iter()
         .map(|r| (r, true))
-        .chain(std::iter::once((scalar_row, false)));
-    let mut fixed_rows = Vec::new();
-    for ((w, h, tris, k, paper_hz), simd) in runs {
+        .chain(std::iter::once((scalar_row, false)))
+        .collect();
+    let mut scenes = Vec::new();
+    for &((w, h, tris, k, _), simd) in &runs {
         let mut s = table_scene(w, h, tris, k)?;
         s.set_simd(simd);
         let center = StereoRig::center(&s.camera, s.aspect())?;
         let d = s.sirds.geometry.to_pixels()?;
-        let strips = |range: &DepthRange| -> Result<Vec<[u8; 4]>> {
-            let g = StripGeometry::new(&s, &center, range, &d, false);
-            Ok(per_vertex(&g, w, h, &d, &s.sirds.pattern, &s.sirds.per_vertex, false)?.pixels)
-        };
-        let range_of = || -> Result<DepthRange> {
-            let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
-            depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)
-        };
-        let frame = || strips(&range_of()?);
-        // At least 300 frames: a frame is ~1 ms, and 15 of them (15 ms) are shorter than a
-        // stall of this shared VM, which then moved the median by up to 35%.
-        let frames = iters.max(300);
-        let full = frame()?;
-        let ms = median_ms(frames, || frame().is_ok());
-        let loops = if !simd {
+        scenes.push((s, center, d));
+    }
+    let strips = |(s, center, d): &(Scene, EyeMatrices, Disparity), range: &DepthRange| {
+        let g = StripGeometry::new(s, center, range, d, false);
+        let (w, h) = (s.width, s.height);
+        Ok::<_, crate::Error>(
+            per_vertex(&g, w, h, d, &s.sirds.pattern, &s.sirds.per_vertex, false)?.pixels,
+        )
+    };
+    let range_of = |(s, center, _): &(Scene, EyeMatrices, Disparity)| {
+        let (fb, _) = render_view(s, center, Shading::DepthOnly)?;
+        depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)
+    };
+    // What is timed: each run's full frame, then each AVX2 run's strips with the range fixed
+    // (the range found once, and the image checked against the full frame's).
+    let mut timed: Vec<(usize, Option<DepthRange>)> = (0..runs.len()).map(|i| (i, None)).collect();
+    for (i, &(_, simd)) in runs.iter().enumerate() {
+        let full = strips(&scenes[i], &range_of(&scenes[i])?)?;
+        if simd {
+            let range = range_of(&scenes[i])?;
+            if strips(&scenes[i], &range)? != full {
+                return Err(crate::Error::internal(
+                    "bench",
+                    "Table 1: the strips with the range fixed differ from the full frame's",
+                ));
+            }
+            timed.push((i, Some(range)));
+        }
+    }
+    const BLOCK: usize = 20;
+    let rounds = iters.max(300).div_ceil(BLOCK);
+    let mut ms = vec![Vec::with_capacity(rounds * BLOCK); timed.len()];
+    let mut failed = None;
+    for _ in 0..rounds {
+        for ((i, range), times) in timed.iter().zip(&mut ms) {
+            for _ in 0..BLOCK {
+                let t = std::time::Instant::now();
+                let frame = match range {
+                    Some(r) => strips(&scenes[*i], r),
+                    None => range_of(&scenes[*i]).and_then(|r| strips(&scenes[*i], &r)),
+                };
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+                if let Err(e) = std::hint::black_box(frame) {
+                    failed = Some(e);
+                }
+            }
+        }
+    }
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let loops = |simd: bool| {
+        if !simd {
             ", scalar loops"
         } else if crate::raster::avx2_available() {
             ", AVX2 loops"
         } else {
             ", scalar loops (no AVX2 here)"
-        };
-        let row = |setting: String, ms: f64, what: &str| {
+        }
+    };
+    Ok(timed
+        .iter()
+        .zip(&mut ms)
+        .map(|(&(i, ref range), times)| {
+            times.sort_by(f64::total_cmp);
+            let ms = times[times.len() / 2];
+            let ((w, h, tris, k, paper_hz), simd) = runs[i];
+            let (setting, what) = if range.is_some() {
+                (
+                    format!("{w}x{h} {tris} tris k={k}, range fixed"),
+                    "strips only (the paper's frame: no depth pass)",
+                )
+            } else {
+                (format!("{w}x{h} {tris} tris k={k}"), "depth pass + strips")
+            };
             let hz = 1e3 / ms;
             Row {
                 area: "sirds".into(),
@@ -74,34 +131,13 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
                 error_unit: String::new(),
                 ms,
                 note: format!(
-                    "{hz:.0} Hz vs paper {paper_hz} Hz (GeForce4): {:.1}x, {what}{loops}",
-                    hz / paper_hz
+                    "{hz:.0} Hz vs paper {paper_hz} Hz (GeForce4): {:.1}x, {what}{}",
+                    hz / paper_hz,
+                    loops(simd)
                 ),
             }
-        };
-        rows.push(row(
-            format!("{w}x{h} {tris} tris k={k}"),
-            ms,
-            "depth pass + strips",
-        ));
-        if simd {
-            let range = range_of()?;
-            if strips(&range)? != full {
-                return Err(crate::Error::internal(
-                    "bench",
-                    "Table 1: the strips with the range fixed differ from the full frame's",
-                ));
-            }
-            let ms = median_ms(frames, || strips(&range).is_ok());
-            fixed_rows.push(row(
-                format!("{w}x{h} {tris} tris k={k}, range fixed"),
-                ms,
-                "strips only (the paper's frame: no depth pass)",
-            ));
-        }
-    }
-    rows.extend(fixed_rows);
-    Ok(rows)
+        })
+        .collect())
 }
 
 /// The Fig. 5 ramp: a 20×20 plane (16×16 quads) turned 35° about y, 512×256, black-white

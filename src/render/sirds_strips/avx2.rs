@@ -177,8 +177,9 @@ pub(super) unsafe fn resolve_row(
         if _mm256_movemask_ps(_mm256_castsi256_ps(has)) == 0 {
             // No lane has a source (the columns left of the nearest separation): the pattern,
             // as `resolve_pixel` answers for a NaN source.
-            for x in x0 + k..x0 + (k + 8).min(n) {
-                row[x] = pattern(x);
+            let (first, end) = (x0 + k, x0 + (k + 8).min(n));
+            for (x, px) in (first..end).zip(&mut row[first..end]) {
+                *px = pattern(x);
             }
             k += 8;
             continue;
