@@ -246,10 +246,9 @@ pub fn remap_color_with(
     let bad = AtomicBool::new(false);
     let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
         let depth = &this.depth[y * wu..y * wu + out.len()];
-        if !depth_row_in_unit(depth) {
+        if !rows.run(other, y as u32, depth, out) {
             bad.store(true, Ordering::Relaxed);
         }
-        rows.run(other, y as u32, depth, out);
     };
     // SAFETY: `RowProgram::run` writes one pixel per depth value of the row, and the depth row
     // is as long as the output row (`check_depth_len`: width × height values).
@@ -308,27 +307,34 @@ impl<'a> RowProgram<'a> {
     }
 
     /// Row `y` of [`remap_color`]: `out[x] = remap_color_pixel(r, other, x, y, depth[x])` for
-    /// every `x < min(out.len(), depth.len())`.
-    fn run(&self, other: &Framebuffer, y: u32, depth: &[f32], out: &mut [MaybeUninit<[u8; 4]>]) {
+    /// every `x < min(out.len(), depth.len())`. Returns whether every depth of the row lies in
+    /// [0, 1] (`check_depth`'s test; the AVX2 rows make it on the vectors they load anyway).
+    fn run(
+        &self,
+        other: &Framebuffer,
+        y: u32,
+        depth: &[f32],
+        out: &mut [MaybeUninit<[u8; 4]>],
+    ) -> bool {
         #[cfg(target_arch = "x86_64")]
         if self.simd {
             let r = self.remapper;
             // SAFETY: `simd` is set only where `avx2::available` found AVX2, the rows' only
             // safety condition. The same bytes as the loop below
             // (`avx2_rows_match_remap_color_pixel`).
-            unsafe {
+            return unsafe {
                 match r.precision {
                     Precision::F64 => avx2::row_f64(r, &self.ndc_x64, y, depth, other, out),
                     Precision::F32 | Precision::F32Composed => {
-                        avx2::row_f32(r, &self.ndc_x32, y, depth, other, out);
+                        avx2::row_f32(r, &self.ndc_x32, y, depth, other, out)
                     }
                 }
-            }
-            return;
+            };
         }
         for (x, (out, d)) in out.iter_mut().zip(depth).enumerate() {
             out.write(remap_color_pixel(self.remapper, other, x as u32, y, *d));
         }
+        depth_row_in_unit(&depth[..out.len().min(depth.len())])
     }
 }
 
