@@ -12,7 +12,7 @@ use image::RgbaImage;
 use rayon::prelude::*;
 
 use super::eye_input::{check_depth, check_depth_len, depth_row_in_unit};
-use super::legend::{draw_legend, draw_legend_reference};
+use super::legend::{LEGEND_HEIGHT, draw_legend, draw_legend_reference};
 use super::par_fill_rows;
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
@@ -414,7 +414,6 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
     if !in_unit {
         check_depth("parallax", fb)?;
     }
-    let legend = draw_legend(fb.width, scale, &|p| parallax_color(p, scale))?;
     let (w, n) = (fb.width as usize, fb.depth.len());
     #[cfg(target_arch = "x86_64")]
     let simd = simd && avx2::available();
@@ -436,9 +435,16 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
             out.write(parallax_pixel_color(rig, *d, scale));
         }
     };
-    // SAFETY: both row programs write one pixel per depth value, and the depth row is as long
-    // as the output row (`check_depth`: width × height values).
-    let mut bytes = unsafe { par_fill_rows(n, w, legend.data().len(), fill) };
+    // The legend is drawn while the rows are colored (it needs only the width and the scale):
+    // one thread would otherwise draw it while the other waited.
+    let legend_bytes = w * LEGEND_HEIGHT as usize * 4;
+    let (legend, mut bytes) = rayon::join(
+        || draw_legend(fb.width, scale, &|p| parallax_color(p, scale)),
+        // SAFETY: both row programs write one pixel per depth value, and the depth row is as
+        // long as the output row (`check_depth_len`: width × height values).
+        || unsafe { par_fill_rows(n, w, legend_bytes, fill) },
+    );
+    let legend = legend?;
     let negative = |x: usize, y: usize| {
         rig.parallax_pixels(fb.depth[y * w + x])
             .is_some_and(|p| p < 0.0)

@@ -180,23 +180,30 @@ impl Affine {
             _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_andnot_ps(sign, _mm256_sub_ps(a, one)), self.delta),
         );
         let half = _mm256_set1_ps(0.5);
-        let mut rgba = _mm256_set1_epi32(0xff00_0000_u32 as i32);
-        // `parallax_color`'s `end[k] − 255` for t < 0 and for t ≥ 0.
-        for (k, (negative, positive)) in [(-255.0f32, 0.0f32), (-191.0, -223.0), (0.0, -255.0)]
-            .into_iter()
-            .enumerate()
-        {
+        // One channel: `round(255 + e·s)` with `e` = `parallax_color`'s `end[k] − 255` for t < 0
+        // (`negative`) and t ≥ 0 (`positive`), and whether it is farther than the margin from
+        // a half-integer. Called three times with constants (unrolled, the constants folded).
+        let channel = |negative: f32, positive: f32| {
             let e = _mm256_blendv_ps(_mm256_set1_ps(positive), _mm256_set1_ps(negative), neg);
             let v = _mm256_add_ps(_mm256_set1_ps(255.0), _mm256_mul_ps(e, s));
             let whole = _mm256_floor_ps(v);
             let frac = _mm256_sub_ps(v, whole);
             let off_half = _mm256_andnot_ps(sign, _mm256_sub_ps(frac, half));
-            ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(off_half, self.margin));
+            let sure = _mm256_cmp_ps::<_CMP_GT_OQ>(off_half, self.margin);
             let up = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(frac, half), one);
-            let byte = _mm256_cvttps_epi32(_mm256_add_ps(whole, up));
-            let shift = _mm256_set1_epi32(8 * k as i32);
-            rgba = _mm256_or_si256(rgba, _mm256_sllv_epi32(byte, shift));
-        }
+            (_mm256_cvttps_epi32(_mm256_add_ps(whole, up)), sure)
+        };
+        let (r, r_sure) = channel(-255.0, 0.0);
+        let (g, g_sure) = channel(-191.0, -223.0);
+        let (b, b_sure) = channel(0.0, -255.0);
+        ok = _mm256_and_ps(ok, _mm256_and_ps(r_sure, _mm256_and_ps(g_sure, b_sure)));
+        let rgba = _mm256_or_si256(
+            _mm256_or_si256(r, _mm256_slli_epi32::<8>(g)),
+            _mm256_or_si256(
+                _mm256_slli_epi32::<16>(b),
+                _mm256_set1_epi32(0xff00_0000_u32 as i32),
+            ),
+        );
         let uncertain = _mm256_andnot_ps(ok, drawn);
         (_mm256_movemask_ps(uncertain) == 0).then_some(rgba)
     }
