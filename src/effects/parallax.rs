@@ -492,7 +492,16 @@ pub fn parallax_image_reference(fb: &Framebuffer, rig: &ParallaxRig) -> Result<R
 mod tests {
     use super::*;
 
-    fn rig(near: f64, far: f64, z0: f64, balance: f64, width: u32, height: u32) -> ParallaxRig {
+    /// A rig with the eye separation 0.065 and the given planes and size (also the AVX2 rows'
+    /// tests').
+    pub(super) fn rig(
+        near: f64,
+        far: f64,
+        z0: f64,
+        balance: f64,
+        width: u32,
+        height: u32,
+    ) -> ParallaxRig {
         ParallaxRig {
             eye_separation: 0.065,
             zero_parallax_distance: z0,

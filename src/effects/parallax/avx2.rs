@@ -326,16 +326,7 @@ mod tests {
             (0.5, 1e5, 2.0, 1.0),
         ] {
             for scale in [0.5, 3.7, 40.0, 1e4] {
-                let rig = ParallaxRig {
-                    eye_separation: 0.065,
-                    zero_parallax_distance: z0,
-                    balance,
-                    near,
-                    far,
-                    pixels_per_unit: 731.3,
-                    width: 1024,
-                    height: 768,
-                };
+                let rig = super::super::tests::rig(near, far, z0, balance, 1024, 768);
                 for len in [0usize, 1, 3, 4, 5, 7, 8, 9, 31, 1000] {
                     let depth: Vec<f32> = (0..len)
                         .map(|_| match next() % 8 {
@@ -384,16 +375,7 @@ mod tests {
             (1e-5, 1.0, 0.5, 0.5, false),
             (0.5, 1e5, 2.0, 0.0, false),
         ] {
-            let rig = ParallaxRig {
-                eye_separation: 0.065,
-                zero_parallax_distance: z0,
-                balance,
-                near,
-                far,
-                pixels_per_unit: 731.3,
-                width: 1024,
-                height: 768,
-            };
+            let rig = super::super::tests::rig(near, far, z0, balance, 1024, 768);
             for scale in [0.5, 3.7, 40.0, 1e4] {
                 // SAFETY: AVX2 is available (checked above).
                 let Some(affine) = (unsafe { Affine::of(&rig, scale) }) else {
