@@ -2,7 +2,7 @@
 //! the same run: the stereo pair, pair + anaglyph, each WGSL finalize pass beside its CPU
 //! function on identical eye framebuffers, and the SIRDS strips of the paper's Table 1 row 1.
 
-use super::{Row, median_ms};
+use super::{Row, interleaved_medians, median_ms};
 use crate::compare::{compare, framebuffer_from_image};
 use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
 use crate::effects::occlusion::occlusion_image;
@@ -174,36 +174,6 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// Medians of `iters` runs of each of `fs` (after one warm-up run of each), the runs taken
-/// round-robin so that a slow spell of the shared machine falls on every row alike and the
-/// ratios between them stay fair.
-///
-/// # Errors
-/// The first error of any run.
-fn interleaved_medians(
-    iters: usize,
-    fs: &mut [&mut dyn FnMut() -> Result<()>],
-) -> Result<Vec<f64>> {
-    for f in fs.iter_mut() {
-        f()?;
-    }
-    let mut times = vec![Vec::with_capacity(iters); fs.len()];
-    for _ in 0..iters.max(1) {
-        for (f, t) in fs.iter_mut().zip(&mut times) {
-            let start = std::time::Instant::now();
-            f()?;
-            t.push(start.elapsed().as_secs_f64() * 1e3);
-        }
-    }
-    Ok(times
-        .into_iter()
-        .map(|mut v| {
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        })
-        .collect())
-}
-
 /// The stereo pair + Dubois anaglyph frame (issue 19, goal 2), timed round-robin in one run:
 /// - the CPU path (passes + `anaglyph`);
 /// - the GPU path through the host, as `render --backend gpu` makes it: passes, readback of
@@ -253,6 +223,7 @@ fn pair_and_anaglyph(
     let resident_diff = compare(&cpu, &fb(&resident))?.max_channel_diff;
     let ms = interleaved_medians(
         iters,
+        1,
         &mut [
             &mut || cpu_frame().map(drop),
             &mut || host_frame().map(drop),

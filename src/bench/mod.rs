@@ -102,6 +102,39 @@ pub(crate) fn median_ms<T>(iters: usize, mut f: impl FnMut() -> T) -> f64 {
     v[v.len() / 2]
 }
 
+/// Medians of `rounds · block` runs of each of `fs` (after one warm-up run of each), taken in
+/// turns, `block` runs of one before the next: a slow spell of the shared machine then falls on
+/// every row alike and the ratios between them stay fair.
+///
+/// # Errors
+/// The first error of any run.
+pub(crate) fn interleaved_medians(
+    rounds: usize,
+    block: usize,
+    fs: &mut [&mut dyn FnMut() -> Result<()>],
+) -> Result<Vec<f64>> {
+    for f in fs.iter_mut() {
+        f()?;
+    }
+    let mut times = vec![Vec::with_capacity(rounds * block); fs.len()];
+    for _ in 0..rounds.max(1) {
+        for (f, t) in fs.iter_mut().zip(&mut times) {
+            for _ in 0..block.max(1) {
+                let start = Instant::now();
+                f()?;
+                t.push(start.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    Ok(times
+        .into_iter()
+        .map(|mut v| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        })
+        .collect())
+}
+
 /// Runs every benchmark group `opts.only` asks for (all when empty).
 ///
 /// # Errors

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{Row, median_ms};
+use super::{Row, interleaved_medians, median_ms};
 use crate::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
 use crate::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
 use crate::effects::sirds::{
@@ -27,12 +27,13 @@ use crate::scene::Scene;
 ///   vertex's eye-space z to a disparity with constants (§4, Fig. 4: `c[2] = (0.5a, f, 0, 0)`),
 ///   so the paper renders no depth pass: its frame is the random initialization and the k
 ///   textured passes. Here the depth range is found once before timing and the frame is the
-///   strip geometry (the vertex program) and the strips. Its image is checked against the
-///   full frame's, byte for byte (the same range, so the same bytes).
+///   strip geometry (the vertex program) and the strips: the second half of the full frame,
+///   so the same image.
 ///
-/// The rows are timed in turns, blocks of 20 frames each, every row once per round, until each
-/// has at least 300 frames: a slow spell of this shared VM (they last seconds and move a frame's
-/// time by up to 40%) then falls on every row alike instead of on whichever was being timed.
+/// The rows are timed in turns ([`interleaved_medians`]), blocks of 20 frames, every row once
+/// per round, until each has at least 300 frames: a slow spell of this shared VM (they last
+/// seconds and move a frame's time by up to 40%) then falls on every row alike instead of on
+/// whichever was being timed.
 fn table_1(iters: usize) -> Result<Vec<Row>> {
     // Row 1 once more with the scalar loops: what the AVX2 loops bring (same bytes).
     let scalar_row = TABLE_1[0];
@@ -51,53 +52,34 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     }
     let strips = |(s, center, d): &(Scene, EyeMatrices, Disparity), range: &DepthRange| {
         let g = StripGeometry::new(s, center, range, d, false);
-        let (w, h) = (s.width, s.height);
-        Ok::<_, crate::Error>(
-            per_vertex(&g, w, h, d, &s.sirds.pattern, &s.sirds.per_vertex, false)?.pixels,
-        )
+        let (p, opts) = (&s.sirds.pattern, &s.sirds.per_vertex);
+        per_vertex(&g, s.width, s.height, d, p, opts, false).map(drop)
     };
     let range_of = |(s, center, _): &(Scene, EyeMatrices, Disparity)| {
         let (fb, _) = render_view(s, center, Shading::DepthOnly)?;
         depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)
     };
-    // What is timed: each run's full frame, then each AVX2 run's strips with the range fixed
-    // (the range found once, and the image checked against the full frame's).
+    // What is timed: each run's full frame, then each AVX2 run's strips with the range fixed.
     let mut timed: Vec<(usize, Option<DepthRange>)> = (0..runs.len()).map(|i| (i, None)).collect();
     for (i, &(_, simd)) in runs.iter().enumerate() {
-        let full = strips(&scenes[i], &range_of(&scenes[i])?)?;
         if simd {
-            let range = range_of(&scenes[i])?;
-            if strips(&scenes[i], &range)? != full {
-                return Err(crate::Error::internal(
-                    "bench",
-                    "Table 1: the strips with the range fixed differ from the full frame's",
-                ));
-            }
-            timed.push((i, Some(range)));
+            timed.push((i, Some(range_of(&scenes[i])?)));
         }
     }
+    let mut frames: Vec<Box<dyn FnMut() -> Result<()> + '_>> = timed
+        .iter()
+        .map(|&(i, range)| -> Box<dyn FnMut() -> Result<()> + '_> {
+            let scene = &scenes[i];
+            match range {
+                Some(r) => Box::new(move || strips(scene, &r)),
+                None => Box::new(move || strips(scene, &range_of(scene)?)),
+            }
+        })
+        .collect();
+    let mut fs: Vec<&mut dyn FnMut() -> Result<()>> =
+        frames.iter_mut().map(|f| &mut **f as _).collect();
     const BLOCK: usize = 20;
-    let rounds = iters.max(300).div_ceil(BLOCK);
-    let mut ms = vec![Vec::with_capacity(rounds * BLOCK); timed.len()];
-    let mut failed = None;
-    for _ in 0..rounds {
-        for ((i, range), times) in timed.iter().zip(&mut ms) {
-            for _ in 0..BLOCK {
-                let t = std::time::Instant::now();
-                let frame = match range {
-                    Some(r) => strips(&scenes[*i], r),
-                    None => range_of(&scenes[*i]).and_then(|r| strips(&scenes[*i], &r)),
-                };
-                times.push(t.elapsed().as_secs_f64() * 1e3);
-                if let Err(e) = std::hint::black_box(frame) {
-                    failed = Some(e);
-                }
-            }
-        }
-    }
-    if let Some(e) = failed {
-        return Err(e);
-    }
+    let ms = interleaved_medians(iters.max(300).div_ceil(BLOCK), BLOCK, &mut fs)?;
     let loops = |simd: bool| {
         if !simd {
             ", scalar loops"
@@ -109,10 +91,8 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     };
     Ok(timed
         .iter()
-        .zip(&mut ms)
-        .map(|(&(i, ref range), times)| {
-            times.sort_by(f64::total_cmp);
-            let ms = times[times.len() / 2];
+        .zip(ms)
+        .map(|(&(i, range), ms)| {
             let ((w, h, tris, k, paper_hz), simd) = runs[i];
             let (setting, what) = if range.is_some() {
                 (
