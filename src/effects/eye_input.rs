@@ -40,13 +40,18 @@ pub(crate) fn check_same_size(left: &Framebuffer, right: &Framebuffer) -> Result
 pub(crate) fn check_depth(name: &str, fb: &Framebuffer) -> Result<()> {
     check_depth_len(name, fb)?;
     if let Some(i) = first_outside_unit(&fb.depth) {
-        return Err(outside_unit(name, fb, i));
+        let (x, y) = (i % fb.width as usize, i / fb.width as usize);
+        return Err(Error::invalid(
+            format!("{name} eye depth at pixel ({x}, {y})"),
+            fb.depth[i],
+            "window depth must be a number in [0, 1] (NaN or out of range found)",
+        ));
     }
     Ok(())
 }
 
 /// The length part of [`check_depth`]: a depth buffer of `fb`'s size, values not read. A mode
-/// that reads every depth value anyway tests them in its own pass ([`depth_row_in_unit`], a row
+/// that reads every depth value anyway tests them in its own pass ([`all_in_unit`], a row
 /// at a time while it is in cache) and calls [`check_depth`] for the error when one fails: the
 /// same error as checking first, one pass over the buffer fewer.
 ///
@@ -65,22 +70,6 @@ pub(crate) fn check_depth_len(name: &str, fb: &Framebuffer) -> Result<()> {
         ));
     }
     Ok(())
-}
-
-/// The error of [`check_depth`] for the bad value at index `i`.
-fn outside_unit(name: &str, fb: &Framebuffer, i: usize) -> Error {
-    let (x, y) = (i % fb.width as usize, i / fb.width as usize);
-    Error::invalid(
-        format!("{name} eye depth at pixel ({x}, {y})"),
-        fb.depth[i],
-        "window depth must be a number in [0, 1] (NaN or out of range found)",
-    )
-}
-
-/// Whether every value of a row of depths lies in [0, 1] (no NaN): [`check_depth`]'s test, for
-/// a mode that tests each row as it reads it (see [`check_depth_len`]).
-pub(crate) fn depth_row_in_unit(row: &[f32]) -> bool {
-    all_in_unit(row)
 }
 
 /// The index of the first value of `depth` outside [0, 1] (NaN included), if any.
@@ -104,8 +93,9 @@ fn first_outside_unit(depth: &[f32]) -> Option<usize> {
 }
 
 /// Whether every value of `c` lies in [0, 1] (NaN does not), with no early exit, compiled for
-/// AVX2 where the CPU has it, so the loop vectorizes eight wide.
-fn all_in_unit(c: &[f32]) -> bool {
+/// AVX2 where the CPU has it, so the loop vectorizes eight wide: [`check_depth`]'s test, also
+/// for a mode that tests each row as it reads it (see [`check_depth_len`]).
+pub(crate) fn all_in_unit(c: &[f32]) -> bool {
     #[inline(always)]
     fn body(c: &[f32]) -> bool {
         // An integer OR reduction: LLVM vectorizes it (a fold of `bool`s it does not).

@@ -11,7 +11,7 @@ use std::mem::MaybeUninit;
 use image::RgbaImage;
 use rayon::prelude::*;
 
-use super::eye_input::{check_depth, check_depth_len, depth_row_in_unit};
+use super::eye_input::{all_in_unit, check_depth, check_depth_len};
 use super::legend::{LEGEND_HEIGHT, draw_legend, draw_legend_reference};
 use super::par_fill_rows;
 use crate::error::{Error, Result};
@@ -126,7 +126,7 @@ impl ParallaxRig {
             ]
             .iter()
             .all(|v| v.is_finite());
-        let extremes = if monotone {
+        let (extremes, in_unit) = if monotone {
             // The drawn depths' extremes, per block in parallel (min and max are exact, so the
             // result does not depend on the split).
             let (lo, hi, in_unit) = depth.par_chunks(1 << 14).map(drawn_extremes).reduce(
@@ -147,9 +147,8 @@ impl ParallaxRig {
                         let (lo, hi) = e.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
                         Some((lo.min(p), hi.max(p)))
                     });
-            (extremes, depth_row_in_unit(depth))
+            (extremes, all_in_unit(depth))
         };
-        let (extremes, in_unit) = extremes;
         let scale = extremes.map_or(0.5, |(lo, hi)| lo.abs().max(hi.abs()).max(0.5));
         (scale, in_unit)
     }
@@ -419,6 +418,12 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
     let simd = simd && avx2::available();
     #[cfg(not(target_arch = "x86_64"))]
     let simd = simd && false;
+    // The AVX2 rows' affine form of the color scale, once per image.
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: only where `simd` says the CPU has AVX2, `Affine::of`'s only requirement.
+    let affine = simd
+        .then(|| unsafe { avx2::Affine::of(rig, scale) })
+        .flatten();
     // Rows in parallel: every pixel is independent, so the bytes do not depend on the threads.
     let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
         let depth = &fb.depth[y * w..y * w + out.len()];
@@ -427,7 +432,7 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
             // SAFETY: `simd` holds only where `avx2::available` found AVX2, the row's only
             // safety condition. The same bytes as the loop below
             // (`avx2_rows_match_parallax_color`).
-            unsafe { avx2::row(rig, scale, depth, out) };
+            unsafe { avx2::row(rig, scale, affine.as_ref(), depth, out) };
             return;
         }
         let _ = simd;

@@ -22,7 +22,7 @@ use glam::{DMat4, DVec4, Mat4, Vec4};
 use image::RgbaImage;
 use rayon::prelude::*;
 
-use super::eye_input::{check_depth, check_depth_len, check_same_size, depth_row_in_unit};
+use super::eye_input::{all_in_unit, check_depth, check_depth_len, check_same_size};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 
@@ -334,7 +334,7 @@ impl<'a> RowProgram<'a> {
         for (x, (out, d)) in out.iter_mut().zip(depth).enumerate() {
             out.write(remap_color_pixel(self.remapper, other, x as u32, y, *d));
         }
-        depth_row_in_unit(&depth[..out.len().min(depth.len())])
+        all_in_unit(&depth[..out.len().min(depth.len())])
     }
 }
 

@@ -379,8 +379,8 @@ mod tests {
         (positions, triangles)
     }
 
-    /// The AVX2 depth-only bands (one or two vectors per row for small triangles, spans for the rest,
-    /// unmasked loads and stores where eight fit) write the scalar `traverse`'s depth bits and
+    /// The AVX2 depth-only bands (one or two vectors per row for small triangles, spans for the
+    /// rest, unmasked loads and stores where eight fit) write the scalar `traverse`'s depth bits and
     /// count the same fragments: grids from 2 to 10,000 triangles, seen straight on and at a
     /// slant (partly clipped), on sizes that end mid-vector.
     #[test]

@@ -124,7 +124,7 @@ pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
 ///
 /// A vector with a lane that fails any test is colored by the division chain, exactly as
 /// before.
-struct Affine {
+pub(super) struct Affine {
     alpha: __m256d,
     beta: __m256d,
     delta: __m256,
@@ -137,7 +137,7 @@ impl Affine {
     /// tests would decline more than about one vector in eight, each then computed twice: the
     /// division chain alone is then the faster program).
     #[target_feature(enable = "avx2")]
-    fn of(rig: &ParallaxRig, scale: f64) -> Option<Affine> {
+    pub(super) fn of(rig: &ParallaxRig, scale: f64) -> Option<Affine> {
         let (n, f, z0, b) = (rig.near, rig.far, rig.zero_parallax_distance, rig.balance);
         let c = rig.eye_separation * rig.pixels_per_unit / scale;
         let slope = z0 * (f - n) / (n * f);
@@ -218,6 +218,8 @@ fn round_up_f32(v: f64) -> f32 {
 
 /// One row of the parallax image before the window marks: `out[k] =
 /// parallax_pixel_color(rig, depth[k], scale)` (the last pixels through the scalar function).
+/// `affine` is [`Affine::of`]`(rig, scale)`, made once per image; with `None` every drawn
+/// vector goes through the division chain.
 ///
 /// # Safety
 /// The CPU must support AVX2 ([`available`]).
@@ -225,6 +227,7 @@ fn round_up_f32(v: f64) -> f32 {
 pub(super) unsafe fn row(
     rig: &ParallaxRig,
     scale: f64,
+    affine: Option<&Affine>,
     depth: &[f32],
     out: &mut [MaybeUninit<[u8; 4]>],
 ) {
@@ -244,9 +247,9 @@ pub(super) unsafe fn row(
     let negative_end = [0.0f64, 64.0, 255.0].map(|e| _mm256_set1_pd(e - 255.0));
     let positive_end = [255.0f64, 32.0, 0.0].map(|e| _mm256_set1_pd(e - 255.0));
     let background = _mm_set1_epi32(i32::from_le_bytes(PARALLAX_BACKGROUND));
+    let background8 = _mm256_set_m128i(background, background);
     let alpha = _mm_set1_epi32(0xff00_0000_u32 as i32);
     let len = out.len().min(depth.len());
-    let affine = Affine::of(rig, scale);
     // Four pixels from their depths and `drawn` mask (lanes with d < 1 set).
     let four = |d32: __m128, drawn: __m128| {
         let d = _mm256_cvtps_pd(d32);
@@ -277,10 +280,9 @@ pub(super) unsafe fn row(
             let drawn = _mm256_cmp_ps::<_CMP_LT_OQ>(d8, _mm256_set1_ps(1.0));
             let dst = out.as_mut_ptr().add(k);
             if _mm256_movemask_ps(drawn) == 0 {
-                _mm256_storeu_si256(dst.cast(), _mm256_set_m128i(background, background));
-            } else if let Some(rgba) = affine.as_ref().and_then(|a| a.colors(d8, drawn)) {
-                let bg = _mm256_set_m128i(background, background);
-                let px = _mm256_blendv_epi8(bg, rgba, _mm256_castps_si256(drawn));
+                _mm256_storeu_si256(dst.cast(), background8);
+            } else if let Some(rgba) = affine.and_then(|a| a.colors(d8, drawn)) {
+                let px = _mm256_blendv_epi8(background8, rgba, _mm256_castps_si256(drawn));
                 _mm256_storeu_si256(dst.cast(), px);
             } else {
                 let lo = four(_mm256_castps256_ps128(d8), _mm256_castps256_ps128(drawn));
@@ -337,18 +339,23 @@ mod tests {
                             _ => (next() % 1_000_001) as f32 / 1e6,
                         })
                         .collect();
-                    let mut fast = vec![MaybeUninit::new([1u8; 4]); len];
                     // SAFETY: AVX2 is available (checked above).
-                    unsafe { row(&rig, scale, &depth, &mut fast) };
-                    for (k, (f, d)) in fast.iter().zip(&depth).enumerate() {
-                        // SAFETY: initialized by `MaybeUninit::new`, then the row.
-                        let f = unsafe { f.assume_init() };
-                        assert_eq!(
-                            f,
-                            parallax_pixel_color(&rig, *d, scale),
-                            "near {near} far {far} z0 {z0} scale {scale}: pixel {k}, depth {d}"
-                        );
-                        checked += 1;
+                    let affine = unsafe { Affine::of(&rig, scale) };
+                    // The division chain alone, and with the affine form where the rig has one.
+                    for affine in [None, affine.as_ref()] {
+                        let mut fast = vec![MaybeUninit::new([1u8; 4]); len];
+                        // SAFETY: AVX2 is available (checked above).
+                        unsafe { row(&rig, scale, affine, &depth, &mut fast) };
+                        for (k, (f, d)) in fast.iter().zip(&depth).enumerate() {
+                            // SAFETY: initialized by `MaybeUninit::new`, then the row.
+                            let f = unsafe { f.assume_init() };
+                            assert_eq!(
+                                f,
+                                parallax_pixel_color(&rig, *d, scale),
+                                "near {near} far {far} z0 {z0} scale {scale}: pixel {k}, depth {d}"
+                            );
+                            checked += 1;
+                        }
                     }
                 }
             }
@@ -400,17 +407,14 @@ mod tests {
                                 out
                             })
                         };
-                        if ordinary && scale == 40.0 {
-                            ordinary_fast.1 += 1;
-                        }
+                        let tracked = ordinary && scale == 40.0;
+                        ordinary_fast.1 += usize::from(tracked);
                         let Some(got) = got else {
                             declined += 1;
                             continue;
                         };
                         fast += 1;
-                        if ordinary && scale == 40.0 {
-                            ordinary_fast.0 += 1;
-                        }
+                        ordinary_fast.0 += usize::from(tracked);
                         for (g, v) in got.iter().zip(&d) {
                             if *v < 1.0 {
                                 assert_eq!(

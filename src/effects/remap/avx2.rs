@@ -189,7 +189,7 @@ pub(super) unsafe fn row_f64(
     for k in k..n {
         out[k].write(super::remap_color_pixel(r, other, k as u32, y, depth[k]));
     }
-    outside == 0 && super::depth_row_in_unit(&depth[k.min(n)..n])
+    outside == 0 && super::all_in_unit(&depth[k..n])
 }
 
 /// Row `y` of `remap_color` in f32 ([`Precision::F32Composed`], or [`Precision::F32`]'s two
@@ -301,7 +301,7 @@ pub(super) unsafe fn row_f32(
     for k in k..n {
         out[k].write(super::remap_color_pixel(r, other, k as u32, y, depth[k]));
     }
-    outside == 0 && super::depth_row_in_unit(&depth[k.min(n)..n])
+    outside == 0 && super::all_in_unit(&depth[k..n])
 }
 
 #[cfg(test)]
