@@ -116,24 +116,33 @@ pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
 ///   within `2⁻⁵³(f/n + 10)·m`), and the step to f32 (within `2⁻²⁴|t|`, which matters only
 ///   for `|t| < 2`: `2⁻²³`). `δ = m·(2⁻⁴⁸ + (f/n + 16)·2⁻⁴⁵) + 2⁻²²` is at least twice that
 ///   sum.
-/// - The sign of t (which end of the scale) is certain where `|t̃| > δ`, the clamp where
-///   `||t̃| − 1| > δ` (beyond it both give s = 1 exactly).
-/// - Each channel `round(255 + e·s)` (`e ≥ −255`) is the same where the f32 value is more than
-///   `255·δ + 2⁻¹²` from a half-integer: the reference's value lies within `255·δ` plus its own
-///   rounding (≤ 2⁻⁴⁴), the f32 evaluation's within 2⁻¹⁴ of the exact one.
+/// - `s = min(|t|, 1)`, the clamped distance from white, is 1-Lipschitz in t, so `|s̃ − s| ≤ δ`
+///   whatever the signs (where `|t| ≥ 2`, beyond the bound's reach, both |t̃| and |t| exceed 1
+///   and both s are 1), and every channel `255 + e·s` (`−255 ≤ e ≤ 0`) of the reference lies
+///   within `255·δ` plus its own rounding (≤ 2⁻⁴⁴) of the exact value at s̃; the f32
+///   evaluation lies within 2⁻¹⁴ of that. So where the f32 channel value is more than the
+///   margin `255·δ + 2⁻¹²` closer to its nearest integer than ½, the reference rounds to that
+///   integer too (round-half-away and round-to-nearest agree off half-integers).
+/// - The end (blue or red) follows the sign of t. Where the two signs differ, `|t̃| + |t| ≤ δ`,
+///   so both s are at most δ and every channel of either end lies within `255·δ < ½` below 255:
+///   both round to (255, 255, 255), whichever end each took. So the end is taken from t̃'s sign
+///   without a test of its own. A vector whose drawn lanes lie on both sides of zero parallax
+///   (a thin contour in an image) is declined, so each vector computes one end's two varying
+///   channels (the third is 255 at either end: `e = 0`).
 ///
-/// A vector with a lane that fails any test is colored by the division chain, exactly as
+/// A vector with a lane that fails the test is colored by the division chain, exactly as
 /// before.
 pub(super) struct Affine {
     alpha: __m256d,
     beta: __m256d,
-    delta: __m256,
-    margin: __m256,
+    /// `½ − margin`, rounded down to f32: a channel is certain where its distance to the
+    /// nearest integer is below this.
+    limit: __m256,
 }
 
 impl Affine {
     /// The affine form for `rig` at `scale`, or `None` where the bound is unusable (a rig
-    /// outside `0 < n < f`, non-finite factors, or δ above 10⁻⁵: there a vector's 24 channel
+    /// outside `0 < n < f`, non-finite factors, or δ above 10⁻⁵: there a vector's 16 channel
     /// tests would decline more than about one vector in eight, each then computed twice: the
     /// division chain alone is then the faster program).
     #[target_feature(enable = "avx2")]
@@ -151,18 +160,15 @@ impl Affine {
         usable.then(|| Affine {
             alpha: _mm256_set1_pd(alpha),
             beta: _mm256_set1_pd(beta),
-            // Rounded up to f32, so never below the bound.
-            delta: _mm256_set1_ps(round_up_f32(delta)),
-            margin: _mm256_set1_ps(round_up_f32(255.0 * delta + 2f64.powi(-12))),
+            limit: _mm256_set1_ps(round_down_f32(0.5 - (255.0 * delta + 2f64.powi(-12)))),
         })
     }
 
-    /// The eight pixels' colors (alpha opaque) where every `drawn` lane passes the tests in the
-    /// type's notes; `None` when one does not. Lanes not drawn are meaningless.
+    /// The eight pixels' colors (alpha opaque) where every `drawn` lane passes the test in the
+    /// type's notes and the drawn lanes share a sign of t; `None` otherwise. Lanes not drawn
+    /// are meaningless.
     #[target_feature(enable = "avx2")]
     fn colors(&self, d: __m256, drawn: __m256) -> Option<__m256i> {
-        let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
-        let sign = _mm256_set1_ps(-0.0);
         let t = |d: __m128| {
             _mm256_cvtpd_ps(_mm256_add_pd(
                 _mm256_mul_pd(self.beta, _mm256_cvtps_pd(d)),
@@ -173,47 +179,56 @@ impl Affine {
             t(_mm256_extractf128_ps::<1>(d)),
             t(_mm256_castps256_ps128(d)),
         );
-        let a = _mm256_andnot_ps(sign, t);
-        let neg = _mm256_cmp_ps::<_CMP_LT_OQ>(t, zero);
-        let s = _mm256_min_ps(a, one);
-        let mut ok = _mm256_and_ps(
-            _mm256_cmp_ps::<_CMP_GT_OQ>(a, self.delta),
-            _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_andnot_ps(sign, _mm256_sub_ps(a, one)), self.delta),
-        );
-        let half = _mm256_set1_ps(0.5);
-        // One channel: `round(255 + e·s)` with `e` = `parallax_color`'s `end[k] − 255` for t < 0
-        // (`negative`) and t ≥ 0 (`positive`), and whether it is farther than the margin from
-        // a half-integer. Called three times with constants (unrolled, the constants folded).
-        let channel = |negative: f32, positive: f32| {
-            let e = _mm256_blendv_ps(_mm256_set1_ps(positive), _mm256_set1_ps(negative), neg);
-            let v = _mm256_add_ps(_mm256_set1_ps(255.0), _mm256_mul_ps(e, s));
-            let whole = _mm256_floor_ps(v);
-            let frac = _mm256_sub_ps(v, whole);
-            let off_half = _mm256_andnot_ps(sign, _mm256_sub_ps(frac, half));
-            let sure = _mm256_cmp_ps::<_CMP_GT_OQ>(off_half, self.margin);
-            let up = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(frac, half), one);
-            (_mm256_cvttps_epi32(_mm256_add_ps(whole, up)), sure)
+        let negative = _mm256_movemask_ps(_mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_setzero_ps()),
+            drawn,
+        ));
+        let all_drawn = _mm256_movemask_ps(drawn);
+        // The end's two varying channels: `parallax_color`'s `end[k] − 255` towards blue (red
+        // −255, green −191) or towards red (green −223, blue −255).
+        let (e1, e2) = match negative {
+            0 => (-223.0, -255.0),
+            m if m == all_drawn => (-255.0, -191.0),
+            _ => return None,
         };
-        let (r, r_sure) = channel(-255.0, 0.0);
-        let (g, g_sure) = channel(-191.0, -223.0);
-        let (b, b_sure) = channel(0.0, -255.0);
-        ok = _mm256_and_ps(ok, _mm256_and_ps(r_sure, _mm256_and_ps(g_sure, b_sure)));
-        let rgba = _mm256_or_si256(
-            _mm256_or_si256(r, _mm256_slli_epi32::<8>(g)),
-            _mm256_or_si256(
-                _mm256_slli_epi32::<16>(b),
-                _mm256_set1_epi32(0xff00_0000_u32 as i32),
-            ),
+        let s = _mm256_min_ps(
+            _mm256_andnot_ps(_mm256_set1_ps(-0.0), t),
+            _mm256_set1_ps(1.0),
         );
-        let uncertain = _mm256_andnot_ps(ok, drawn);
-        (_mm256_movemask_ps(uncertain) == 0).then_some(rgba)
+        // One channel `255 + e·s` rounded to the nearest integer, and its distance from it.
+        let channel = |e: f32| {
+            let v = _mm256_add_ps(_mm256_set1_ps(255.0), _mm256_mul_ps(_mm256_set1_ps(e), s));
+            let r = _mm256_round_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(v);
+            let off = _mm256_andnot_ps(_mm256_set1_ps(-0.0), _mm256_sub_ps(v, r));
+            (_mm256_cvtps_epi32(r), off)
+        };
+        let (c1, off1) = channel(e1);
+        let (c2, off2) = channel(e2);
+        let sure = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_max_ps(off1, off2), self.limit);
+        if _mm256_movemask_ps(_mm256_andnot_ps(sure, drawn)) != 0 {
+            return None;
+        }
+        let rgba = if negative == 0 {
+            // (255, c1, c2, 255)
+            _mm256_or_si256(
+                _mm256_or_si256(_mm256_slli_epi32::<8>(c1), _mm256_slli_epi32::<16>(c2)),
+                _mm256_set1_epi32(0xff00_00ff_u32 as i32),
+            )
+        } else {
+            // (c1, c2, 255, 255)
+            _mm256_or_si256(
+                _mm256_or_si256(c1, _mm256_slli_epi32::<8>(c2)),
+                _mm256_set1_epi32(0xffff_0000_u32 as i32),
+            )
+        };
+        Some(rgba)
     }
 }
 
-/// The smallest f32 at or above `v` (v finite and positive).
-fn round_up_f32(v: f64) -> f32 {
+/// The largest f32 at or below `v` (v finite and positive).
+fn round_down_f32(v: f64) -> f32 {
     let r = v as f32;
-    if (r as f64) < v { r.next_up() } else { r }
+    if (r as f64) > v { r.next_down() } else { r }
 }
 
 /// One row of the parallax image before the window marks: `out[k] =
@@ -366,7 +381,8 @@ mod tests {
     /// The affine fast path gives `parallax_pixel_color`'s bytes on every float of dense
     /// intervals of window depth (each 2¹⁶ consecutive f32 values, so every color step inside
     /// them is crossed, rounding boundaries included), for rigs near and far from their near
-    /// plane and scales that clamp much or nothing; and it is taken for nearly every vector of
+    /// plane and scales that clamp much or nothing, and across zero parallax (where the end
+    /// changes); and it is taken for nearly every vector of
     /// an ordinary rig, and declined near color steps (both counted, so a path that never ran
     /// cannot pass).
     #[test]
@@ -375,7 +391,7 @@ mod tests {
             eprintln!("affine_colors_match_parallax_color_on_dense_intervals: NOT RUN: no AVX2");
             return;
         }
-        let (mut fast, mut declined) = (0usize, 0usize);
+        let (mut fast, mut declined, mut crossings) = (0usize, 0usize, 0usize);
         let mut ordinary_fast = (0usize, 0usize);
         for (near, far, z0, balance, ordinary) in [
             (1.0, 20.0, 4.0, 1.0, true),
@@ -389,7 +405,13 @@ mod tests {
                 let Some(affine) = (unsafe { Affine::of(&rig, scale) }) else {
                     continue;
                 };
-                for start in [0.0f32, 0.5, 0.9, 0.99, 0.999_9] {
+                // The window depth of zero parallax (z = z0/b), where the end changes: an
+                // interval centred on it, beside the fixed ones.
+                let zero = (far / (far - near) * (1.0 - near * balance / z0)) as f32;
+                let centred = (balance > 0.0 && zero > 0.001 && zero < 0.999)
+                    .then(|| f32::from_bits(zero.to_bits() - (1 << 15)));
+                for start in [0.0f32, 0.5, 0.9, 0.99, 0.999_9].into_iter().chain(centred) {
+                    crossings += usize::from(centred == Some(start));
                     let mut d = [0f32; 8];
                     let mut bits = start.to_bits();
                     for _ in 0..(1 << 16) / 8 {
@@ -429,9 +451,10 @@ mod tests {
             }
         }
         assert!(
-            fast > 10_000 && declined > 100,
-            "{fast} fast, {declined} declined"
+            fast > 10_000 && declined > 100 && crossings >= 8,
+            "{fast} fast, {declined} declined, {crossings} intervals across zero parallax"
         );
+        eprintln!("{fast} fast, {declined} declined, {crossings} intervals across zero parallax");
         let (taken, all) = ordinary_fast;
         assert!(
             taken * 10 >= all * 9,
