@@ -104,25 +104,30 @@ pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
 ///
 /// `parallax_color` takes `t = clamp(p(d)/scale, −1, 1)` with `p = S·(b − z0/z)`, `S` the eye
 /// separation times pixels per unit, and `z = n f/(f − d(f − n))`. As `1/z` is affine in the
-/// window depth d, so is t before the clamp: `t(d) = α + β·d` with `α = c(b − z0/n)`,
-/// `β = c·z0(f − n)/(n f)`, `c = S/scale` — in exact arithmetic. The reference computes it with
-/// three divisions in f64; this computes it with one multiply and one add in f64 (α and β
-/// nearly cancel where the scene lies far from the near plane, so f32 would lose too much),
-/// takes the result to f32 and does the rest eight lanes wide in f32. A pixel's color is taken
+/// window depth d, so is t before the clamp: `t(d) = α + β·d = β·(d − d0)` with
+/// `α = c(b − z0/n)`, `β = c·z0(f − n)/(n f)`, `c = S/scale` and `d0 = −α/β`, the window depth
+/// of zero parallax — in exact arithmetic. The reference computes t with three divisions in
+/// f64; this computes it in f32 as `β·((d − h) − l)`, with `h + l` the f64 value of d0 split
+/// into two f32 (so the distance from zero parallax keeps its precision where α and β nearly
+/// cancel: `d − h` is exact wherever d lies within a factor 2 of h). A pixel's color is taken
 /// from that only where no rounding can make the two differ:
-/// - `|t̃ − t| ≤ δ`, where t is the reference's f64 value: the affine form's roundings (α, β,
-///   the product and the sum: within `2⁻⁵⁰·m`, `m ≥ |α|, |β|`), the reference's own (its
-///   subtraction `f − d(f − n)` loses up to `f/n` ulps to cancellation, the rest a few ulps:
-///   within `2⁻⁵³(f/n + 10)·m`), and the step to f32 (within `2⁻²⁴|t|`, which matters only
-///   for `|t| < 2`: `2⁻²³`). `δ = m·(2⁻⁴⁸ + (f/n + 16)·2⁻⁴⁵) + 2⁻²²` is at least twice that
-///   sum.
+/// - `|t̃ − t| ≤ δ`, where t is the reference's f64 value:
+///   - the form's own roundings: α, β and d0 in f64 (within `2⁻⁴⁷·m` once multiplied by β,
+///     `m ≥ |α|, |β|`, for `|d0| ≤ 4`), then four f32 roundings, each within `2⁻²⁴|t|` (β to
+///     f32, `d − h`, `− l`, the product) and the splitting of d0 (within `2⁻⁴⁶·m`): within
+///     `2⁻²²|t| + 2⁻⁴⁴·m`, which for `|t| < 2` is at most `2⁻²¹ + 2⁻⁴⁴·m`;
+///   - the reference's own: its subtraction `f − d(f − n)` loses up to `f/n` ulps to
+///     cancellation, the rest a few ulps: within `2⁻⁵³(f/n + 10)·m`.
+///
+///   `δ = 2⁻²⁰ + m·(2⁻⁴³ + (f/n + 16)·2⁻⁴⁵)` is at least twice that sum.
 /// - `s = min(|t|, 1)`, the clamped distance from white, is 1-Lipschitz in t, so `|s̃ − s| ≤ δ`
 ///   whatever the signs (where `|t| ≥ 2`, beyond the bound's reach, both |t̃| and |t| exceed 1
 ///   and both s are 1), and every channel `255 + e·s` (`−255 ≤ e ≤ 0`) of the reference lies
 ///   within `255·δ` plus its own rounding (≤ 2⁻⁴⁴) of the exact value at s̃; the f32
-///   evaluation lies within 2⁻¹⁴ of that. So where the f32 channel value is more than the
-///   margin `255·δ + 2⁻¹²` closer to its nearest integer than ½, the reference rounds to that
-///   integer too (round-half-away and round-to-nearest agree off half-integers).
+///   evaluation (a product and a sum) lies within 2⁻¹⁵ of that. So where the f32 channel value
+///   is more than the margin `255·δ + 2⁻¹⁴` closer to its nearest integer than ½, the
+///   reference rounds to that integer too (round-half-away and round-to-nearest agree off
+///   half-integers).
 /// - The end (blue or red) follows the sign of t. Where the two signs differ, `|t̃| + |t| ≤ δ`,
 ///   so both s are at most δ and every channel of either end lies within `255·δ < ½` below 255:
 ///   both round to (255, 255, 255), whichever end each took. So the end is taken from t̃'s sign
@@ -133,8 +138,12 @@ pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
 /// A vector with a lane that fails the test is colored by the division chain, exactly as
 /// before.
 pub(super) struct Affine {
-    alpha: __m256d,
-    beta: __m256d,
+    /// d0's nearest f32.
+    h: __m256,
+    /// The rest of d0, `d0 − h`, to f32.
+    l: __m256,
+    /// β to f32.
+    beta: __m256,
     /// `½ − margin`, rounded down to f32: a channel is certain where its distance to the
     /// nearest integer is below this.
     limit: __m256,
@@ -142,25 +151,33 @@ pub(super) struct Affine {
 
 impl Affine {
     /// The affine form for `rig` at `scale`, or `None` where the bound is unusable (a rig
-    /// outside `0 < n < f`, non-finite factors, or δ above 10⁻⁵: there a vector's 16 channel
-    /// tests would decline more than about one vector in eight, each then computed twice: the
-    /// division chain alone is then the faster program).
+    /// outside `0 < n < f`, non-finite factors, zero parallax beyond window depth ±4 (no rig
+    /// whose zero-parallax plane lies between its near and far planes), or δ above 10⁻⁵: there
+    /// a vector's 16 channel tests would decline more than about one vector in eight, each then
+    /// computed twice: the division chain alone is then the faster program).
     #[target_feature(enable = "avx2")]
     pub(super) fn of(rig: &ParallaxRig, scale: f64) -> Option<Affine> {
         let (n, f, z0, b) = (rig.near, rig.far, rig.zero_parallax_distance, rig.balance);
         let c = rig.eye_separation * rig.pixels_per_unit / scale;
         let slope = z0 * (f - n) / (n * f);
         let (alpha, beta) = (c * (b - z0 / n), c * slope);
+        let d0 = -alpha / beta;
+        let h = d0 as f32;
+        // Exact in f64: h is d0's nearest f32, within a factor 2 of it.
+        let l = (d0 - h as f64) as f32;
         let m = c.abs() * (b.abs() + (z0 / n).abs() + slope.abs()) + 1.0;
-        let delta = m * (2f64.powi(-48) + (f / n + 16.0) * 2f64.powi(-45)) + 2f64.powi(-22);
+        let delta = 2f64.powi(-20) + m * (2f64.powi(-43) + (f / n + 16.0) * 2f64.powi(-45));
         let usable = n > 0.0
             && f > n
             && [alpha, beta, m, delta].iter().all(|v| v.is_finite())
+            && (beta as f32).is_finite()
+            && d0.abs() <= 4.0
             && delta < 1e-5;
         usable.then(|| Affine {
-            alpha: _mm256_set1_pd(alpha),
-            beta: _mm256_set1_pd(beta),
-            limit: _mm256_set1_ps(round_down_f32(0.5 - (255.0 * delta + 2f64.powi(-12)))),
+            h: _mm256_set1_ps(h),
+            l: _mm256_set1_ps(l),
+            beta: _mm256_set1_ps(beta as f32),
+            limit: _mm256_set1_ps(round_down_f32(0.5 - (255.0 * delta + 2f64.powi(-14)))),
         })
     }
 
@@ -169,16 +186,7 @@ impl Affine {
     /// are meaningless.
     #[target_feature(enable = "avx2")]
     fn colors(&self, d: __m256, drawn: __m256) -> Option<__m256i> {
-        let t = |d: __m128| {
-            _mm256_cvtpd_ps(_mm256_add_pd(
-                _mm256_mul_pd(self.beta, _mm256_cvtps_pd(d)),
-                self.alpha,
-            ))
-        };
-        let t = _mm256_set_m128(
-            t(_mm256_extractf128_ps::<1>(d)),
-            t(_mm256_castps256_ps128(d)),
-        );
+        let t = _mm256_mul_ps(self.beta, _mm256_sub_ps(_mm256_sub_ps(d, self.h), self.l));
         let negative = _mm256_movemask_ps(_mm256_and_ps(
             _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_setzero_ps()),
             drawn,
