@@ -339,7 +339,7 @@ pub fn anaglyph_with(
         };
         // SAFETY: `fill` writes one pixel per pixel of the eyes' rows, which are as long as the
         // output row (`check_same_size`: both color buffers hold width × height pixels).
-        unsafe { par_fill_rows(left.color.len(), w, 0, fill) }
+        unsafe { par_fill_rows(left.color.len(), w, fill) }
     } else {
         #[cfg(target_arch = "x86_64")]
         let simd = simd && avx2::available();
@@ -360,7 +360,7 @@ pub fn anaglyph_with(
             }
         };
         // SAFETY: as above; `avx2::row` writes every pixel of a row as long as its inputs.
-        unsafe { par_fill_rows(left.color.len(), w, 0, fill) }
+        unsafe { par_fill_rows(left.color.len(), w, fill) }
     };
     Ok(RgbaImage::from_raw(left.width, left.height, bytes).expect("4 bytes per pixel"))
 }

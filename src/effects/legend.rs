@@ -1,7 +1,9 @@
 //! The parallax legend bar, drawn with tiny-skia: the color scale, ticks, and labels in a tiny
 //! built-in 3×5 pixel font (tiny-skia draws no text).
 
-use tiny_skia::{Color, Paint, Pixmap, Rect, Transform};
+use std::mem::MaybeUninit;
+
+use tiny_skia::{Color, IntSize, Paint, Pixmap, Rect, Transform};
 
 use super::parallax::PARALLAX_BUDGET_PERCENT;
 use crate::error::{Error, Result};
@@ -127,31 +129,104 @@ fn legend_fills(width: u32, scale: f64, color_of: &dyn Fn(f64) -> [u8; 4]) -> Ve
 /// # Errors
 /// A zero width.
 pub fn draw_legend(width: u32, scale: f64, color_of: &dyn Fn(f64) -> [u8; 4]) -> Result<Pixmap> {
+    let size = IntSize::from_wh(width, LEGEND_HEIGHT)
+        .ok_or_else(|| Error::invalid("legend width", width, "must be at least 1 pixel"))?;
+    let n = width as usize * LEGEND_HEIGHT as usize;
+    let mut data: Vec<[u8; 4]> = Vec::with_capacity(n);
+    draw_legend_into(&mut data.spare_capacity_mut()[..n], width, scale, color_of)?;
+    // SAFETY: `draw_legend_into` wrote all n pixels, within the capacity.
+    unsafe { data.set_len(n) };
+    Ok(Pixmap::from_vec(data.into_flattened(), size).expect("4 bytes per pixel of the size"))
+}
+
+/// [`draw_legend`] into `out`, `width` × [`LEGEND_HEIGHT`] pixels (RGBA, rows top to bottom),
+/// every one of which it writes: the parallax image draws its legend straight into the rows
+/// below the image this way.
+///
+/// # Errors
+/// A zero width; `out` not `width` × [`LEGEND_HEIGHT`] pixels long.
+pub(crate) fn draw_legend_into(
+    out: &mut [MaybeUninit<[u8; 4]>],
+    width: u32,
+    scale: f64,
+    color_of: &dyn Fn(f64) -> [u8; 4],
+) -> Result<()> {
+    if width == 0 || out.len() != width as usize * LEGEND_HEIGHT as usize {
+        return Err(Error::invalid(
+            "legend width",
+            width,
+            format!("must be at least 1 pixel, for {} pixels", out.len()),
+        ));
+    }
     let fills = legend_fills(width, scale, color_of);
     if width > TINY_SKIA_TILE || fills.iter().any(|(_, rgba)| rgba[3] != 255) {
         // Translucent colors blend in tiny-skia's pipeline, and beyond its tile size it fills
         // rectangles as paths (other pixels at half-pixel edges): let it draw those.
-        return draw_legend_reference(width, scale, color_of);
+        let pm = draw_legend_reference(width, scale, color_of)?;
+        for (o, px) in out.iter_mut().zip(pm.data().as_chunks::<4>().0) {
+            o.write(*px);
+        }
+        return Ok(());
     }
-    let mut pm = Pixmap::new(width, LEGEND_HEIGHT)
-        .ok_or_else(|| Error::invalid("legend width", width, "must be at least 1 pixel"))?;
+    for o in out.iter_mut() {
+        o.write(LEGEND_BACKGROUND);
+    }
+    // SAFETY: every element was written just above, and `MaybeUninit<T>` has `T`'s layout.
+    let data = unsafe { &mut *(std::ptr::from_mut(out) as *mut [[u8; 4]]) };
     let (w, h) = (width as i64, LEGEND_HEIGHT as i64);
-    let data = pm.data_mut().as_chunks_mut::<4>().0;
-    data.fill(LEGEND_BACKGROUND);
-    for ([x, y, rw, rh], rgba) in fills {
-        let Some(r) = Rect::from_xywh(x, y, rw, rh).and_then(|r| r.round()) else {
-            continue;
+    let w_px = width as usize;
+    // A run of rectangles side by side over the same rows (the bar's columns): each is filled
+    // in the run's first row, and the run's span is copied to its other rows once it ends.
+    // Rectangles of a run cover the same rows and abut, so that gives each row what filling
+    // them one by one would.
+    let mut run: Option<(std::ops::Range<i64>, std::ops::Range<usize>)> = None;
+    let copy_down =
+        |data: &mut [[u8; 4]], run: &Option<(std::ops::Range<i64>, std::ops::Range<usize>)>| {
+            if let Some((rows, span)) = run {
+                let first = rows.start as usize * w_px;
+                for y in rows.start + 1..rows.end {
+                    let row = y as usize * w_px;
+                    data.copy_within(first + span.start..first + span.end, row + span.start);
+                }
+            }
         };
-        let (x0, y0) = (r.left() as i64, r.top() as i64);
-        let (x1, y1) = (x0 + r.width() as i64, y0 + r.height() as i64);
+    for ([x, y, rw, rh], rgba) in fills {
+        let (x0, y0, x1, y1) = if let Some([x, y, rw, rh]) = whole_pixels([x, y, rw, rh]) {
+            // What `Rect::round` gives such a rectangle, without its four calls to `floor`.
+            (x, y, x + rw, y + rh)
+        } else {
+            let Some(r) = Rect::from_xywh(x, y, rw, rh).and_then(|r| r.round()) else {
+                continue;
+            };
+            let (x0, y0) = (r.left() as i64, r.top() as i64);
+            (x0, y0, x0 + r.width() as i64, y0 + r.height() as i64)
+        };
         let (x0, x1) = (x0.clamp(0, w) as usize, x1.clamp(0, w) as usize);
         let (y0, y1) = (y0.clamp(0, h), y1.clamp(0, h));
-        for y in y0..y1 {
-            let row = y as usize * width as usize;
-            data[row + x0..row + x1.max(x0)].fill(rgba);
+        let x1 = x1.max(x0);
+        match &mut run {
+            Some((rows, span)) if *rows == (y0..y1) && span.end == x0 => span.end = x1,
+            _ => {
+                copy_down(data, &run);
+                run = Some((y0..y1, x0..x1));
+            }
+        }
+        if y0 < y1 {
+            let row = y0 as usize * w_px;
+            data[row + x0..row + x1].fill(rgba);
         }
     }
-    Ok(pm)
+    copy_down(data, &run);
+    Ok(())
+}
+
+/// The rectangle `[x, y, w, h]` as whole numbers, where each is one (and the sides at least 1,
+/// all within ±2²²): there tiny-skia's rounding (`x + ½` floored, the sides the difference of
+/// the edges, at least 1) gives it unchanged. `None` otherwise.
+fn whole_pixels(r: [f32; 4]) -> Option<[i64; 4]> {
+    const LIMIT: f32 = (1 << 22) as f32;
+    let whole = |v: f32| v.abs() <= LIMIT && v == (v as i64) as f32;
+    (r.iter().all(|v| whole(*v)) && r[2] >= 1.0 && r[3] >= 1.0).then(|| r.map(|v| v as i64))
 }
 
 /// [`draw_legend`] drawn by tiny-skia, one `fill_rect` per rectangle: the reference it is held

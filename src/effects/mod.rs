@@ -22,7 +22,6 @@ pub mod sirds;
 /// parallel by `fill(y, row)` on rows of `width` pixels (the last one shorter when `width`
 /// does not divide `pixels`), without being zeroed first: the finalize passes write every byte
 /// anyway, and zeroing a frame-sized buffer is a serial pass over it before the parallel one.
-/// The vector has room for `spare_bytes` more bytes (a legend appended without reallocating).
 /// Rows are split between threads, never pixels, so the bytes do not depend on the thread
 /// count.
 ///
@@ -32,11 +31,10 @@ pub mod sirds;
 pub(crate) unsafe fn par_fill_rows(
     pixels: usize,
     width: usize,
-    spare_bytes: usize,
     fill: impl Fn(usize, &mut [std::mem::MaybeUninit<[u8; 4]>]) + Sync,
 ) -> Vec<u8> {
     use rayon::prelude::*;
-    let mut out: Vec<[u8; 4]> = Vec::with_capacity(pixels + spare_bytes.div_ceil(4));
+    let mut out: Vec<[u8; 4]> = Vec::with_capacity(pixels);
     out.spare_capacity_mut()[..pixels]
         .par_chunks_mut(width.max(1))
         .enumerate()

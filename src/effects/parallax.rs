@@ -12,8 +12,7 @@ use image::RgbaImage;
 use rayon::prelude::*;
 
 use super::eye_input::{all_in_unit, check_depth, check_depth_len};
-use super::legend::{LEGEND_HEIGHT, draw_legend, draw_legend_reference};
-use super::par_fill_rows;
+use super::legend::{LEGEND_HEIGHT, draw_legend_into, draw_legend_reference};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::math::{Camera, CameraMode, StereoRig};
@@ -440,16 +439,25 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
             out.write(parallax_pixel_color(rig, *d, scale));
         }
     };
-    // The legend is drawn while the rows are colored (it needs only the width and the scale):
-    // one thread would otherwise draw it while the other waited.
-    let legend_bytes = w * LEGEND_HEIGHT as usize * 4;
-    let (legend, mut bytes) = rayon::join(
-        || draw_legend(fb.width, scale, &|p| parallax_color(p, scale)),
-        // SAFETY: both row programs write one pixel per depth value, and the depth row is as
-        // long as the output row (`check_depth_len`: width × height values).
-        || unsafe { par_fill_rows(n, w, legend_bytes, fill) },
+    // The legend is drawn into the rows below the image while the image's rows are colored
+    // (it needs only the width and the scale): one thread would otherwise draw it while the
+    // other waited.
+    let legend_px = w * LEGEND_HEIGHT as usize;
+    let mut out: Vec<[u8; 4]> = Vec::with_capacity(n + legend_px);
+    let (rows, legend) = out.spare_capacity_mut()[..n + legend_px].split_at_mut(n);
+    let (drawn, ()) = rayon::join(
+        || draw_legend_into(legend, fb.width, scale, &|p| parallax_color(p, scale)),
+        || {
+            rows.par_chunks_mut(w.max(1))
+                .enumerate()
+                .for_each(|(y, row)| fill(y, row))
+        },
     );
-    let legend = legend?;
+    drawn?;
+    // SAFETY: the rows (`check_depth_len`: width × height depth values, one pixel each) and
+    // the legend wrote every one of the first n + legend_px elements, within the capacity.
+    unsafe { out.set_len(n + legend_px) };
+    let mut bytes = out.into_flattened();
     let negative = |x: usize, y: usize| {
         rig.parallax_pixels(fb.depth[y * w + x])
             .is_some_and(|p| p < 0.0)
@@ -457,8 +465,7 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
     for i in violation_marks_where(fb.width, fb.height, negative) {
         bytes[4 * i..4 * i + 4].copy_from_slice(&VIOLATION_COLOR);
     }
-    bytes.extend_from_slice(legend.data());
-    let h = fb.height + legend.height();
+    let h = fb.height + LEGEND_HEIGHT;
     Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))
 }
 

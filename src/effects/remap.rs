@@ -252,7 +252,7 @@ pub fn remap_color_with(
     };
     // SAFETY: `RowProgram::run` writes one pixel per depth value of the row, and the depth row
     // is as long as the output row (`check_depth_len`: width × height values).
-    let bytes = unsafe { super::par_fill_rows(this.depth.len(), wu, 0, fill) };
+    let bytes = unsafe { super::par_fill_rows(this.depth.len(), wu, fill) };
     if bad.into_inner() {
         // The error `check_depth` gives, naming the first bad pixel; the image is dropped.
         check_depth("this", this)?;
