@@ -4,7 +4,7 @@
 use glam::Mat4;
 use rayon::prelude::*;
 
-use super::{Row, median_ms};
+use super::{Row, interleaved_medians, median_ms};
 use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph, anaglyph_with};
 use crate::effects::occlusion::occlusion_image;
 use crate::effects::parallax::parallax_image_with;
@@ -31,8 +31,8 @@ fn row(knob: &str, setting: impl Into<String>, error: Option<f64>, unit: &str, m
 
 /// The yardstick: median ms of copying `bytes` bytes between two buffers allocated once
 /// (`copy_from_slice`), on one thread and on every thread of the pool (the bytes split into one
-/// contiguous part per thread), as `[one thread, all threads]`. The finalize modes run on the
-/// pool's threads and allocate their output each call; the copy does neither on one thread.
+/// contiguous part per thread). The finalize modes run on the pool's threads and allocate their
+/// output each call; the copy does neither on one thread.
 #[derive(Clone, Copy, Debug)]
 struct Memcpy {
     bytes: usize,
@@ -40,25 +40,49 @@ struct Memcpy {
     all_threads_ms: f64,
 }
 
-fn memcpy_ms(bytes: usize, iters: usize) -> Memcpy {
+/// Runs of each throughput row and of its copy: at least this many, whatever `--iterations`
+/// asks (a sub-millisecond mode's median of 15 runs moves with this shared machine's spells).
+const THROUGHPUT_RUNS: usize = 200;
+
+/// Runs of one before the next in [`with_copy`]'s turns.
+const BLOCK: usize = 10;
+
+/// Median ms of `f`, and the [`Memcpy`] of `bytes` bytes, timed in turns (blocks of
+/// [`BLOCK`] runs, at least [`THROUGHPUT_RUNS`] of each): a slow spell of the machine falls on
+/// the mode and its yardstick alike, so the ratio stays fair.
+///
+/// # Errors
+/// The first error of `f`.
+fn with_copy(
+    iters: usize,
+    bytes: usize,
+    f: &mut dyn FnMut() -> Result<()>,
+) -> Result<(f64, Memcpy)> {
     let src = vec![7u8; bytes];
-    let mut dst = vec![0u8; bytes];
-    let one_thread_ms = median_ms(iters, || {
-        dst.copy_from_slice(std::hint::black_box(&src));
-        dst[bytes / 2]
-    });
+    let (mut one, mut all) = (vec![0u8; bytes], vec![0u8; bytes]);
     let part = bytes.div_ceil(rayon::current_num_threads()).max(1);
-    let all_threads_ms = median_ms(iters, || {
-        dst.par_chunks_mut(part)
+    let mut copy_one = || {
+        one.copy_from_slice(std::hint::black_box(&src));
+        std::hint::black_box(one.get(bytes / 2));
+        Ok(())
+    };
+    let mut copy_all = || {
+        all.par_chunks_mut(part)
             .zip(std::hint::black_box(&src).par_chunks(part))
             .for_each(|(d, s)| d.copy_from_slice(s));
-        dst[bytes / 2]
-    });
-    Memcpy {
-        bytes,
-        one_thread_ms,
-        all_threads_ms,
-    }
+        std::hint::black_box(all.get(bytes / 2));
+        Ok(())
+    };
+    let rounds = iters.max(THROUGHPUT_RUNS).div_ceil(BLOCK);
+    let t = interleaved_medians(rounds, BLOCK, &mut [f, &mut copy_one, &mut copy_all])?;
+    Ok((
+        t[0],
+        Memcpy {
+            bytes,
+            one_thread_ms: t[1],
+            all_threads_ms: t[2],
+        },
+    ))
 }
 
 /// Fills in the throughput note: the mode reads `copy.bytes` of framebuffers; a plain copy of
@@ -83,8 +107,8 @@ fn with_throughput(mut r: Row, copy: Memcpy) -> Row {
 }
 
 /// Every finalize row on `scene` (its size; `stereolab bench` uses 1024×768), each mode on the
-/// thread pool it runs on in a render (rows in parallel), against a copy of the same bytes on
-/// one thread and on the pool's threads.
+/// thread pool it runs on in a render (rows in parallel), timed in turns with a copy of the
+/// bytes it reads on one thread and on the pool's threads ([`with_copy`]).
 ///
 /// # Errors
 /// The scene cannot be rendered, or a mode fails.
@@ -96,17 +120,9 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let mvp = [frame.eyes[0].mvp, frame.eyes[1].mvp];
     let px = left.color.len();
     let mut rows = anaglyph_rows(left, right, iters)?;
-    let copy_color_depth = memcpy_ms(px * 8, iters);
-    let mut err = None;
-    let mut time = |f: &mut dyn FnMut() -> Result<()>| {
-        median_ms(iters, || {
-            if let Err(e) = f() {
-                err = Some(e);
-            }
-        })
-    };
     // Each mode on the AVX2 rows (where the CPU has AVX2) and on the scalar loops, what a CPU
-    // without AVX2 runs; the bytes are the same (unit tests).
+    // without AVX2 runs; the bytes are the same (unit tests). Each against a copy of the bytes
+    // it reads: color and depth for the remap and occlusion, depth for the parallax.
     let remap = |simd: bool, right_eye: bool| {
         let (this, other, k) = if right_eye {
             (right, left, 1)
@@ -115,34 +131,35 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         };
         move || remap_color_with(this, other, &mvp[k], &mvp[1 - k], Precision::F64, simd).map(drop)
     };
-    let remap_ms = time(&mut remap(true, false));
-    let remap_right_ms = time(&mut remap(true, true));
-    let remap_scalar_ms = time(&mut remap(false, false));
-    let remap_f32_ms = time(&mut || {
-        remap_color_with(left, right, &mvp[0], &mvp[1], Precision::F32Composed, true).map(drop)
-    });
-    let occlusion_ms =
-        time(&mut || occlusion_image(left, right, [&mvp[0], &mvp[1]], Precision::F64).map(drop));
-    let rig = scene.parallax_rig()?;
-    let parallax_ms = time(&mut || parallax_image_with(left, &rig, true).map(drop));
-    let parallax_scalar_ms = time(&mut || parallax_image_with(left, &rig, false).map(drop));
-    if let Some(e) = err {
-        return Err(e);
-    }
     let drawn_share = |fb: &Framebuffer| {
         let drawn = fb.depth.iter().filter(|d| **d < 1.0).count();
         format!("{:.0}% of pixels drawn", 100.0 * drawn as f64 / px as f64)
     };
-    for (name, ms, eye) in [
-        ("remap_left", remap_ms, left),
-        ("remap_right", remap_right_ms, right),
-        ("remap_left scalar", remap_scalar_ms, left),
-        ("remap_left f32 composed", remap_f32_ms, left),
+    for (name, eye, mut f) in [
+        (
+            "remap_left",
+            left,
+            Box::new(remap(true, false)) as Box<dyn FnMut() -> Result<()>>,
+        ),
+        ("remap_right", right, Box::new(remap(true, true))),
+        ("remap_left scalar", left, Box::new(remap(false, false))),
+        (
+            "remap_left f32 composed",
+            left,
+            Box::new(|| {
+                remap_color_with(left, right, &mvp[0], &mvp[1], Precision::F32Composed, true)
+                    .map(drop)
+            }),
+        ),
     ] {
+        let (ms, copy) = with_copy(iters, px * 8, &mut f)?;
         let mut r = row("mode", name, None, "", ms);
         r.note = drawn_share(eye);
-        rows.push(with_throughput(r, copy_color_depth));
+        rows.push(with_throughput(r, copy));
     }
+    let (occlusion_ms, copy) = with_copy(iters, px * 8, &mut || {
+        occlusion_image(left, right, [&mvp[0], &mvp[1]], Precision::F64).map(drop)
+    })?;
     let map = visibility_map(left, right, &mvp[0], &mvp[1], Precision::F64)?;
     let n = |v: Visibility| map.iter().filter(|m| **m == v).count();
     let mut occlusion = row("mode", "occlusion", None, "", occlusion_ms);
@@ -153,15 +170,18 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         n(Visibility::OutOfView),
         n(Visibility::Farther)
     );
-    rows.push(with_throughput(occlusion, copy_color_depth));
-    let copy_depth = memcpy_ms(px * 4, iters);
-    for (name, ms) in [
-        ("parallax + legend", parallax_ms),
-        ("parallax + legend scalar", parallax_scalar_ms),
+    rows.push(with_throughput(occlusion, copy));
+    let rig = scene.parallax_rig()?;
+    for (name, simd) in [
+        ("parallax + legend", true),
+        ("parallax + legend scalar", false),
     ] {
+        let (ms, copy) = with_copy(iters, px * 4, &mut || {
+            parallax_image_with(left, &rig, simd).map(drop)
+        })?;
         let mut r = row("mode", name, None, "", ms);
         r.note = drawn_share(left);
-        rows.push(with_throughput(r, copy_depth));
+        rows.push(with_throughput(r, copy));
     }
     let (near, deep) = remap_precision(scene, iters)?;
     rows.extend(near);
@@ -198,7 +218,6 @@ pub(super) fn remap_precision(scene: &Scene, iters: usize) -> Result<(Vec<Row>, 
 /// channel difference (8-bit levels) of linear light against stored values.
 fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Result<Vec<Row>> {
     let px = left.color.len();
-    let copy = memcpy_ms(px * 8, iters);
     let mut rows = Vec::new();
     for kind in AnaglyphKind::ALL {
         let run = |linear_light| {
@@ -222,8 +241,8 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
             .collect();
         let max = diffs.iter().copied().max().unwrap_or(0) as f64;
         let mean = diffs.iter().map(|d| *d as f64).sum::<f64>() / (px * 3) as f64;
-        let stored_ms = median_ms(iters, || run(false).is_ok());
-        let linear_ms = median_ms(iters, || run(true).is_ok());
+        let (stored_ms, copy) = with_copy(iters, px * 8, &mut || run(false).map(drop))?;
+        let (linear_ms, linear_copy) = with_copy(iters, px * 8, &mut || run(true).map(drop))?;
         rows.push(with_throughput(
             row(
                 "anaglyph",
@@ -242,7 +261,7 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
             linear_ms,
         );
         r.note = format!("mean {mean:.2} levels");
-        rows.push(with_throughput(r, copy));
+        rows.push(with_throughput(r, linear_copy));
     }
     // The frame's background is one color in both eyes, which the AVX2 rows compute once per
     // run of equal pixels: the same kind on two eyes of pseudo-random colors (no two
@@ -262,9 +281,9 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
     };
     let (noise_l, noise_r) = (noise(0x2545_f491_4f6c_dd1d)?, noise(0x9e37_79b9_7f4a_7c15)?);
     for (simd, label) in [(true, ""), (false, " scalar")] {
-        let ms = median_ms(iters, || {
-            anaglyph_with(&noise_l, &noise_r, kind, AnaglyphOptions::default(), simd).is_ok()
-        });
+        let (ms, copy) = with_copy(iters, px * 8, &mut || {
+            anaglyph_with(&noise_l, &noise_r, kind, AnaglyphOptions::default(), simd).map(drop)
+        })?;
         let mut r = row(
             "anaglyph",
             format!("{} stored, noise{label}", kind.output_name()),
@@ -276,9 +295,9 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
         rows.push(with_throughput(r, copy));
     }
     // The scalar loop, what a CPU without AVX2 runs (the same bytes), on the kind goal 1 uses.
-    let scalar_ms = median_ms(iters, || {
-        anaglyph_with(left, right, kind, AnaglyphOptions::default(), false).is_ok()
-    });
+    let (scalar_ms, copy) = with_copy(iters, px * 8, &mut || {
+        anaglyph_with(left, right, kind, AnaglyphOptions::default(), false).map(drop)
+    })?;
     rows.push(with_throughput(
         row(
             "anaglyph",
