@@ -59,17 +59,40 @@ fn round_to_byte(v: __m256d) -> __m128i {
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
     let one = _mm256_set1_ps(1.0);
-    let (mut lo, mut hi) = (one, _mm256_setzero_ps());
-    let mut bits_max = _mm256_setzero_si256();
-    let (blocks, rest) = c.as_chunks::<8>();
+    // Four sets of accumulators, one per vector of a 32-depth step, so that the four chains
+    // of minima and maxima run side by side (min and max are exact and associative on the
+    // values in [0, 1] the result is kept for, so the order does not matter).
+    let mut lo = [one; 4];
+    let mut hi = [_mm256_setzero_ps(); 4];
+    let mut bits_max = [_mm256_setzero_si256(); 4];
+    let mut add = |i: usize, d: __m256| {
+        lo[i] = _mm256_min_ps(lo[i], d);
+        let drawn = _mm256_cmp_ps::<_CMP_LT_OQ>(d, one);
+        hi[i] = _mm256_max_ps(hi[i], _mm256_and_ps(d, drawn));
+        bits_max[i] = _mm256_max_epu32(bits_max[i], _mm256_castps_si256(d));
+    };
+    let (steps, tail) = c.as_chunks::<32>();
+    let (blocks, rest) = tail.as_chunks::<8>();
+    for step in steps {
+        let p = step.as_ptr();
+        // SAFETY: a step is 32 f32: four unaligned loads of eight in bounds.
+        unsafe {
+            add(0, _mm256_loadu_ps(p));
+            add(1, _mm256_loadu_ps(p.add(8)));
+            add(2, _mm256_loadu_ps(p.add(16)));
+            add(3, _mm256_loadu_ps(p.add(24)));
+        }
+    }
     for block in blocks {
         // SAFETY: a block is eight f32 (32 bytes); the unaligned load needs no alignment.
-        let d = unsafe { _mm256_loadu_ps(block.as_ptr()) };
-        lo = _mm256_min_ps(lo, d);
-        let drawn = _mm256_cmp_ps::<_CMP_LT_OQ>(d, one);
-        hi = _mm256_max_ps(hi, _mm256_and_ps(d, drawn));
-        bits_max = _mm256_max_epu32(bits_max, _mm256_castps_si256(d));
+        add(0, unsafe { _mm256_loadu_ps(block.as_ptr()) });
     }
+    let lo = _mm256_min_ps(_mm256_min_ps(lo[0], lo[1]), _mm256_min_ps(lo[2], lo[3]));
+    let hi = _mm256_max_ps(_mm256_max_ps(hi[0], hi[1]), _mm256_max_ps(hi[2], hi[3]));
+    let bits_max = _mm256_max_epu32(
+        _mm256_max_epu32(bits_max[0], bits_max[1]),
+        _mm256_max_epu32(bits_max[2], bits_max[3]),
+    );
     let most = _mm256_set1_epi32(0x3f80_0000);
     // All lanes' largest bits at most 1.0's: max(bits_max, 1.0's) == 1.0's in every lane.
     let in_unit = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
@@ -293,14 +316,36 @@ pub(super) unsafe fn row(
         );
         _mm_blendv_epi8(background, rgba, _mm_castps_si128(drawn))
     };
+    let one = _mm256_set1_ps(1.0);
     let mut k = 0;
     while k + 8 <= len {
+        // Thirty-two background pixels at once (most of an image is background): one test and
+        // four stores instead of four tests.
+        if k + 32 <= len {
+            // SAFETY: `k + 32 <= len`: 32 depths and pixels in bounds; unaligned forms.
+            unsafe {
+                let p = depth.as_ptr().add(k);
+                let drawn = |i: usize| _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_loadu_ps(p.add(i)), one);
+                let any = _mm256_or_ps(
+                    _mm256_or_ps(drawn(0), drawn(8)),
+                    _mm256_or_ps(drawn(16), drawn(24)),
+                );
+                if _mm256_movemask_ps(any) == 0 {
+                    let dst = out.as_mut_ptr().add(k).cast::<__m256i>();
+                    for i in 0..4 {
+                        _mm256_storeu_si256(dst.add(i), background8);
+                    }
+                    k += 32;
+                    continue;
+                }
+            }
+        }
         // SAFETY: `k + 8 <= len`: eight depths and eight pixels (32 bytes) in bounds; the
         // unaligned forms need no alignment.
         unsafe {
             let d8 = _mm256_loadu_ps(depth.as_ptr().add(k));
             // `parallax_pixels`: drawn where `d < 1`.
-            let drawn = _mm256_cmp_ps::<_CMP_LT_OQ>(d8, _mm256_set1_ps(1.0));
+            let drawn = _mm256_cmp_ps::<_CMP_LT_OQ>(d8, one);
             let dst = out.as_mut_ptr().add(k);
             if _mm256_movemask_ps(drawn) == 0 {
                 _mm256_storeu_si256(dst.cast(), background8);
@@ -486,7 +531,7 @@ mod tests {
             state ^= state << 17;
             state
         };
-        for len in [0usize, 1, 7, 8, 9, 100, 4099] {
+        for len in [0usize, 1, 7, 8, 9, 45, 100, 4099] {
             for background_share in [0, 1, 2, 7, 8] {
                 let c: Vec<f32> = (0..len)
                     .map(|_| match next() % 8 {
