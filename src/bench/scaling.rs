@@ -86,8 +86,10 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     let mut rows = Vec::new();
     for (what, setting, f) in cases {
-        // At least 40 frames: short frames on a shared machine need many to steady the median.
-        let n = iters.max(40);
+        // At least 300 frames: a fresh pool's first tens of frames run slow on this shared
+        // machine (with 40, the speed-ups read 1.1–1.5 where 300 give 1.9–2.0 in the same
+        // hour), and short frames need many to steady the median.
+        let n = iters.max(300);
         let one = on_threads(1, n, f)?;
         let two = on_threads(2, n, f)?;
         rows.push(row(
