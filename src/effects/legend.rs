@@ -151,11 +151,20 @@ pub(crate) fn draw_legend_into(
     scale: f64,
     color_of: &dyn Fn(f64) -> [u8; 4],
 ) -> Result<()> {
-    if width == 0 || out.len() != width as usize * LEGEND_HEIGHT as usize {
+    if width == 0 {
         return Err(Error::invalid(
             "legend width",
             width,
-            format!("must be at least 1 pixel, for {} pixels", out.len()),
+            "must be at least 1 pixel",
+        ));
+    }
+    if out.len() != width as usize * LEGEND_HEIGHT as usize {
+        return Err(Error::internal(
+            "legend",
+            format!(
+                "{} pixels to draw a {width}x{LEGEND_HEIGHT} legend into",
+                out.len()
+            ),
         ));
     }
     let fills = legend_fills(width, scale, color_of);
@@ -289,9 +298,12 @@ mod tests {
         assert_eq!(cases, 16 * 8);
     }
 
-    /// A zero width is an error, not a panic.
+    /// A zero width is an error, not a panic; so is a buffer of another size than the legend's.
     #[test]
     fn draw_legend_rejects_zero_width() {
         assert!(draw_legend(0, 1.0, &|_| [0, 0, 0, 255]).is_err());
+        let mut out = vec![MaybeUninit::uninit(); 4 * LEGEND_HEIGHT as usize - 1];
+        let err = draw_legend_into(&mut out, 4, 1.0, &|_| [0, 0, 0, 255]).unwrap_err();
+        assert!(err.to_string().contains("4x40"), "{err}");
     }
 }
