@@ -2,6 +2,7 @@
 //! built-in 3×5 pixel font (tiny-skia draws no text).
 
 use std::mem::MaybeUninit;
+use std::ops::Range;
 
 use tiny_skia::{Color, IntSize, Paint, Pixmap, Rect, Transform};
 
@@ -188,17 +189,17 @@ pub(crate) fn draw_legend_into(
     // in the run's first row, and the run's span is copied to its other rows once it ends.
     // Rectangles of a run cover the same rows and abut, so that gives each row what filling
     // them one by one would.
-    let mut run: Option<(std::ops::Range<i64>, std::ops::Range<usize>)> = None;
-    let copy_down =
-        |data: &mut [[u8; 4]], run: &Option<(std::ops::Range<i64>, std::ops::Range<usize>)>| {
-            if let Some((rows, span)) = run {
-                let first = rows.start as usize * w_px;
-                for y in rows.start + 1..rows.end {
-                    let row = y as usize * w_px;
-                    data.copy_within(first + span.start..first + span.end, row + span.start);
-                }
+    type Run = Option<(Range<i64>, Range<usize>)>;
+    let mut run: Run = None;
+    let copy_down = |data: &mut [[u8; 4]], run: &Run| {
+        if let Some((rows, span)) = run {
+            let first = rows.start as usize * w_px;
+            for y in rows.start + 1..rows.end {
+                let row = y as usize * w_px;
+                data.copy_within(first + span.start..first + span.end, row + span.start);
             }
-        };
+        }
+    };
     for ([x, y, rw, rh], rgba) in fills {
         let (x0, y0, x1, y1) = if let Some([x, y, rw, rh]) = whole_pixels([x, y, rw, rh]) {
             // What `Rect::round` gives such a rectangle, without its four calls to `floor`.
