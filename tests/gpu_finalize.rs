@@ -313,6 +313,61 @@ fn gpu_render_writes_the_wgsl_finalize_outputs() {
     println!("outputs where the WGSL route differs from the CPU's: {differs_from_cpu:?}");
 }
 
+/// A frame whose only output is an anaglyph folds the anaglyph into the eye passes (no pass
+/// over the whole frame, `folds_anaglyph`) and gives the full-screen route's bytes: every kind,
+/// stored values and linear light, on wuson's background and on another (the clear value of
+/// the anaglyph where neither eye draws). With the eyes swapped the frame takes the full-screen
+/// pass, and gives the same bytes as ever.
+#[test]
+fn a_lone_anaglyph_folded_into_the_eye_passes_equals_the_host_route() {
+    use stereolab::gpu::resident::folds_anaglyph;
+    use stereolab::gpu::{GpuScene, effects::produce_wgsl};
+    use stereolab::plan::{Output, Plan};
+    let Some(r) = gpu() else { return };
+    let fin = GpuFinalize::new(r).expect("compiles");
+    let mut scene = Scene::load(&common::asset("scenes/wuson.toml"), &[]).expect("scene");
+    scene.set_size(320, 240).expect("size");
+    let (mut folded, mut compared) = (0, 0);
+    for background in [scene.background, [200, 30, 90, 255]] {
+        scene.background = background;
+        for (linear_light, swap_eyes) in [(false, false), (true, false), (false, true)] {
+            scene.finalize.linear_light = linear_light;
+            scene.finalize.swap_eyes = swap_eyes;
+            let gpu_scene = GpuScene::upload(r, &scene).expect("upload");
+            for kind in AnaglyphKind::ALL {
+                let outputs = [Output::Anaglyph(kind)];
+                let folds = folds_anaglyph(&scene, &outputs).expect("plan");
+                assert_eq!(folds, !swap_eyes, "{}", kind.output_name());
+                folded += usize::from(folds);
+                let host = r.render(&gpu_scene, &Plan::new(&outputs)).expect("frame");
+                let expected = produce_wgsl(r, &fin, outputs[0], &host, &scene)
+                    .expect("wgsl")
+                    .expect("has a WGSL pass");
+                let got = r
+                    .render_resident(&gpu_scene, &fin, &outputs)
+                    .expect("resident frame");
+                let (max, n) = diff(&expected, &got[0]);
+                assert_eq!(
+                    (max, n),
+                    (0, 0),
+                    "{} (background {background:?}, linear {linear_light}, swap {swap_eyes}, \
+                     folded {folds}): differs from the host route in {n} pixels, by up to {max}",
+                    kind.output_name()
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert_eq!((folded, compared), (2 * 2 * 9, 2 * 3 * 9));
+    // Not one output alone, or not an anaglyph: no fold.
+    let both = [
+        Output::Anaglyph(AnaglyphKind::DuboisRedCyan),
+        Output::RemapLeft,
+    ];
+    assert!(!folds_anaglyph(&scene, &both).expect("plan"));
+    assert!(!folds_anaglyph(&scene, &[Output::RemapLeft]).expect("plan"));
+}
+
 /// The texture-resident frame (`GpuRenderer::render_resident`: eyes drawn into textures, the
 /// WGSL pass reading them in the same submission, only the output read back) gives the bytes
 /// of the host route (`render`, readback of both eyes, upload, the same pass, readback), for

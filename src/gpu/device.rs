@@ -22,6 +22,22 @@ pub(crate) struct PipelineKey {
     pub perspective_correct: bool,
     /// Depth test LESS with writes (true), or neither.
     pub depth_test: bool,
+    /// A Blinn-Phong eye pass with the anaglyph folded in (src/gpu/resident.rs), or none.
+    pub fused: Option<FusedEye>,
+}
+
+/// A fused frame's clear value is kept per the anaglyph's matrices (their bits), linear light
+/// and the background color.
+pub(crate) type FusedClearKey = (Vec<u32>, bool, [u8; 4]);
+
+/// Which eye pass of a frame with the anaglyph folded into the eye passes
+/// (anaglyph_fused.wgsl), and whether the anaglyph mixes in linear light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum FusedEye {
+    /// The left eye: its color, and the anaglyph with the right eye's background.
+    Left { linear_light: bool },
+    /// The right eye: the anaglyph of the left eye's color under it with its own.
+    Right { linear_light: bool },
 }
 
 /// A wgpu device and queue with the pipelines built so far. Create once, render many frames.
@@ -33,6 +49,12 @@ pub struct GpuRenderer {
     pub(crate) uniform_layout: wgpu::BindGroupLayout,
     /// The ChromaDepth ramp's texels as a read-only storage buffer (group 1).
     pub(crate) ramp_layout: wgpu::BindGroupLayout,
+    /// The fused anaglyph's group 1 in the left eye's pass (its parameters) and in the right
+    /// eye's (the parameters and the left eye's color texture).
+    pub(crate) fused_layouts: [wgpu::BindGroupLayout; 2],
+    /// The anaglyph of two background colors as the full-screen pass computes it, per
+    /// (matrices' bits, linear light, background): the clear value of a fused frame's anaglyph.
+    pub(crate) fused_clears: Mutex<HashMap<FusedClearKey, [u8; 4]>>,
     pub(crate) pipelines: Mutex<HashMap<PipelineKey, wgpu::RenderPipeline>>,
     /// Targets of earlier frames, reused when the size matches (fresh ones cost page faults).
     pub(crate) spare_targets: Mutex<Vec<Target>>,
@@ -94,12 +116,40 @@ impl GpuRenderer {
                 count: None,
             }],
         });
+        let params = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let left_color = wgpu::BindGroupLayoutEntry {
+            binding: 1,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let fused_layouts = [&[params][..], &[params, left_color][..]].map(|entries| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fused anaglyph"),
+                entries,
+            })
+        });
         Ok(GpuRenderer {
             device,
             queue,
             info,
             uniform_layout,
             ramp_layout,
+            fused_layouts,
+            fused_clears: Mutex::new(HashMap::new()),
             pipelines: Mutex::new(HashMap::new()),
             spare_targets: Mutex::new(Vec::new()),
         })

@@ -24,7 +24,10 @@ use super::device::GpuRenderer;
 use super::fullscreen::FullscreenPass;
 
 /// The mirror of `anaglyph::anaglyph`.
-const ANAGLYPH_WGSL: &str = include_str!("shaders/anaglyph.wgsl");
+const ANAGLYPH_WGSL: &str = concat!(
+    include_str!("shaders/anaglyph_mix.wgsl"),
+    include_str!("shaders/anaglyph.wgsl")
+);
 /// The mirror of `parallax::parallax_color` over `parallax_pixels`.
 const PARALLAX_WGSL: &str = include_str!("shaders/parallax.wgsl");
 /// The mirror of `remap_color` and `occlusion_image` (`Precision::F32Composed`).

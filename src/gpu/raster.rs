@@ -18,7 +18,7 @@ use crate::render::{Frame, PassResult, planned_shear_rotate_eyes};
 use crate::scene::{Object, Scene};
 use crate::shade::BlinnPhong;
 
-use super::device::{GpuRenderer, PipelineKey};
+use super::device::{FusedEye, GpuRenderer, PipelineKey};
 use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
 use super::resources::buffer_with;
 
@@ -32,6 +32,24 @@ const CHROMADEPTH_WGSL: &str = concat!(
     include_str!("shaders/common.wgsl"),
     include_str!("shaders/chromadepth.wgsl")
 );
+/// The anaglyph folded into the eye passes (after [`BLINN_PHONG_WGSL`] and `LINEAR_LIGHT`).
+const FUSED_WGSL: &str = concat!(
+    include_str!("shaders/anaglyph_mix.wgsl"),
+    include_str!("shaders/anaglyph_fused.wgsl")
+);
+/// What [`GpuRenderer::encode_views`] needs to fold the anaglyph into the eye passes.
+pub(crate) struct Fused<'a> {
+    /// Mix in linear light (the `LINEAR_LIGHT` of the anaglyph).
+    pub linear_light: bool,
+    /// anaglyph_fused.wgsl's `params`: seven vec4 (the matrices' rows, then the right eye's
+    /// background as the texture unit reads it).
+    pub params: &'a wgpu::Buffer,
+    /// The target the anaglyph is drawn into (its color texture).
+    pub anaglyph: &'a Target,
+    /// The anaglyph of the two backgrounds, where neither eye draws.
+    pub clear: wgpu::Color,
+}
+
 /// The mirror of [`DepthOnly`](crate::shade::DepthOnly).
 const DEPTH_ONLY_WGSL: &str = include_str!("shaders/depth_only.wgsl");
 
@@ -216,7 +234,7 @@ impl GpuRenderer {
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        let targets = self.encode_views(scene, views, &mut encoder)?;
+        let targets = self.encode_views(scene, views, &mut encoder, None)?;
         for t in &targets {
             t.encode_copies(&mut encoder);
         }
@@ -231,6 +249,12 @@ impl GpuRenderer {
     /// and depth textures that stay on the GPU until a copy is recorded), in `views`' order.
     /// Hand the targets back with `Target::give_back` once the submission has completed.
     ///
+    /// With `fused`, the two views are the left and the right eye, shaded, and the anaglyph is
+    /// folded into their passes (anaglyph_fused.wgsl): the left pass also writes the anaglyph
+    /// of its color with the right eye's background into `fused.anaglyph` (cleared to
+    /// `fused.clear` first), and the right pass writes the anaglyph of the left color under it
+    /// with its own there instead of its color.
+    ///
     /// # Errors
     /// Resolving a ChromaDepth view's texgen or ramp fails, or a target cannot be made.
     pub(crate) fn encode_views(
@@ -238,7 +262,14 @@ impl GpuRenderer {
         scene: &GpuScene,
         views: &[(EyeMatrices, Shading)],
         encoder: &mut wgpu::CommandEncoder,
+        fused: Option<&Fused>,
     ) -> Result<Vec<Target>> {
+        if fused.is_some() && (views.len() != 2 || views.iter().any(|v| v.1 != Shading::Color)) {
+            return Err(crate::Error::internal(
+                "fused anaglyph",
+                "needs exactly the two eyes, shaded",
+            ));
+        }
         let s = scene.scene;
         let align = self.device.limits().min_uniform_buffer_offset_alignment as u64;
         let slot = UNIFORM_BYTES.next_multiple_of(align);
@@ -310,6 +341,28 @@ impl GpuRenderer {
             b: bg[2],
             a: bg[3],
         };
+        // The fused anaglyph's group 1 for the left and the right pass.
+        let fused_groups = fused.map(|f| {
+            let params = wgpu::BindGroupEntry {
+                binding: 0,
+                resource: f.params.as_entire_binding(),
+            };
+            let left_color = wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&targets[0].color_view),
+            };
+            [vec![params.clone()], vec![params, left_color]]
+                .iter()
+                .zip(&self.fused_layouts)
+                .map(|(entries, layout)| {
+                    self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("fused anaglyph"),
+                        layout,
+                        entries,
+                    })
+                })
+                .collect::<Vec<_>>()
+        });
         for (v, ((m, shading), target)) in views.iter().zip(&targets).enumerate() {
             let key = PipelineKey {
                 shaded: *shading != Shading::DepthOnly,
@@ -317,17 +370,26 @@ impl GpuRenderer {
                 cull_back: s.raster.cull_back,
                 perspective_correct: s.raster.perspective_correct,
                 depth_test: s.raster.depth_test,
+                fused: fused.map(|f| {
+                    let linear_light = f.linear_light;
+                    if v == 0 {
+                        FusedEye::Left { linear_light }
+                    } else {
+                        FusedEye::Right { linear_light }
+                    }
+                }),
             };
             let pipeline = self.scene_pipeline(key)?;
-            let color_attachment = wgpu::RenderPassColorAttachment {
-                view: &target.color_view,
+            let attachment = |view, load| wgpu::RenderPassColorAttachment {
+                view,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
+                    load,
                     store: wgpu::StoreOp::Store,
                 },
             };
+            let color_attachment = attachment(&target.color_view, wgpu::LoadOp::Clear(clear));
             if !key.shaded {
                 // A depth-only pipeline has no color target: clear the color in a pass of its own,
                 // as the CPU path leaves the background where it never shades.
@@ -337,7 +399,17 @@ impl GpuRenderer {
                     ..Default::default()
                 });
             }
-            let color_attachments = [Some(color_attachment)];
+            let color_attachments = match (fused, v) {
+                (None, _) => vec![Some(color_attachment)],
+                (Some(f), 0) => vec![
+                    Some(color_attachment),
+                    Some(attachment(
+                        &f.anaglyph.color_view,
+                        wgpu::LoadOp::Clear(f.clear),
+                    )),
+                ],
+                (Some(f), _) => vec![Some(attachment(&f.anaglyph.color_view, wgpu::LoadOp::Load))],
+            };
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("scene pass"),
                 color_attachments: if key.shaded { &color_attachments } else { &[] },
@@ -359,6 +431,9 @@ impl GpuRenderer {
             }
             if let (true, Some(ramp)) = (key.chromadepth, &ramp_group) {
                 pass.set_bind_group(1, ramp, &[]);
+            }
+            if let Some(groups) = &fused_groups {
+                pass.set_bind_group(1, &groups[v.min(1)], &[]);
             }
             for (k, mesh) in scene.meshes.iter().enumerate() {
                 let offset = ((v * s.objects.len() + k) as u64 * slot) as u32;
@@ -465,9 +540,31 @@ fn build_scene_pipeline(r: &GpuRenderer, key: PipelineKey) -> wgpu::RenderPipeli
         (true, false) => (BLINN_PHONG_WGSL, "blinn_phong.wgsl"),
         (false, _) => (DEPTH_ONLY_WGSL, "depth_only.wgsl"),
     };
+    // The anaglyph folded into Blinn-Phong's eye passes: its arithmetic and entry points after
+    // the shading (anaglyph_fused.wgsl).
+    let (source, label, entry, group1, outputs) = match key.fused {
+        None => (
+            source.to_string(),
+            label,
+            "fs_main",
+            key.chromadepth.then_some(&r.ramp_layout),
+            1,
+        ),
+        Some(eye) => {
+            let (FusedEye::Left { linear_light } | FusedEye::Right { linear_light }) = eye;
+            let (entry, layout, outputs) = match eye {
+                FusedEye::Left { .. } => ("fs_left", &r.fused_layouts[0], 2),
+                FusedEye::Right { .. } => ("fs_right", &r.fused_layouts[1], 1),
+            };
+            let source = format!(
+                "{BLINN_PHONG_WGSL}\nconst LINEAR_LIGHT: bool = {linear_light};\n{FUSED_WGSL}"
+            );
+            (source, "anaglyph_fused.wgsl", entry, Some(layout), outputs)
+        }
+    };
     // Affine varyings are the same shader with linear (screen-space) interpolation.
     let source = if key.perspective_correct {
-        source.to_string()
+        source
     } else {
         source.replace("@interpolate(perspective)", "@interpolate(linear)")
     };
@@ -475,12 +572,12 @@ fn build_scene_pipeline(r: &GpuRenderer, key: PipelineKey) -> wgpu::RenderPipeli
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
-    let groups = [Some(&r.uniform_layout), Some(&r.ramp_layout)];
+    let groups = [Some(&r.uniform_layout), group1];
     let layout = r
         .device
         .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("scene"),
-            bind_group_layouts: &groups[..1 + usize::from(key.chromadepth)],
+            bind_group_layouts: &groups[..1 + usize::from(group1.is_some())],
             immediate_size: 0,
         });
     let attributes = [
@@ -500,11 +597,12 @@ fn build_scene_pipeline(r: &GpuRenderer, key: PipelineKey) -> wgpu::RenderPipeli
     } else {
         &attributes[..1]
     };
-    let targets = [Some(wgpu::ColorTargetState {
+    let target = Some(wgpu::ColorTargetState {
         format: COLOR_FORMAT,
         blend: None,
         write_mask: wgpu::ColorWrites::ALL,
-    })];
+    });
+    let targets = [target.clone(), target];
     r.device
         .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("scene"),
@@ -539,9 +637,9 @@ fn build_scene_pipeline(r: &GpuRenderer, key: PipelineKey) -> wgpu::RenderPipeli
             multisample: Default::default(),
             fragment: key.shaded.then(|| wgpu::FragmentState {
                 module: &module,
-                entry_point: Some("fs_main"),
+                entry_point: Some(entry),
                 compilation_options: Default::default(),
-                targets: &targets,
+                targets: &targets[..outputs],
             }),
             multiview_mask: None,
             cache: None,

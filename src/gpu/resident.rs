@@ -11,13 +11,17 @@
 
 use image::RgbaImage;
 
+use crate::effects::anaglyph::{AnaglyphKind, AnaglyphOptions};
 use crate::error::{Error, Result};
-use crate::plan::{Output, Plan, View};
+use crate::math::EyeMatrices;
+use crate::plan::{Output, Plan, Shading, View};
+use crate::scene::Scene;
 
 use super::device::GpuRenderer;
 use super::effects::{GpuFinalize, anaglyph_params, remap_params};
-use super::raster::{GpuScene, plan_views};
+use super::raster::{Fused, GpuScene, plan_views};
 use super::readback::{DepthKind, Target, submit_and_read_colors, submit_and_wait};
+use super::resources::buffer_with;
 
 /// Whether `output` is made by [`GpuRenderer::render_resident`]: the anaglyphs and the two
 /// remaps, whose WGSL passes need nothing from the host but matrices. Occlusion and parallax
@@ -30,10 +34,38 @@ pub fn is_resident(output: Output) -> bool {
     )
 }
 
+/// Whether a frame of `outputs` on `scene` folds the anaglyph into the eye passes
+/// ([`GpuRenderer::render_resident`]): the only output is an anaglyph, its plan is the left and
+/// then the right eye, both Blinn-Phong, each drawing every column (no image-shift viewport),
+/// and the eyes are not swapped. Other anaglyph frames run the full-screen pass over the eye
+/// textures.
+///
+/// # Errors
+/// An invalid camera or rig (as the frame itself).
+pub fn folds_anaglyph(scene: &Scene, outputs: &[Output]) -> Result<bool> {
+    let plan = Plan::new(outputs);
+    Ok(matches!(outputs, [Output::Anaglyph(_)])
+        && folds(scene, &plan, &plan_views(scene, &plan)?.passes))
+}
+
+/// [`folds_anaglyph`] of a frame of `plan` with the scene passes `passes`, its only output an
+/// anaglyph.
+fn folds(scene: &Scene, plan: &Plan, passes: &[(EyeMatrices, Shading)]) -> bool {
+    let views: Vec<View> = plan.passes.iter().map(|p| p.view).collect();
+    let full = 0..scene.width;
+    views == [View::Left, View::Right]
+        && passes.len() == 2
+        && passes
+            .iter()
+            .all(|(m, shading)| *shading == Shading::Color && m.drawn_columns(scene.width) == full)
+        && !scene.finalize.swap_eyes
+}
+
 impl GpuRenderer {
     /// One frame of `outputs` (each [`is_resident`]) without the eyes leaving the GPU: the
     /// plan's scene passes into textures, one WGSL finalize pass per output reading them, one
-    /// submission, and one readback of the outputs' color only. The images, in `outputs`'
+    /// submission, and one readback of the outputs' color only. A lone anaglyph is folded into
+    /// the eye passes instead, where [`folds_anaglyph`] says so: no pass over the whole frame. The images, in `outputs`'
     /// order, are byte for byte those of [`GpuRenderer::render`] followed by
     /// [`produce_wgsl`](super::effects::produce_wgsl).
     ///
@@ -46,6 +78,22 @@ impl GpuRenderer {
         fin: &GpuFinalize,
         outputs: &[Output],
     ) -> Result<Vec<RgbaImage>> {
+        self.resident(scene, fin, outputs, true)
+    }
+
+    /// [`GpuRenderer::render_resident`], with the anaglyph folded into the eye passes where
+    /// [`folds_anaglyph`] allows and `fold` asks, else as a full-screen pass (the bench times
+    /// both routes).
+    ///
+    /// # Errors
+    /// As [`GpuRenderer::render_resident`].
+    pub(crate) fn resident(
+        &self,
+        scene: &GpuScene,
+        fin: &GpuFinalize,
+        outputs: &[Output],
+        fold: bool,
+    ) -> Result<Vec<RgbaImage>> {
         if let Some(o) = outputs.iter().find(|o| !is_resident(**o)) {
             return Err(Error::invalid(
                 "gpu resident output",
@@ -57,10 +105,21 @@ impl GpuRenderer {
         let s = scene.scene;
         let plan = Plan::new(outputs);
         let planned = plan_views(s, &plan)?;
+        if let [Output::Anaglyph(kind)] = outputs
+            && fold
+            && folds(s, &plan, &planned.passes)
+        {
+            return Ok(vec![self.fused_anaglyph(
+                scene,
+                fin,
+                *kind,
+                &planned.passes,
+            )?]);
+        }
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        let eyes = self.encode_views(scene, &planned.passes, &mut encoder)?;
+        let eyes = self.encode_views(scene, &planned.passes, &mut encoder, None)?;
         // The eye drawn for `view`, as `Frame::view` finds it (the first pass from that view).
         let eye = |v: View| -> Result<[&wgpu::TextureView; 2]> {
             let i = plan
@@ -113,6 +172,111 @@ impl GpuRenderer {
         Ok(out)
     }
 
+    /// A frame whose only output is an anaglyph, folded into the eye passes (see
+    /// [`folds_anaglyph`]): one submission, and one readback of the anaglyph. The same bytes as
+    /// the full-screen pass over the eye textures on lavapipe
+    /// (`tests/gpu_finalize.rs`); the eye passes decode their own quantized colors as its
+    /// texture unit does (`k · (1/255)`).
+    ///
+    /// # Errors
+    /// As [`GpuRenderer::render_resident`].
+    fn fused_anaglyph(
+        &self,
+        scene: &GpuScene,
+        fin: &GpuFinalize,
+        kind: AnaglyphKind,
+        passes: &[(EyeMatrices, Shading)],
+    ) -> Result<RgbaImage> {
+        let s = scene.scene;
+        let options = s.finalize;
+        let mut params = anaglyph_params(kind);
+        let clear = self.background_anaglyph(fin, options, &params, s.background)?;
+        // The right eye's background as the texture unit reads the stored bytes.
+        params.extend(s.background.map(|c| c as f32 * (1.0 / 255.0)));
+        let bytes: Vec<u8> = params.iter().flat_map(|f| f.to_ne_bytes()).collect();
+        let params = buffer_with(self, "fused anaglyph", &bytes, wgpu::BufferUsages::UNIFORM);
+        let target = Target::take(self, s.width, s.height, DepthKind::ColorR32)?;
+        let [r, g, b, a] = clear.map(|c| c as f64 / 255.0);
+        let fused = Fused {
+            linear_light: options.linear_light,
+            params: &params,
+            anaglyph: &target,
+            clear: wgpu::Color { r, g, b, a },
+        };
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        let eyes = self.encode_views(scene, passes, &mut encoder, Some(&fused))?;
+        target.encode_color_copy(&mut encoder);
+        let mut out = submit_and_read_colors(self, encoder, &[&target])?;
+        Target::give_back(self, eyes.into_iter().chain([target]));
+        out.pop()
+            .ok_or_else(|| Error::internal("fused anaglyph", "no image read back"))
+    }
+
+    /// The anaglyph of a pixel where both eyes show `background`, as the full-screen pass
+    /// computes it (a 1×1 frame of it, run once per matrices, mode and background and kept).
+    ///
+    /// # Errors
+    /// A GPU failure.
+    fn background_anaglyph(
+        &self,
+        fin: &GpuFinalize,
+        options: AnaglyphOptions,
+        params: &[f32],
+        background: [u8; 4],
+    ) -> Result<[u8; 4]> {
+        let key = (
+            params.iter().map(|p| p.to_bits()).collect::<Vec<_>>(),
+            options.linear_light,
+            background,
+        );
+        let poisoned = || Error::internal("fused anaglyph", "cache poisoned by a panic");
+        let cached = self
+            .fused_clears
+            .lock()
+            .map_err(|_| poisoned())?
+            .get(&key)
+            .copied();
+        if let Some(c) = cached {
+            return Ok(c);
+        }
+        let eye = Target::take(self, 1, 1, DepthKind::DepthBuffer)?;
+        let out = Target::take(self, 1, 1, DepthKind::ColorR32)?;
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        let [r, g, b, a] = background.map(|c| c as f64 / 255.0);
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("background"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &eye.color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            ..Default::default()
+        });
+        let views = [&eye.color_view, &eye.depth_view];
+        fin.anaglyph_pass(options)
+            .encode(self, &mut encoder, &[views, views], params, &out)?;
+        out.encode_color_copy(&mut encoder);
+        let image = submit_and_read_colors(self, encoder, &[&out])?;
+        Target::give_back(self, [eye, out]);
+        let c = image
+            .first()
+            .map(|i| i.get_pixel(0, 0).0)
+            .ok_or_else(|| Error::internal("fused anaglyph", "no background read back"))?;
+        self.fused_clears
+            .lock()
+            .map_err(|_| poisoned())?
+            .insert(key, c);
+        Ok(c)
+    }
+
     /// The scene passes of `plan` into textures, submitted and waited for, with nothing read
     /// back: the floor under any frame of that plan (the bench's bound for
     /// [`GpuRenderer::render_resident`]).
@@ -124,7 +288,7 @@ impl GpuRenderer {
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        let eyes = self.encode_views(scene, &planned.passes, &mut encoder)?;
+        let eyes = self.encode_views(scene, &planned.passes, &mut encoder, None)?;
         submit_and_wait(self, encoder)?;
         Target::give_back(self, eyes);
         Ok(())

@@ -36,6 +36,11 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
 
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    return shade(in, front_facing);
+}
+
+// The fragment's color, quantized (`quantize`): also called by anaglyph_fused.wgsl.
+fn shade(in: VertexOut, front_facing: bool) -> vec4<f32> {
     let p = in.p_eye;
     var n = normalize_or_zero(in.n_eye);
     if !front_facing {
