@@ -313,6 +313,13 @@ fn gpu_render_writes_the_wgsl_finalize_outputs() {
     println!("outputs where the WGSL route differs from the CPU's: {differs_from_cpu:?}");
 }
 
+/// The real model at 320×240, the resident frames' tests' scene.
+fn wuson_320x240() -> Scene {
+    let mut scene = Scene::load(&common::asset("scenes/wuson.toml"), &[]).expect("scene");
+    scene.set_size(320, 240).expect("size");
+    scene
+}
+
 /// A frame whose only output is an anaglyph folds the anaglyph into the eye passes (no pass
 /// over the whole frame, `folds_anaglyph`) and gives the full-screen route's bytes: every kind,
 /// stored values and linear light, on wuson's background and on another (the clear value of
@@ -325,8 +332,7 @@ fn a_lone_anaglyph_folded_into_the_eye_passes_equals_the_host_route() {
     use stereolab::plan::{Output, Plan};
     let Some(r) = gpu() else { return };
     let fin = GpuFinalize::new(r).expect("compiles");
-    let mut scene = Scene::load(&common::asset("scenes/wuson.toml"), &[]).expect("scene");
-    scene.set_size(320, 240).expect("size");
+    let mut scene = wuson_320x240();
     let (mut folded, mut compared) = (0, 0);
     for background in [scene.background, [200, 30, 90, 255]] {
         scene.background = background;
@@ -380,8 +386,7 @@ fn resident_frames_equal_the_host_route_byte_for_byte() {
     use stereolab::plan::{Output, Plan};
     let Some(r) = gpu() else { return };
     let fin = GpuFinalize::new(r).expect("compiles");
-    let mut scene = Scene::load(&common::asset("scenes/wuson.toml"), &[]).expect("scene");
-    scene.set_size(320, 240).expect("size");
+    let mut scene = wuson_320x240();
     let mut outputs: Vec<Output> = AnaglyphKind::ALL.map(Output::Anaglyph).to_vec();
     outputs.extend([Output::RemapLeft, Output::RemapRight]);
     let mut compared = 0;

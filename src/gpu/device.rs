@@ -7,6 +7,7 @@ use crate::error::Result;
 
 use super::gpu_error;
 use super::readback::Target;
+use super::resources::{fragment_texture_entry, fragment_uniform_entry};
 
 /// Which pipeline a scene pass needs: its shading and the rasterizer options that change
 /// fixed-function state or the shader (see [`crate::raster::RasterOptions`]).
@@ -116,26 +117,7 @@ impl GpuRenderer {
                 count: None,
             }],
         });
-        let params = wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let left_color = wgpu::BindGroupLayoutEntry {
-            binding: 1,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let (params, left_color) = (fragment_uniform_entry(0), fragment_texture_entry(1));
         let fused_layouts = [&[params][..], &[params, left_color][..]].map(|entries| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fused anaglyph"),

@@ -11,7 +11,7 @@ use crate::framebuffer::Framebuffer;
 use super::device::GpuRenderer;
 use super::gpu_error;
 use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read, submit_and_read_colors};
-use super::resources::{texture_2d, write_texels};
+use super::resources::{fragment_texture_entry, fragment_uniform_entry, texture_2d, write_texels};
 
 /// Vertex stage and helpers every full-screen shader gets.
 const PRELUDE_WGSL: &str = concat!(
@@ -114,27 +114,8 @@ impl FullscreenPass {
         source.push_str(PRELUDE_WGSL);
         source.push_str(fragment_wgsl);
 
-        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let mut entries: Vec<_> = (0..2 * inputs as u32).map(texture_entry).collect();
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: 2 * inputs as u32,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        });
+        let mut entries: Vec<_> = (0..2 * inputs as u32).map(fragment_texture_entry).collect();
+        entries.push(fragment_uniform_entry(2 * inputs as u32));
         let scope = r.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let layout = r
             .device

@@ -1,5 +1,5 @@
-//! Small constructors every GPU module needs: buffers filled at creation, 2D textures, and
-//! texel uploads. One copy of each, so that the passes differ only in what they draw.
+//! Small constructors every GPU module needs: buffers filled at creation, 2D textures, texel
+//! uploads, and the fragment stage's bind group layout entries. One copy of each, so that the passes differ only in what they draw.
 
 use super::device::GpuRenderer;
 
@@ -65,4 +65,33 @@ pub(crate) fn write_texels(r: &GpuRenderer, texture: &wgpu::Texture, data: &[u8]
         },
         size,
     );
+}
+
+/// A layout entry for the fragment stage: an unfilterable 2D float texture at `binding`, read
+/// with `textureLoad` (an RGBA8 color, or a depth buffer as its f32 values).
+pub(crate) fn fragment_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A layout entry for the fragment stage: a uniform buffer at `binding`, bound whole.
+pub(crate) fn fragment_uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
 }

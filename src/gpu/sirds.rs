@@ -34,7 +34,7 @@ use crate::render::sirds_strips::{StripGeometry, StripResult, plan_strips};
 
 use super::device::GpuRenderer;
 use super::readback::{COLOR_FORMAT, padded_row_bytes};
-use super::resources::{buffer_with, texture_2d, write_texels};
+use super::resources::{buffer_with, fragment_texture_entry, texture_2d, write_texels};
 use super::{GL_TO_WGPU_DEPTH, gpu_error};
 
 /// The mirror of `StripShader`.
@@ -75,16 +75,7 @@ impl GpuStrips {
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("sirds strip"),
                 entries: &[
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 0,
-                        visibility: wgpu::ShaderStages::FRAGMENT,
-                        ty: wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                            view_dimension: wgpu::TextureViewDimension::D2,
-                            multisampled: false,
-                        },
-                        count: None,
-                    },
+                    fragment_texture_entry(0),
                     wgpu::BindGroupLayoutEntry {
                         binding: 1,
                         visibility: wgpu::ShaderStages::FRAGMENT,
