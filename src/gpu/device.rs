@@ -34,11 +34,12 @@ pub(crate) type FusedClearKey = (Vec<u32>, bool, [u8; 4]);
 /// Which eye pass of a frame with the anaglyph folded into the eye passes
 /// (anaglyph_fused.wgsl), and whether the anaglyph mixes in linear light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(crate) enum FusedEye {
-    /// The left eye: its color, and the anaglyph with the right eye's background.
-    Left { linear_light: bool },
-    /// The right eye: the anaglyph of the left eye's color under it with its own.
-    Right { linear_light: bool },
+pub(crate) struct FusedEye {
+    /// The right eye (the anaglyph of the left eye's color under it with its own), else the
+    /// left (its color, and the anaglyph with the right eye's background).
+    pub right: bool,
+    /// The anaglyph's `LINEAR_LIGHT`.
+    pub linear_light: bool,
 }
 
 /// A wgpu device and queue with the pipelines built so far. Create once, render many frames.

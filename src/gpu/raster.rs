@@ -20,7 +20,7 @@ use crate::shade::BlinnPhong;
 
 use super::device::{FusedEye, GpuRenderer, PipelineKey};
 use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
-use super::resources::buffer_with;
+use super::resources::{buffer_with, clear_color};
 
 /// The mirror of [`BlinnPhong`](crate::shade::BlinnPhong).
 const BLINN_PHONG_WGSL: &str = concat!(
@@ -334,13 +334,7 @@ impl GpuRenderer {
             .iter()
             .map(|_| Target::take(self, s.width, s.height, DepthKind::DepthBuffer))
             .collect::<Result<Vec<_>>>()?;
-        let bg = s.background.map(|c| c as f64 / 255.0);
-        let clear = wgpu::Color {
-            r: bg[0],
-            g: bg[1],
-            b: bg[2],
-            a: bg[3],
-        };
+        let clear = clear_color(s.background);
         // The fused anaglyph's group 1 for the left and the right pass.
         let fused_groups = fused.map(|f| {
             let params = wgpu::BindGroupEntry {
@@ -370,13 +364,9 @@ impl GpuRenderer {
                 cull_back: s.raster.cull_back,
                 perspective_correct: s.raster.perspective_correct,
                 depth_test: s.raster.depth_test,
-                fused: fused.map(|f| {
-                    let linear_light = f.linear_light;
-                    if v == 0 {
-                        FusedEye::Left { linear_light }
-                    } else {
-                        FusedEye::Right { linear_light }
-                    }
+                fused: fused.map(|f| FusedEye {
+                    right: v == 1,
+                    linear_light: f.linear_light,
                 }),
             };
             let pipeline = self.scene_pipeline(key)?;
@@ -550,11 +540,14 @@ fn build_scene_pipeline(r: &GpuRenderer, key: PipelineKey) -> wgpu::RenderPipeli
             key.chromadepth.then_some(&r.ramp_layout),
             1,
         ),
-        Some(eye) => {
-            let (FusedEye::Left { linear_light } | FusedEye::Right { linear_light }) = eye;
-            let (entry, layout, outputs) = match eye {
-                FusedEye::Left { .. } => ("fs_left", &r.fused_layouts[0], 2),
-                FusedEye::Right { .. } => ("fs_right", &r.fused_layouts[1], 1),
+        Some(FusedEye {
+            right,
+            linear_light,
+        }) => {
+            let (entry, layout, outputs) = if right {
+                ("fs_right", &r.fused_layouts[1], 1)
+            } else {
+                ("fs_left", &r.fused_layouts[0], 2)
             };
             let source = format!(
                 "{BLINN_PHONG_WGSL}\nconst LINEAR_LIGHT: bool = {linear_light};\n{FUSED_WGSL}"

@@ -21,7 +21,10 @@ use super::device::GpuRenderer;
 use super::effects::{GpuFinalize, anaglyph_params, remap_params};
 use super::raster::{Fused, GpuScene, plan_views};
 use super::readback::{DepthKind, Target, submit_and_read_colors, submit_and_wait};
-use super::resources::buffer_with;
+use super::resources::{buffer_with, clear_color};
+
+/// Most clear values of fused frames kept ([`GpuRenderer`]'s `fused_clears`).
+const MAX_FUSED_CLEARS: usize = 64;
 
 /// Whether `output` is made by [`GpuRenderer::render_resident`]: the anaglyphs and the two
 /// remaps, whose WGSL passes need nothing from the host but matrices. Occlusion and parallax
@@ -65,9 +68,9 @@ impl GpuRenderer {
     /// One frame of `outputs` (each [`is_resident`]) without the eyes leaving the GPU: the
     /// plan's scene passes into textures, one WGSL finalize pass per output reading them, one
     /// submission, and one readback of the outputs' color only. A lone anaglyph is folded into
-    /// the eye passes instead, where [`folds_anaglyph`] says so: no pass over the whole frame. The images, in `outputs`'
-    /// order, are byte for byte those of [`GpuRenderer::render`] followed by
-    /// [`produce_wgsl`](super::effects::produce_wgsl).
+    /// the eye passes instead, where [`folds_anaglyph`] says so: no pass over the whole frame.
+    /// The images, in `outputs`' order, are byte for byte those of [`GpuRenderer::render`]
+    /// followed by [`produce_wgsl`](super::effects::produce_wgsl).
     ///
     /// # Errors
     /// An output that is not [`is_resident`], an invalid camera, rig or eye matrix, or a GPU
@@ -196,12 +199,11 @@ impl GpuRenderer {
         let bytes: Vec<u8> = params.iter().flat_map(|f| f.to_ne_bytes()).collect();
         let params = buffer_with(self, "fused anaglyph", &bytes, wgpu::BufferUsages::UNIFORM);
         let target = Target::take(self, s.width, s.height, DepthKind::ColorR32)?;
-        let [r, g, b, a] = clear.map(|c| c as f64 / 255.0);
         let fused = Fused {
             linear_light: options.linear_light,
             params: &params,
             anaglyph: &target,
-            clear: wgpu::Color { r, g, b, a },
+            clear: clear_color(clear),
         };
         let mut encoder = self
             .device
@@ -246,7 +248,6 @@ impl GpuRenderer {
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        let [r, g, b, a] = background.map(|c| c as f64 / 255.0);
         encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("background"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -254,7 +255,7 @@ impl GpuRenderer {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
+                    load: wgpu::LoadOp::Clear(clear_color(background)),
                     store: wgpu::StoreOp::Store,
                 },
             })],
@@ -270,10 +271,12 @@ impl GpuRenderer {
             .first()
             .map(|i| i.get_pixel(0, 0).0)
             .ok_or_else(|| Error::internal("fused anaglyph", "no background read back"))?;
-        self.fused_clears
-            .lock()
-            .map_err(|_| poisoned())?
-            .insert(key, c);
+        let mut cache = self.fused_clears.lock().map_err(|_| poisoned())?;
+        // Bounded: a program that renders many backgrounds recomputes some instead of growing.
+        if cache.len() >= MAX_FUSED_CLEARS {
+            cache.clear();
+        }
+        cache.insert(key, c);
         Ok(c)
     }
 

@@ -95,3 +95,10 @@ pub(crate) fn fragment_uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry
         count: None,
     }
 }
+
+/// The clear value that stores the RGBA8 bytes `c` exactly (each `k/255`, which the unorm
+/// conversion rounds back to k).
+pub(crate) fn clear_color(c: [u8; 4]) -> wgpu::Color {
+    let [r, g, b, a] = c.map(|v| v as f64 / 255.0);
+    wgpu::Color { r, g, b, a }
+}
