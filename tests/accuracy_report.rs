@@ -3,9 +3,9 @@
 //! committed report byte for byte), and the committed copy in `docs/accuracy/` (every plot it
 //! shows exists and decodes; the slides' copies are the report's plots).
 
-use stereolab::bench::BenchOptions;
-use stereolab::bench::report::{ReportOptions, SLIDE_KNOBS, write_report};
-use stereolab::figures::plot::pareto_front;
+use stereolab_bench::BenchOptions;
+use stereolab_bench::report::{ReportOptions, SLIDE_KNOBS, write_report};
+use stereolab_figures::plot::pareto_front;
 
 use crate::common::{asset, out_dir, root};
 
@@ -75,7 +75,7 @@ fn quick_report_has_a_plot_per_knob_with_axes_and_a_reading() {
             k.id
         );
         assert!(html.contains(&format!("src=\"{}.png\"", k.id)), "{}", k.id);
-        let reading = stereolab::bench::report::reading(k);
+        let reading = stereolab_bench::report::reading(k);
         assert!(reading.starts_with("**Use "), "{}: {reading}", k.id);
         assert!(md.contains(&reading), "{}: reading missing", k.id);
         // The front in the table is the front of the numbers.

@@ -1,52 +1,59 @@
-//! Dependencies point one way: the import graph of the library's top-level modules, read from
-//! the source, has no cycle, and every edge goes down the layers below.
+//! Dependencies point one way inside each library crate too. Cargo keeps the crates apart
+//! (`stereolab-core` ← `stereolab` ← the tool crates ← the command); what it cannot see is the
+//! order of the modules inside one crate. This test reads each crate's source: the import graph
+//! of its top-level modules has no cycle, and every edge goes down the crate's layers.
 //!
-//! `cargo test --test main architecture -- --nocapture` prints the graph.
+//! `cargo test --test main architecture -- --nocapture` prints the graphs.
 //!
-//! The layers, lowest first. A module may import modules of lower layers only (and the same
-//! layer never: no two modules of one layer import each other).
+//! `stereolab-core`, lowest first:
 //! - `error`: the one error type.
 //! - `files`: bounded reads and all-or-nothing writes.
-//! - `math`, `framebuffer`, `shade`: matrices and the rig, the render target (and the image
-//!   sizes it accepts), the shader stages.
+//! - `math`, `framebuffer`, `shade`, `text`: matrices and the rig, the render target (and the
+//!   image sizes it accepts), the shader stages, text in pictures.
 //! - `raster`, `reference`: fixed-point setup and traversal (knows nothing of scenes or
 //!   stereo); the f64 reference the hard cases are measured against.
-//! - `effects`: pure functions of framebuffers, matrices and their own settings types (never a
-//!   `Scene`, `Frame`, `Plan` or `Output`).
+//! - `effects`: pure functions of framebuffers, matrices and their own settings types.
+//!
+//! `stereolab` (the pipeline), lowest first:
 //! - `plan`: the outputs a scene can ask for, and the passes each needs.
 //! - `scene`: the scene file, meshes, camera and rig, with every effect's settings.
 //! - `fixtures`: scenes and depth maps shared by tests, benchmarks and the GPU path.
 //! - `render`: the passes (eye passes, the ChromaDepth pass, the SIRDS strips) over a scene.
 //! - `output`: a rendered frame into the images the scene asked for, and files.
-//! - `info`, `figures`, `compare`: reports, the slides' figures, image metrics.
-//! - `gpu`, `exercise`: the wgpu parity path; the exercise protocol.
-//! - `grade`, `bench`: the auto-grader; the benchmarks.
-//! - `viewer`: `stereolab view`, the interactive window over the library (feature `viewer`).
+//! - `info`, `compare`: reports, image metrics.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use crate::common::root;
 
-const LAYERS: &[&[&str]] = &[
-    &["error"],
-    &["files"],
-    &["math", "framebuffer", "shade", "text"],
-    &["raster", "reference"],
-    &["effects"],
-    &["plan"],
-    &["scene"],
-    &["fixtures"],
-    &["render"],
-    &["output"],
-    &["info", "figures", "compare"],
-    &["gpu", "exercise"],
-    &["grade", "bench"],
-    &["viewer"],
+/// Each layered crate's source folder and its layers, lowest first.
+const CRATES: &[(&str, &[&[&str]])] = &[
+    (
+        "crates/core/src",
+        &[
+            &["error"],
+            &["files"],
+            &["math", "framebuffer", "shade", "text"],
+            &["raster", "reference"],
+            &["effects"],
+        ],
+    ),
+    (
+        "crates/stereolab/src",
+        &[
+            &["plan"],
+            &["scene"],
+            &["fixtures"],
+            &["render"],
+            &["output"],
+            &["info", "compare"],
+        ],
+    ),
 ];
 
-fn layer_of(module: &str) -> Option<usize> {
-    LAYERS.iter().position(|l| l.contains(&module))
+fn layer_of(layers: &[&[&str]], module: &str) -> Option<usize> {
+    layers.iter().position(|l| l.contains(&module))
 }
 
 /// Every `.rs` file under `dir`, sorted.
@@ -168,14 +175,14 @@ fn referenced(code: &str, path: &[String]) -> BTreeSet<String> {
     out
 }
 
-/// The import graph: top-level module → the other top-level modules it names.
-fn graph() -> BTreeMap<String, BTreeSet<String>> {
-    let src = root().join("src");
+/// The import graph of the crate whose source is `src`: top-level module → the other
+/// top-level modules it names.
+fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
     let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for file in rust_files(&src) {
         let rel = file.strip_prefix(&src).unwrap();
-        if rel.starts_with("bin") || rel == Path::new("lib.rs") || rel == Path::new("main.rs") {
-            continue; // the binary is its own crate; lib.rs declares the modules
+        if rel == Path::new("lib.rs") {
+            continue; // it declares the modules
         }
         let path = module_path(rel);
         let top = path[0].clone();
@@ -224,37 +231,41 @@ fn find_cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
 
 #[test]
 fn top_level_modules_import_each_other_one_way_only() {
-    let g = graph();
-    println!("import graph of src/ (module -> what it imports):");
-    for (m, deps) in &g {
-        let deps: Vec<&str> = deps.iter().map(String::as_str).collect();
-        println!("  {m:<12} -> {}", deps.join(", "));
-    }
-    assert!(
-        g.len() >= 15,
-        "the graph reader found only {:?}: is src/ where it looks?",
-        g.keys()
-    );
-    if let Some(cycle) = find_cycle(&g) {
-        panic!("import cycle: {}", cycle.join(" -> "));
-    }
-    let mut upward = Vec::new();
-    for (m, deps) in &g {
-        let Some(lm) = layer_of(m) else {
-            panic!("module `{m}` has no layer: add it to LAYERS in tests/architecture.rs");
-        };
-        for d in deps {
-            let ld = layer_of(d).unwrap_or(usize::MAX);
-            if ld >= lm {
-                upward.push(format!("{m} (layer {lm}) imports {d} (layer {ld})"));
+    for (dir, layers) in CRATES {
+        let g = graph(&root().join(dir));
+        println!("import graph of {dir} (module -> what it imports):");
+        for (m, deps) in &g {
+            let deps: Vec<&str> = deps.iter().map(String::as_str).collect();
+            println!("  {m:<12} -> {}", deps.join(", "));
+        }
+        let declared: usize = layers.iter().map(|l| l.len()).sum();
+        assert_eq!(
+            g.len(),
+            declared,
+            "{dir}: the graph reader found {:?}, the layers name {declared} modules",
+            g.keys()
+        );
+        if let Some(cycle) = find_cycle(&g) {
+            panic!("{dir}: import cycle: {}", cycle.join(" -> "));
+        }
+        let mut upward = Vec::new();
+        for (m, deps) in &g {
+            let Some(lm) = layer_of(layers, m) else {
+                panic!("{dir}: module `{m}` has no layer: add it to CRATES in tests/architecture.rs");
+            };
+            for d in deps {
+                let ld = layer_of(layers, d).unwrap_or(usize::MAX);
+                if ld >= lm {
+                    upward.push(format!("{m} (layer {lm}) imports {d} (layer {ld})"));
+                }
             }
         }
+        assert!(
+            upward.is_empty(),
+            "{dir}: imports against the layers:\n{}",
+            upward.join("\n")
+        );
     }
-    assert!(
-        upward.is_empty(),
-        "imports against the layers:\n{}",
-        upward.join("\n")
-    );
 }
 
 #[test]
@@ -273,18 +284,4 @@ fn the_reader_sees_grouped_nested_and_super_imports() {
     g.insert("a".to_string(), BTreeSet::from(["b".to_string()]));
     g.insert("b".to_string(), BTreeSet::from(["a".to_string()]));
     assert!(find_cycle(&g).is_some(), "a two-module cycle must be found");
-}
-
-#[test]
-fn effects_and_gpu_never_import_benchmarks() {
-    for dir in ["src/effects", "src/gpu"] {
-        for f in rust_files(&root().join(dir)) {
-            let code = strip_comments(&std::fs::read_to_string(&f).unwrap());
-            assert!(
-                !code.contains("crate::bench"),
-                "{} imports benchmark code",
-                f.display()
-            );
-        }
-    }
 }

@@ -5,17 +5,17 @@ use std::path::Path;
 
 use glam::{Mat4, Vec3, Vec4};
 use proptest::prelude::*;
-use stereolab::Error;
-use stereolab::effects::chromadepth::glasses::{self, Eye, pixel_shift};
-use stereolab::effects::chromadepth::ramp::{self, Ramp, RampKind, Sampling};
-use stereolab::effects::chromadepth::texgen::{Texgen, auto_range, eye_plane_specified_under};
-use stereolab::effects::chromadepth::{ChromaDepthSettings, TexgenMode};
-use stereolab::math::StereoRig;
 use stereolab::output;
 use stereolab::plan::{Output, Pass, Plan, Shading, View};
 use stereolab::render::chromadepth::{render_center_with, texgen_map};
 use stereolab::render::render;
 use stereolab::scene::{Scene, terrain, terrain_data};
+use stereolab_core::Error;
+use stereolab_core::effects::chromadepth::glasses::{self, Eye, pixel_shift};
+use stereolab_core::effects::chromadepth::ramp::{self, Ramp, RampKind, Sampling};
+use stereolab_core::effects::chromadepth::texgen::{Texgen, auto_range, eye_plane_specified_under};
+use stereolab_core::effects::chromadepth::{ChromaDepthSettings, TexgenMode};
+use stereolab_core::math::StereoRig;
 
 use crate::common;
 
@@ -373,7 +373,7 @@ fn redder_pixels_get_larger_inward_shifts() {
         let mut last = f32::INFINITY;
         for k in 0..=200 {
             let c = ramp::exact(kind, k as f32 / 200.0);
-            let rgba = stereolab::shade::to_rgba8(c);
+            let rgba = stereolab_core::shade::to_rgba8(c);
             let shift = pixel_shift(rgba, 10.0);
             assert!(
                 shift <= last,
@@ -432,7 +432,7 @@ fn glasses_disparity_order_matches_depth_order() {
             .expect("right");
     // Each square is one color (camera-facing): find its columns on the middle row.
     let row = s.height / 2;
-    let mean_x = |fb: &stereolab::Framebuffer, color: [u8; 4]| {
+    let mean_x = |fb: &stereolab_core::Framebuffer, color: [u8; 4]| {
         let xs: Vec<u32> = (0..fb.width)
             .filter(|&x| fb.pixel(x, row) == color)
             .collect();
@@ -471,10 +471,10 @@ fn glasses_disparity_order_matches_depth_order() {
         &s.chromadepth,
     )
     .expect("ok");
-    let expected = stereolab::effects::anaglyph::anaglyph(
+    let expected = stereolab_core::effects::anaglyph::anaglyph(
         &left,
         &right,
-        stereolab::effects::anaglyph::AnaglyphKind::Gray,
+        stereolab_core::effects::anaglyph::AnaglyphKind::Gray,
         Default::default(),
     )
     .expect("same size");
@@ -522,11 +522,11 @@ fn glasses_shift_falls_with_depth_on_the_fault_valley() {
 #[test]
 fn glasses_views_move_inward() {
     // One red pixel column on black: the left view moves it right, the right view left.
-    let mut fb = stereolab::Framebuffer::new(21, 1, [0, 0, 0, 255]).expect("size");
+    let mut fb = stereolab_core::Framebuffer::new(21, 1, [0, 0, 0, 255]).expect("size");
     fb.color[10] = [255, 0, 0, 255];
     let l = glasses::glasses_view(&fb, Eye::Left, 3.0);
     let r = glasses::glasses_view(&fb, Eye::Right, 3.0);
-    let at = |f: &stereolab::Framebuffer| f.color.iter().position(|p| p[0] == 255);
+    let at = |f: &stereolab_core::Framebuffer| f.color.iter().position(|p| p[0] == 255);
     assert_eq!(at(&l), Some(13));
     assert_eq!(at(&r), Some(7));
 }

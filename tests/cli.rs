@@ -265,7 +265,7 @@ fn scene_syntax_errors_and_unknown_fields_give_the_line() {
 #[test]
 fn figures_draws_every_figure_and_names_a_missing_bench_file() {
     let dir = out_dir("cli_figures");
-    let bench = stereolab::figures::all();
+    let bench = stereolab_figures::all();
     let csv = root().join("slides/data/bench.csv");
     let out = stereolab(&[
         "figures",

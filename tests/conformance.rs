@@ -6,9 +6,9 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use proptest::prelude::*;
 use stereolab::compare::ascii_map;
-use stereolab::framebuffer::Framebuffer;
-use stereolab::raster::{RasterOptions, rasterize};
-use stereolab::shade::{Fragment, Shader, Varyings};
+use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::raster::{RasterOptions, rasterize};
+use stereolab_core::shade::{Fragment, Shader, Varyings};
 
 use crate::common::failure_dir;
 
@@ -305,7 +305,7 @@ fn eye_triangle(tri: [Vec3; 3], width: u32, height: u32) -> Framebuffer {
             Some([255; 4])
         }
     }
-    let p: Mat4 = stereolab::math::perspective(60.0, width as f32 / height as f32, 1.0, 50.0);
+    let p: Mat4 = stereolab_core::math::perspective(60.0, width as f32 / height as f32, 1.0, 50.0);
     let shader = Eye {
         clip: tri.iter().map(|v| p * v.extend(1.0)).collect(),
     };
@@ -433,7 +433,7 @@ proptest! {
         tile_w in 5u32..40,
         tile_h in 3u32..30,
     ) {
-        use stereolab::raster::{Band, setup_triangles, traverse};
+        use stereolab_core::raster::{Band, setup_triangles, traverse};
         let clip: Vec<Vec4> = verts.iter().map(|&(x, y, z, w)| Vec4::new(x * w, y * w, z * w, w)).collect();
         let tris: Vec<[u32; 3]> = (0..10).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
         let shader = Gradient { clip };

@@ -6,8 +6,8 @@ use std::collections::BTreeSet;
 
 use proptest::prelude::*;
 use stereolab::compare::ascii_map;
-use stereolab::raster::{RasterOptions, Setup, SetupTriangle, WindowVertex, setup_triangle};
-use stereolab::shade::{MAX_VARYINGS, Varyings};
+use stereolab_core::raster::{RasterOptions, Setup, SetupTriangle, WindowVertex, setup_triangle};
+use stereolab_core::shade::{MAX_VARYINGS, Varyings};
 
 /// The target: small, so that every pixel is tested, and not a multiple of 8 wide.
 const W: u32 = 37;

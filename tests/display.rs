@@ -2,19 +2,19 @@
 //! above-below calibration screen, and the marks and numbers the parallax and ChromaDepth
 //! outputs add. Each test measures the defining number on a shipped scene or a crafted one.
 
-use stereolab::effects::calibration::{
-    ARROW_COLOR, BLANK_COLOR, CalibrationLayout, VIEW_COLOR, calibration_screen,
-};
-use stereolab::effects::ghosting::{DEFAULT_LEAK, ghost_risk};
-use stereolab::effects::parallax::{
-    VIOLATION_COLOR, budget, parallax_image, parallax_map, violation_band,
-};
-use stereolab::effects::rds::rds_left;
-use stereolab::framebuffer::{BACK_LEFT, BACK_RIGHT};
 use stereolab::output::{Image, produce, report::effect_lines};
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
+use stereolab_core::effects::calibration::{
+    ARROW_COLOR, BLANK_COLOR, CalibrationLayout, VIEW_COLOR, calibration_screen,
+};
+use stereolab_core::effects::ghosting::{DEFAULT_LEAK, ghost_risk};
+use stereolab_core::effects::parallax::{
+    VIOLATION_COLOR, budget, parallax_image, parallax_map, violation_band,
+};
+use stereolab_core::effects::rds::rds_left;
+use stereolab_core::framebuffer::{BACK_LEFT, BACK_RIGHT};
 
 use crate::common::{asset, out_dir};
 
@@ -210,8 +210,8 @@ fn ghosting_leaks_the_set_share_of_the_other_eye_in_linear_light() {
         .flat_map(|y| (0..l.width).map(move |x| (x, y)))
         .find(|&(x, y)| l.pixel(x, y)[..3] == [0, 0, 0] && r.pixel(x, y)[1] > 200)
         .expect("a ghost pixel");
-    let dec = |v: u8| stereolab::effects::anaglyph::srgb_to_linear(v as f32 / 255.0);
-    let enc = |v: f32| (stereolab::effects::anaglyph::linear_to_srgb(v) * 255.0).round() as u8;
+    let dec = |v: u8| stereolab_core::effects::anaglyph::srgb_to_linear(v as f32 / 255.0);
+    let enc = |v: f32| (stereolab_core::effects::anaglyph::linear_to_srgb(v) * 255.0).round() as u8;
     let other = r.pixel(x, y);
     for (c, leak) in [0.1f32, 0.2, 0.05].into_iter().enumerate() {
         assert_eq!(

@@ -2,9 +2,9 @@
 //! the two eyes' matrices actually give a point, for every rig mode and balance.
 
 use glam::Vec3;
-use stereolab::figures::parallax_curve;
-use stereolab::math::project_ndc;
 use stereolab::scene::Scene;
+use stereolab_core::math::project_ndc;
+use stereolab_figures::parallax_curve;
 
 use crate::common::asset;
 
@@ -73,12 +73,12 @@ fn committed_figures_are_what_the_code_draws() {
     let s = Scene::load(&asset("scenes/wuson.toml"), &[]).expect("scene");
     let csv_path = root.join("slides/data/bench.csv");
     let csv = std::fs::read_to_string(&csv_path).expect("slides/data/bench.csv");
-    let bench = stereolab::figures::bench::parse_csv(&csv, &csv_path).expect("bench rows");
-    let ctx = stereolab::figures::Context {
+    let bench = stereolab_figures::bench::parse_csv(&csv, &csv_path).expect("bench rows");
+    let ctx = stereolab_figures::Context {
         scene: &s,
         bench: &bench,
     };
-    let drawn = stereolab::figures::draw_all(&ctx).expect("figures");
+    let drawn = stereolab_figures::draw_all(&ctx).expect("figures");
     let dir = root.join("slides/figures");
     let mut stale = Vec::new();
     for (name, png) in &drawn {
@@ -160,7 +160,7 @@ fn decks_show_every_figure_and_only_existing_ones() {
             );
         }
     }
-    for f in stereolab::figures::all() {
+    for f in stereolab_figures::all() {
         assert!(
             shown.contains(&format!("{}.png", f.name)),
             "figure {} is drawn but no deck shows it",
@@ -174,7 +174,7 @@ fn decks_show_every_figure_and_only_existing_ones() {
 /// line, and the sign of p must say behind / on / in front of the screen.
 #[test]
 fn parallax_diagram_rays_meet_at_the_point() {
-    let geometry = stereolab::figures::parallax_types_geometry();
+    let geometry = stereolab_figures::parallax_types_geometry();
     let (d, z0) = (1.0, 4.0); // the schematic rig the figure states in its caption
     for (z, xl, xr) in geometry {
         for (eye, x_screen) in [(-d / 2.0, xl), (d / 2.0, xr)] {
@@ -197,8 +197,8 @@ fn parallax_diagram_rays_meet_at_the_point() {
 /// on a rendered point; off-axis has none.
 #[test]
 fn vertical_parallax_map_is_zero_for_off_axis_and_not_for_toe_in() {
-    use stereolab::figures::vertical_parallax_grid;
-    use stereolab::math::CameraMode;
+    use stereolab_core::math::CameraMode;
+    use stereolab_figures::vertical_parallax_grid;
     let s = Scene::load(&asset("scenes/wuson.toml"), &[]).expect("scene");
     let toe = vertical_parallax_grid(&s, CameraMode::ToeIn, 8, 6).expect("grid");
     let off = vertical_parallax_grid(&s, CameraMode::OffAxis, 8, 6).expect("grid");
@@ -216,7 +216,7 @@ fn vertical_parallax_map_is_zero_for_off_axis_and_not_for_toe_in() {
 /// strips use: both models meet at the background, and eq. 3's front separation is δ.
 #[test]
 fn sirds_figure_models_agree_at_the_background() {
-    use stereolab::effects::sirds::{DisparityModel, Geometry};
+    use stereolab_core::effects::sirds::{DisparityModel, Geometry};
     let g = Geometry::default();
     let eq3 = g.to_pixels().expect("eq. 3");
     let eq1 = Geometry {

@@ -9,10 +9,10 @@ mod remap;
 
 use std::path::Path;
 
-use stereolab::Framebuffer;
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
+use stereolab_core::Framebuffer;
 
 /// A test rig: camera at the origin looking down −Z, absolute eye separation and zero-parallax
 /// distance, so every expected number can be computed by hand from these fields.

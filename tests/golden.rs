@@ -1,10 +1,10 @@
 //! Golden images: the deterministic path must reproduce the committed PNGs byte for byte.
 //! Regenerate only on purpose: `UPDATE_GOLDENS=1 cargo test golden`.
 
-use stereolab::framebuffer::Framebuffer;
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::render;
 use stereolab::scene::Scene;
+use stereolab_core::framebuffer::Framebuffer;
 
 use crate::common::{asset, failure_dir};
 

@@ -1,21 +1,21 @@
 //! Finalize parity apart from raster parity (issue 6): the CPU path's own eye framebuffers go
-//! into the CPU finalize functions and into their WGSL mirrors (`stereolab::gpu::effects`), so a
+//! into the CPU finalize functions and into their WGSL mirrors (`stereolab_gpu::effects`), so a
 //! difference here is the effect's alone, never rasterization's.
 //!
 //! Every tolerance is measured on this machine (lavapipe, Mesa 22.3.6, LLVM 15.0.6) and stated
 //! where it is asserted; docs/gpu-parity.md has the figures.
 
 use image::RgbaImage;
-use stereolab::Framebuffer;
-use stereolab::effects::anaglyph::{self, AnaglyphKind, AnaglyphOptions};
-use stereolab::effects::occlusion::occlusion_image;
-use stereolab::effects::parallax::{parallax_image, parallax_map};
-use stereolab::effects::remap::{Precision, remap_color};
-use stereolab::gpu::GpuFinalize;
-use stereolab::math::EyeMatrices;
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab::scene::Scene;
+use stereolab_core::Framebuffer;
+use stereolab_core::effects::anaglyph::{self, AnaglyphKind, AnaglyphOptions};
+use stereolab_core::effects::occlusion::occlusion_image;
+use stereolab_core::effects::parallax::{parallax_image, parallax_map};
+use stereolab_core::effects::remap::{Precision, remap_color};
+use stereolab_core::math::EyeMatrices;
+use stereolab_gpu::GpuFinalize;
 
 use crate::common;
 use crate::gpu_parity::gpu;
@@ -200,10 +200,10 @@ const CREASE_PERCENT: f64 = 0.01;
 /// step of 4], because an ulp of `s` can cross a texel edge `k/N`.
 #[test]
 fn chromadepth_pass_matches_the_cpu_in_every_mode() {
-    use stereolab::effects::chromadepth::TexgenMode;
-    use stereolab::effects::chromadepth::ramp::{Ramp, Sampling};
-    use stereolab::gpu::GpuScene;
-    use stereolab::math::StereoRig;
+    use stereolab_core::effects::chromadepth::TexgenMode;
+    use stereolab_core::effects::chromadepth::ramp::{Ramp, Sampling};
+    use stereolab_core::math::StereoRig;
+    use stereolab_gpu::GpuScene;
     let Some(r) = gpu() else { return };
     for name in ["chromadepth_fault", "chromadepth_molecule"] {
         let mut scene =
@@ -257,8 +257,8 @@ fn chromadepth_pass_matches_the_cpu_in_every_mode() {
 /// parallax outputs from their WGSL passes on the GPU frame, and keeps the layouts on the CPU.
 #[test]
 fn gpu_render_writes_the_wgsl_finalize_outputs() {
-    use stereolab::gpu::{GpuScene, effects::produce_wgsl};
     use stereolab::plan::{Output, Plan};
+    use stereolab_gpu::{GpuScene, effects::produce_wgsl};
     let Some(r) = gpu() else { return };
     let mut scene = Scene::load(&common::asset("scenes/wuson.toml"), &[]).expect("scene");
     scene.set_size(320, 240).expect("size");
@@ -278,7 +278,7 @@ fn gpu_render_writes_the_wgsl_finalize_outputs() {
         )
         .expect("gpu frame");
     let dir = common::out_dir("gpu_finalize_render");
-    let paths = stereolab::gpu::output::write_all(r, &frame, &scene, &dir).expect("writes");
+    let paths = stereolab_gpu::output::write_all(r, &frame, &scene, &dir).expect("writes");
     assert_eq!(paths.len(), outputs.len(), "{paths:?}");
     let fin = GpuFinalize::new(r).expect("compiles");
     let mut differs_from_cpu = Vec::new();
@@ -327,9 +327,9 @@ fn wuson_320x240() -> Scene {
 /// pass, and gives the same bytes as ever.
 #[test]
 fn a_lone_anaglyph_folded_into_the_eye_passes_equals_the_host_route() {
-    use stereolab::gpu::resident::folds_anaglyph;
-    use stereolab::gpu::{GpuScene, effects::produce_wgsl};
     use stereolab::plan::{Output, Plan};
+    use stereolab_gpu::resident::folds_anaglyph;
+    use stereolab_gpu::{GpuScene, effects::produce_wgsl};
     let Some(r) = gpu() else { return };
     let fin = GpuFinalize::new(r).expect("compiles");
     let mut scene = wuson_320x240();
@@ -381,9 +381,9 @@ fn a_lone_anaglyph_folded_into_the_eye_passes_equals_the_host_route() {
 /// both remaps, several outputs in one frame; an output that needs the host is refused.
 #[test]
 fn resident_frames_equal_the_host_route_byte_for_byte() {
-    use stereolab::gpu::resident::is_resident;
-    use stereolab::gpu::{GpuScene, effects::produce_wgsl};
     use stereolab::plan::{Output, Plan};
+    use stereolab_gpu::resident::is_resident;
+    use stereolab_gpu::{GpuScene, effects::produce_wgsl};
     let Some(r) = gpu() else { return };
     let fin = GpuFinalize::new(r).expect("compiles");
     let mut scene = wuson_320x240();

@@ -13,13 +13,13 @@ use std::sync::OnceLock;
 
 use glam::{Mat4, Vec3};
 use stereolab::compare::{Metrics, ascii_map, compare, coverage, write_diff_strip};
-use stereolab::gpu::parity::{compare_scene, depth_identity};
-use stereolab::gpu::{FullscreenPass, GpuRenderer, GpuScene};
-use stereolab::math::EyeMatrices;
 use stereolab::plan::{Plan, Shading};
 use stereolab::render::render_view;
 use stereolab::scene::{Mesh, Object, Scene};
-use stereolab::{Framebuffer, Result};
+use stereolab_core::math::EyeMatrices;
+use stereolab_core::{Framebuffer, Result};
+use stereolab_gpu::parity::{compare_scene, depth_identity};
+use stereolab_gpu::{FullscreenPass, GpuRenderer, GpuScene};
 
 use crate::common;
 

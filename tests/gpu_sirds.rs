@@ -3,14 +3,14 @@
 //! Compiled only with `--features gpu`; skips without an adapter, fails when `CI` is set (the
 //! helper of tests/gpu_parity.rs).
 
-use stereolab::effects::sirds::decode::{DecodeOptions, decode, round_trip};
-use stereolab::effects::sirds::{Filter, Pattern, PerVertexOptions, Start};
-use stereolab::gpu::parity::compare_scene;
-use stereolab::gpu::sirds::GpuStrips;
 use stereolab::output::sirds::scene_depth;
 use stereolab::plan::Plan;
 use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::scene::Scene;
+use stereolab_core::effects::sirds::decode::{DecodeOptions, decode, round_trip};
+use stereolab_core::effects::sirds::{Filter, Pattern, PerVertexOptions, Start};
+use stereolab_gpu::parity::compare_scene;
+use stereolab_gpu::sirds::GpuStrips;
 
 use crate::gpu_parity::gpu;
 use crate::sirds::{RAMP, SPHERE, frame, sized_scene};
@@ -149,12 +149,12 @@ fn gpu_render_writes_the_wgsl_sirds() {
     let s = scene(SPHERE); // center start, bilinear: a few pixels differ from the CPU
     let f = frame(&s);
     let dir = crate::common::out_dir("gpu_sirds_render");
-    let paths = stereolab::gpu::output::write_all(r, &f, &s, &dir).expect("writes");
+    let paths = stereolab_gpu::output::write_all(r, &f, &s, &dir).expect("writes");
     assert_eq!(paths.len(), 2, "{paths:?}");
     let png = image::open(dir.join("sirds.png")).expect("png").to_rgba8();
     let written: Vec<[u8; 4]> = png.pixels().map(|p| p.0).collect();
     let strips = GpuStrips::new(r).expect("compiles");
-    let gpu_sirds = stereolab::gpu::sirds_frame::from_frame(r, &strips, &f, &s).expect("gpu");
+    let gpu_sirds = stereolab_gpu::sirds_frame::from_frame(r, &strips, &f, &s).expect("gpu");
     let cpu_sirds = stereolab::output::sirds::from_frame(&f, &s).expect("cpu");
     assert_eq!(written, gpu_sirds.pixels);
     assert_ne!(

@@ -569,11 +569,15 @@ fn hidden_cases_come_from_the_seed_the_solution_passes_them_and_a_mutant_fails_t
 }
 
 /// Every file a shipped copy of stereolab's sources (`lib`: the handout's or the bundle's
-/// `stereolab/`) compiles in with `include_str!` / `include_bytes!` exists in that copy: a
-/// copy missing one does not build, and building it here would take minutes.
+/// `stereolab/`: the command's `src/` and the library crates) compiles in with `include_str!`
+/// / `include_bytes!` exists in that copy: a copy missing one does not build, and building it
+/// here would take minutes.
 pub(crate) fn assert_includes_resolve(lib: &Path) {
     let mut checked = 0;
-    for file in files_under(&lib.join("src")) {
+    let sources = files_under(&lib.join("src"))
+        .into_iter()
+        .chain(files_under(&lib.join("crates")));
+    for file in sources {
         if file.extension().is_none_or(|e| e != "rs") {
             continue;
         }

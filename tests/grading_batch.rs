@@ -413,7 +413,7 @@ fn the_gradescope_bundle_runs_in_an_autograder_layout() {
         "setup.sh",
         "run_autograder",
         "stereolab/Cargo.toml",
-        "stereolab/src/lib.rs",
+        "stereolab/crates/core/src/lib.rs",
     ] {
         assert!(names.iter().any(|n| n == needed), "{needed} in {names:?}");
     }

@@ -247,7 +247,7 @@ fn a_render_that_draws_nothing_says_so() {
 }
 
 /// Catalogue: near/far ratios from 10 to 1e12, each depth mode against the f64 reference
-/// (`stereolab::reference`), on the depth benchmark's decal scene (pairs of squares 1/10 000
+/// (`stereolab_core::reference`), on the depth benchmark's decal scene (pairs of squares 1/10 000
 /// of their depth apart). Tolerance: zero wrong or lost pixels (of those the reference decides)
 /// wherever the mode's predicted resolution `resolution_of` at the farthest pair (eye depth 90)
 /// is under a quarter of that pair's gap; reason: a resolution finer than the gap separates
@@ -255,8 +255,8 @@ fn a_render_that_draws_nothing_says_so() {
 /// the scene loader warns (`a_near_plane_that_coarsens…`, the refusal above).
 #[test]
 fn catalogue_near_far_ratios_within_the_predicted_resolution_of_each_depth_mode() {
-    use stereolab::bench::depth::{FAR, measure, modes};
     use stereolab::scene::resolution_of;
+    use stereolab_bench::depth::{FAR, measure, modes};
     let rows = measure(96, 64, 1).expect("measure");
     let gap = 90.0 * 1e-4;
     let mut standard_failed_somewhere = false;
@@ -292,7 +292,7 @@ fn catalogue_near_far_ratios_within_the_predicted_resolution_of_each_depth_mode(
 /// rounding of the formula. Before: 67 px (t_far − t_near rounded in f32).
 #[test]
 fn catalogue_sirds_depth_far_in_1e8_keeps_the_front_separation() {
-    use stereolab::effects::sirds::disparity::Geometry;
+    use stereolab_core::effects::sirds::disparity::Geometry;
     let g = Geometry {
         depth_far_in: 1e8,
         ..Geometry::default()
@@ -336,16 +336,16 @@ fn depth_mode_values_are_checked_by_name() {
 
 /// Draws `triangles` through `mvp` on the CPU, as triangle ids, and compares each pixel the
 /// f64 reference decides (the same f32 vertices through `mvp64`) with the reference's winner
-/// (`stereolab::reference`).
+/// (`stereolab_core::reference`).
 fn against_reference_through(
     positions: &[glam::Vec3],
     triangles: &[[u32; 3]],
     (mvp, mvp64): (glam::Mat4, glam::DMat4),
     (width, height): (u32, u32),
-) -> stereolab::reference::Mismatch {
-    use stereolab::framebuffer::Framebuffer;
-    use stereolab::raster::{RasterOptions, rasterize};
-    use stereolab::reference::{IdShader, compare, soup, visible};
+) -> stereolab_core::reference::Mismatch {
+    use stereolab_core::framebuffer::Framebuffer;
+    use stereolab_core::raster::{RasterOptions, rasterize};
+    use stereolab_core::reference::{IdShader, compare, soup, visible};
     let world: Vec<glam::DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
     let reference = visible(&world, triangles, &mvp64, width, height);
     let soup_positions = soup(positions, triangles);
@@ -374,11 +374,11 @@ fn against_reference(
     triangles: &[[u32; 3]],
     (near, far): (f32, f32),
     (width, height): (u32, u32),
-) -> stereolab::reference::Mismatch {
+) -> stereolab_core::reference::Mismatch {
     let aspect = width as f32 / height as f32;
     let (a, b) = (near * aspect, near);
-    let mvp = stereolab::math::frustum(-a, a, -b, b, near, far);
-    let mvp64 = stereolab::reference::frustum(
+    let mvp = stereolab_core::math::frustum(-a, a, -b, b, near, far);
+    let mvp64 = stereolab_core::reference::frustum(
         -f64::from(a),
         f64::from(a),
         -f64::from(b),
@@ -532,7 +532,7 @@ fn catalogue_chromadepth_d1_equal_to_d2_within_an_ulp() {
 /// refusal naming `t + f`, never an infinity or NaN passed on.
 #[test]
 fn catalogue_sirds_eq3_near_the_pole_stays_within_ulps_or_is_refused() {
-    use stereolab::effects::sirds::disparity::separation_eye_distance;
+    use stereolab_core::effects::sirds::disparity::separation_eye_distance;
     let (a, f) = (180.0f32, 864.0f32);
     let mut t = -f + 1.0;
     let mut checked = 0;
@@ -571,13 +571,13 @@ fn catalogue_sirds_eq3_near_the_pole_stays_within_ulps_or_is_refused() {
 
 /// Catalogue: toe-in at extreme separations, from 1e-6 to 1e6 times the model's size. Each
 /// eye's f32 matrix (`StereoRig::eyes_for_image`, what every render uses) against the f64
-/// reference rig (`stereolab::reference::eye`) on the model's bounding-box corners and
+/// reference rig (`stereolab_core::reference::eye`) on the model's bounding-box corners and
 /// centre. Tolerance: 0.01 px on a 320×240 image for every point in front of the eye; a
 /// separation whose cameras overflow is refused by name instead (`1e20`, tested above).
 #[test]
 fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
     use glam::{DVec3, Vec3};
-    use stereolab::math::CameraMode;
+    use stereolab_core::math::CameraMode;
     let path = asset("scenes/anaglyph.toml");
     let (w, h) = (320u32, 240u32);
     let mut worst = 0.0f64;
@@ -610,7 +610,7 @@ fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
         }
         points.push(target);
         for (side, eye) in [(-1.0, &eyes[0]), (1.0, &eyes[1])] {
-            let m64 = stereolab::reference::eye(
+            let m64 = stereolab_core::reference::eye(
                 &scene.rig,
                 &scene.camera,
                 aspect,
@@ -656,8 +656,8 @@ fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
 /// this ratio the near plane is warned about, naming `camera.near`.
 #[test]
 fn catalogue_remap_at_near_far_1e_minus_6_stays_within_half_a_pixel() {
-    use stereolab::effects::remap::{Precision, remap_coordinates};
     use stereolab::plan::{Output as Out, Plan, View};
+    use stereolab_core::effects::remap::{Precision, remap_coordinates};
     let (w, h) = (160u32, 120u32);
     let sets = vec!["camera.near=2e-5".to_string()];
     let mut scene =
@@ -746,12 +746,12 @@ fn catalogue_coordinates_far_from_the_origin_against_the_f64_reference() {
         let eye = c + DVec3::new(0.5, 0.8, 6.0);
         // A 34° vertical field of view: the model fills most of the image.
         let (x, y) = (0.15 * near * aspect, 0.15 * near);
-        let mvp = stereolab::math::frustum(-x, x, -y, y, near, far)
-            * stereolab::math::look_at(eye.as_vec3(), c.as_vec3(), Vec3::Y);
+        let mvp = stereolab_core::math::frustum(-x, x, -y, y, near, far)
+            * stereolab_core::math::look_at(eye.as_vec3(), c.as_vec3(), Vec3::Y);
         let (n, f, a) = (f64::from(near), f64::from(far), f64::from(aspect));
         let (x, y) = (0.15 * n * a, 0.15 * n);
-        let mvp64 = stereolab::reference::frustum(-x, x, -y, y, n, f)
-            * stereolab::reference::look_at(eye, c, DVec3::Y);
+        let mvp64 = stereolab_core::reference::frustum(-x, x, -y, y, n, f)
+            * stereolab_core::reference::look_at(eye, c, DVec3::Y);
         let m = against_reference_through(&positions, &triangles, (mvp, mvp64), (w, h));
         assert!(m.covered > 2000, "t = {t:e}: {m:?}");
         let share = m.total() as f64 / m.covered as f64;

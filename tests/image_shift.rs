@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use stereolab::framebuffer::Framebuffer;
 use stereolab::info::describe;
-use stereolab::math::{CameraMode, ImageShift};
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
+use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::math::{CameraMode, ImageShift};
 
 use crate::common::asset;
 

@@ -1,7 +1,7 @@
 //! Stereo layouts, the StereoGraphics guide's above-below format included.
 
-use stereolab::effects::layout;
-use stereolab::framebuffer::Framebuffer;
+use stereolab_core::effects::layout;
+use stereolab_core::framebuffer::Framebuffer;
 
 const RED: [u8; 4] = [255, 0, 0, 255];
 const BLUE: [u8; 4] = [0, 0, 255, 255];

@@ -10,10 +10,10 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Vec3, Vec4};
-use stereolab::framebuffer::Framebuffer;
 use stereolab::plan::{Plan, View};
 use stereolab::render::render;
 use stereolab::scene::{Mesh, Scene, load_obj};
+use stereolab_core::framebuffer::Framebuffer;
 
 use crate::common::out_dir;
 
@@ -222,8 +222,8 @@ fn every_loadable_assimp_model_renders_the_same_bytes_twice() {
 #[test]
 fn every_loadable_assimp_model_passes_compare_against_lavapipe() {
     use stereolab::compare::Thresholds;
-    use stereolab::gpu::GpuScene;
-    use stereolab::gpu::parity::{compare_finalize, compare_frames, depth_identity};
+    use stereolab_gpu::GpuScene;
+    use stereolab_gpu::parity::{compare_finalize, compare_frames, depth_identity};
     let Some(r) = crate::gpu_parity::gpu() else {
         return;
     };
@@ -330,8 +330,8 @@ fn the_concave_64_gon_renders_as_exactly_its_outline_facing_forward() {
 #[test]
 fn the_concave_64_gon_renders_as_its_outline_on_lavapipe_too() {
     use stereolab::compare::Thresholds;
-    use stereolab::gpu::GpuScene;
-    use stereolab::gpu::parity::compare_frames;
+    use stereolab_gpu::GpuScene;
+    use stereolab_gpu::parity::compare_frames;
     let Some(r) = crate::gpu_parity::gpu() else {
         return;
     };

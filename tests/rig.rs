@@ -2,8 +2,8 @@
 
 use glam::{Vec3, Vec3Swizzles};
 use proptest::prelude::*;
-use stereolab::Error;
-use stereolab::math::{
+use stereolab_core::Error;
+use stereolab_core::math::{
     Camera, CameraMode, Lighting, Separation, StereoRig, ZeroParallax, frustum, project_ndc,
 };
 

@@ -3,19 +3,19 @@
 
 use std::path::Path;
 
-use stereolab::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
-use stereolab::effects::sirds::disparity::{
-    separation_eye_distance, separation_view_angle, tan_phi_eye_distance,
-};
-use stereolab::effects::sirds::per_pixel::{PerPixelOptions, RowLinker, per_pixel};
-use stereolab::effects::sirds::{
-    Algorithm, DepthMap, DisparityModel, Filter, Geometry, Pattern, PerVertexOptions, Start,
-};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::{Output, Pass, Plan, Shading, View};
 use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
+use stereolab_core::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
+use stereolab_core::effects::sirds::disparity::{
+    separation_eye_distance, separation_view_angle, tan_phi_eye_distance,
+};
+use stereolab_core::effects::sirds::per_pixel::{PerPixelOptions, RowLinker, per_pixel};
+use stereolab_core::effects::sirds::{
+    Algorithm, DepthMap, DisparityModel, Filter, Geometry, Pattern, PerVertexOptions, Start,
+};
 
 use crate::common;
 
@@ -426,7 +426,7 @@ fn decoder_tells_sirds_from_noise() {
 #[test]
 fn bad_inputs_get_clear_errors() {
     let d = Geometry::default().to_pixels().expect("valid");
-    let msg = |r: Result<DepthMap, stereolab::Error>| r.expect_err("must fail").to_string();
+    let msg = |r: Result<DepthMap, stereolab_core::Error>| r.expect_err("must fail").to_string();
     assert!(msg(DepthMap::new(0, 10, vec![])).contains("at least 1"));
     let mut z = vec![0.5; 12];
     z[7] = f32::NAN;

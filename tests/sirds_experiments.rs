@@ -1,12 +1,12 @@
 //! Issue 17, item 14: the SIRDS paper's experiments as outputs. Fig. 5's three bands, Fig. 6's
 //! centre start from an initialization texture, and the depth error of large triangles.
 
-use stereolab::effects::sirds::decode::{DecodeOptions, decode, round_trip};
-use stereolab::effects::sirds::{DisparityModel, Filter};
 use stereolab::output::sirds::{FIG5_BANDS, fig5_bands, from_frame, scene_depth};
 use stereolab::plan::Plan;
 use stereolab::render::render;
 use stereolab::scene::Scene;
+use stereolab_core::effects::sirds::decode::{DecodeOptions, decode, round_trip};
+use stereolab_core::effects::sirds::{DisparityModel, Filter};
 
 use crate::common::asset;
 

@@ -5,12 +5,12 @@
 use std::path::Path;
 use std::process::Command;
 
-use stereolab::effects::sirds::decode::{AutoDecoded, decode_auto, round_trip};
-use stereolab::effects::sirds::pair::views;
-use stereolab::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
-use stereolab::effects::sirds::search::SearchOptions;
-use stereolab::effects::sirds::{Algorithm, DisparityModel, Geometry, Pattern};
 use stereolab::output::sirds::{from_frame, scene_depth};
+use stereolab_core::effects::sirds::decode::{AutoDecoded, decode_auto, round_trip};
+use stereolab_core::effects::sirds::pair::views;
+use stereolab_core::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
+use stereolab_core::effects::sirds::search::SearchOptions;
+use stereolab_core::effects::sirds::{Algorithm, DisparityModel, Geometry, Pattern};
 
 use crate::common;
 use crate::sirds::{SPHERE, frame, sized_scene};
@@ -322,7 +322,7 @@ fn pfm(channels: usize, w: usize, rows_top_first: &[Vec<f32>], little: bool) -> 
 /// Issue 21, part 4: every format maps as docs/interop.md says, both ways round.
 #[test]
 fn depth_maps_from_any_format_map_as_documented() {
-    use stereolab::effects::sirds::depthfile::{DepthSamples, Near};
+    use stereolab_core::effects::sirds::depthfile::{DepthSamples, Near};
     let dir = common::out_dir("sirds_interop_depth");
     let z =
         |d: &DepthSamples| -> Vec<f32> { d.samples.iter().map(|&v| v as f32 / 65535.0).collect() };

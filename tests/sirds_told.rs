@@ -5,13 +5,13 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use stereolab::effects::sirds::Pattern;
-use stereolab::effects::sirds::decode::{DecodeOptions, decode, round_trip};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::output::{Image, produce};
 use stereolab::plan::{Output, Plan};
 use stereolab::render::render;
 use stereolab::scene::Scene;
+use stereolab_core::effects::sirds::Pattern;
+use stereolab_core::effects::sirds::decode::{DecodeOptions, decode, round_trip};
 
 use crate::common::{asset, out_dir};
 use crate::sirds::{SPHERE, frame, sized_scene};

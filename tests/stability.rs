@@ -2,12 +2,12 @@
 
 use glam::Vec4;
 use proptest::prelude::*;
-use stereolab::framebuffer::Framebuffer;
 use stereolab::plan::{Output, Plan, View};
-use stereolab::raster::{RasterOptions, rasterize};
 use stereolab::render::render;
 use stereolab::scene::Scene;
-use stereolab::shade::{Fragment, Shader, Varyings};
+use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::raster::{RasterOptions, rasterize};
+use stereolab_core::shade::{Fragment, Shader, Varyings};
 
 struct Clip(Vec<Vec4>);
 

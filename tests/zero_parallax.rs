@@ -2,10 +2,10 @@
 //! field-of-view advice (the StereoGraphics guide (Akka) §7–8).
 
 use glam::Vec3;
-use stereolab::effects::parallax::PARALLAX_BUDGET_PERCENT;
 use stereolab::info::{describe, horizontal_fov_degrees, scene_budget};
-use stereolab::math::ZeroParallax;
 use stereolab::scene::Scene;
+use stereolab_core::effects::parallax::PARALLAX_BUDGET_PERCENT;
+use stereolab_core::math::ZeroParallax;
 
 use crate::common::asset;
 

@@ -2,8 +2,8 @@
 //! linear light and swapped eyes.
 
 use proptest::prelude::*;
-use stereolab::Framebuffer;
-use stereolab::effects::anaglyph::{
+use stereolab_core::Framebuffer;
+use stereolab_core::effects::anaglyph::{
     AnaglyphKind, AnaglyphMatrices, AnaglyphOptions, ColorMatrix, anaglyph, anaglyph_pixel,
     linear_to_srgb, mix, srgb_to_linear,
 };

@@ -1,12 +1,12 @@
 //! Bad input to every finalize mode is a clear error, never a panic.
 
 use glam::Mat4;
-use stereolab::Framebuffer;
-use stereolab::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
-use stereolab::effects::occlusion::occlusion_image;
-use stereolab::effects::parallax::{ParallaxRig, parallax_image, parallax_image_with};
-use stereolab::effects::remap::{Precision, remap_color, remap_color_with, visibility_map};
-use stereolab::math::{Camera, StereoRig};
+use stereolab_core::Framebuffer;
+use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
+use stereolab_core::effects::occlusion::occlusion_image;
+use stereolab_core::effects::parallax::{ParallaxRig, parallax_image, parallax_image_with};
+use stereolab_core::effects::remap::{Precision, remap_color, remap_color_with, visibility_map};
+use stereolab_core::math::{Camera, StereoRig};
 
 fn fb(w: u32, h: u32) -> Framebuffer {
     Framebuffer::new(w, h, [90, 90, 90, 255]).expect("framebuffer")

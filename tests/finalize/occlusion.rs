@@ -1,14 +1,14 @@
 //! The visibility check and the occlusion map: an occluder in front of a wall marks exactly
 //! the strips the rig predicts; flat planes are never flagged; near/far ratios 10 to 1e5.
 
-use stereolab::Framebuffer;
-use stereolab::effects::occlusion::{OCCLUDED_COLOR, OUT_OF_VIEW_COLOR, occlusion_image};
-use stereolab::effects::remap::{
+use stereolab::plan::Output;
+use stereolab_core::Framebuffer;
+use stereolab_core::effects::occlusion::{OCCLUDED_COLOR, OUT_OF_VIEW_COLOR, occlusion_image};
+use stereolab_core::effects::remap::{
     DEPTH_PRECISION, Precision, Remapper, Visibility, classify, depth_slope, tolerance,
     visibility_map,
 };
-use stereolab::math::EyeMatrices;
-use stereolab::plan::Output;
+use stereolab_core::math::EyeMatrices;
 
 use super::{Rig, eyes, plane, render_outputs, scene};
 

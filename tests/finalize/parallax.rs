@@ -1,12 +1,12 @@
 //! Parallax p(z) = d (1 − z0/z) measured in rendered pairs, the budget report, the color image,
 //! the plan, the scene table, and the real-model scene.
 
-use stereolab::effects::legend::LEGEND_HEIGHT;
-use stereolab::effects::parallax::{budget_of, parallax_color, parallax_image, parallax_map};
-use stereolab::math::project_ndc;
 use stereolab::plan::{Output, Pass, Plan, Shading, View};
 use stereolab::scene::Scene;
 use stereolab::{info, output};
+use stereolab_core::effects::legend::LEGEND_HEIGHT;
+use stereolab_core::effects::parallax::{budget_of, parallax_color, parallax_image, parallax_map};
+use stereolab_core::math::project_ndc;
 
 use super::{Rig, drawn_centroid, eyes, plane, render_outputs, scene};
 
@@ -236,7 +236,7 @@ fn finalize_outputs_run_only_the_passes_they_need() {
         ),
         (
             &[Output::Anaglyph(
-                stereolab::effects::anaglyph::AnaglyphKind::DuboisRedCyan,
+                stereolab_core::effects::anaglyph::AnaglyphKind::DuboisRedCyan,
             )],
             vec![color(View::Left), color(View::Right)],
         ),

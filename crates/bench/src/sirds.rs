@@ -1,0 +1,440 @@
+//! SIRDS benchmark rows: the SIRDS paper's Table 1 (with and without the depth pass) beside the paper's
+//! frame rates, every accuracy knob with its decode error, and TIW on a 4096×3072 depth map.
+
+use std::path::Path;
+
+use super::{Row, interleaved_medians, median_ms};
+use stereolab::fixtures::{TABLE_1, scene_from_text, sphere_over_ramp, table_scene};
+use stereolab::output::sirds::{from_frame, scene_depth};
+use stereolab::plan::{Output, Plan, Shading};
+use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
+use stereolab::render::{render, render_view};
+use stereolab::scene::Scene;
+use stereolab_core::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
+use stereolab_core::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
+use stereolab_core::effects::sirds::{
+    Algorithm, DepthRange, Disparity, Filter, Pattern, PerVertexOptions, Start, depth_range,
+};
+use stereolab_core::error::Result;
+use stereolab_core::math::{EyeMatrices, StereoRig};
+
+/// The SIRDS paper's Table 1, two rows per line of the table, each rate also as a multiple of
+/// the paper's:
+/// - **depth pass + strips**: stereolab's frame with the scene's automatic depth range (a depth
+///   pass finds the nearest and farthest drawn depth, then the strip geometry and the strips;
+///   left start, bilinear, k as in the paper). Row 1 once more with the scalar loops.
+/// - **strips, range fixed**: the work the paper's frame does. Its vertex program maps each
+///   vertex's eye-space z to a disparity with constants (§4, Fig. 4: `c[2] = (0.5a, f, 0, 0)`),
+///   so the paper renders no depth pass: its frame is the random initialization and the k
+///   textured passes. Here the depth range is found once before timing and the frame is the
+///   strip geometry (the vertex program) and the strips: the second half of the full frame,
+///   so the same image.
+///
+/// The rows are timed in turns ([`interleaved_medians`]), blocks of 20 frames, every row once
+/// per round, until each has at least 300 frames: a slow spell of this shared VM (they last
+/// seconds and move a frame's time by up to 40%) then falls on every row alike instead of on
+/// whichever was being timed.
+fn table_1(iters: usize) -> Result<Vec<Row>> {
+    // Row 1 once more with the scalar loops: what the AVX2 loops bring (same bytes).
+    let scalar_row = TABLE_1[0];
+    let runs: Vec<_> = TABLE_1
+        .into_iter()
+        .map(|r| (r, true))
+        .chain(std::iter::once((scalar_row, false)))
+        .collect();
+    let mut scenes = Vec::new();
+    for &((w, h, tris, k, _), simd) in &runs {
+        let mut s = table_scene(w, h, tris, k)?;
+        s.set_simd(simd);
+        let center = StereoRig::center(&s.camera, s.aspect())?;
+        let d = s.sirds.geometry.to_pixels()?;
+        scenes.push((s, center, d));
+    }
+    let strips = |(s, center, d): &(Scene, EyeMatrices, Disparity), range: &DepthRange| {
+        let g = StripGeometry::new(s, center, range, d, false);
+        let (p, opts) = (&s.sirds.pattern, &s.sirds.per_vertex);
+        per_vertex(&g, s.width, s.height, d, p, opts, false).map(drop)
+    };
+    let range_of = |(s, center, _): &(Scene, EyeMatrices, Disparity)| {
+        let (fb, _) = render_view(s, center, Shading::DepthOnly)?;
+        depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)
+    };
+    // What is timed: each run's full frame, then each AVX2 run's strips with the range fixed.
+    let mut timed: Vec<(usize, Option<DepthRange>)> = (0..runs.len()).map(|i| (i, None)).collect();
+    for (i, &(_, simd)) in runs.iter().enumerate() {
+        if simd {
+            timed.push((i, Some(range_of(&scenes[i])?)));
+        }
+    }
+    let mut frames: Vec<Box<dyn FnMut() -> Result<()> + '_>> = timed
+        .iter()
+        .map(|&(i, range)| -> Box<dyn FnMut() -> Result<()> + '_> {
+            let scene = &scenes[i];
+            match range {
+                Some(r) => Box::new(move || strips(scene, &r)),
+                None => Box::new(move || strips(scene, &range_of(scene)?)),
+            }
+        })
+        .collect();
+    let mut fs: Vec<&mut dyn FnMut() -> Result<()>> =
+        frames.iter_mut().map(|f| &mut **f as _).collect();
+    const BLOCK: usize = 20;
+    let ms = interleaved_medians(iters.max(300).div_ceil(BLOCK), BLOCK, &mut fs)?;
+    let loops = |simd: bool| {
+        if !simd {
+            ", scalar loops"
+        } else if stereolab_core::raster::avx2_available() {
+            ", AVX2 loops"
+        } else {
+            ", scalar loops (no AVX2 here)"
+        }
+    };
+    Ok(timed
+        .iter()
+        .zip(ms)
+        .map(|(&(i, range), ms)| {
+            let ((w, h, tris, k, paper_hz), simd) = runs[i];
+            let (setting, what) = if range.is_some() {
+                (
+                    format!("{w}x{h} {tris} tris k={k}, range fixed"),
+                    "strips only (the paper's frame: no depth pass)",
+                )
+            } else {
+                (format!("{w}x{h} {tris} tris k={k}"), "depth pass + strips")
+            };
+            let hz = 1e3 / ms;
+            Row {
+                area: "sirds".into(),
+                knob: "the SIRDS paper's Table 1".into(),
+                setting,
+                error: None,
+                error_unit: String::new(),
+                ms,
+                note: format!(
+                    "{hz:.0} Hz vs paper {paper_hz} Hz (GeForce4): {:.1}x, {what}{}",
+                    hz / paper_hz,
+                    loops(simd)
+                ),
+            }
+        })
+        .collect())
+}
+
+/// The Fig. 5 ramp: a 20×20 plane (16×16 quads) turned 35° about y, 512×256, black-white
+/// dots with seed 5; the scene of every SIRDS accuracy knob.
+///
+/// # Errors
+/// None in practice (the scene text is fixed).
+pub(super) fn ramp_scene() -> Result<Scene> {
+    let mut base = scene_from_text(
+        r#"outputs = ["sirds"]
+[image]
+width = 512
+height = 256
+[camera]
+eye = [0.0, 0.0, 5.0]
+target = [0.0, 0.0, 0.0]
+fov_y = 40.0
+near = 1.0
+far = 20.0
+[[mesh]]
+kind = "plane"
+size = 20.0
+detail = 16
+rotate = [0.0, 35.0, 0.0]
+"#,
+    )?;
+    base.sirds.pattern = Pattern::BlackWhite { seed: 5 };
+    Ok(base)
+}
+
+/// Every accuracy knob on the Fig. 5 ramp at 512×256: time to make the SIRDS from the depth
+/// pass, and the decoded separation's RMS error (share within ±1 px in the note).
+fn knobs(iters: usize) -> Result<Vec<Row>> {
+    let base = ramp_scene()?;
+    let frame = render(&base, &Plan::new(&[Output::Sirds]))?;
+    let (depth, _) = scene_depth(&frame, &base)?;
+    let mut variants: Vec<(&str, String, Scene)> = Vec::new();
+    for (start, filter) in [
+        (Start::Left, Filter::Nearest),
+        (Start::Left, Filter::Bilinear),
+        (Start::Center, Filter::Nearest),
+        (Start::Center, Filter::Bilinear),
+    ] {
+        let mut s = base.clone();
+        s.sirds.per_vertex = PerVertexOptions {
+            start,
+            filter,
+            iterations: None,
+            ..PerVertexOptions::default()
+        };
+        variants.push(("strip start/filter", format!("{start:?} {filter:?}"), s));
+    }
+    for (hidden_surface, oversample) in [(false, 1), (true, 1), (true, 2), (true, 4)] {
+        let mut s = base.clone();
+        s.sirds.algorithm = Algorithm::PerPixel;
+        s.sirds.per_pixel = PerPixelOptions {
+            hidden_surface,
+            oversample,
+        };
+        variants.push((
+            "TIW hsr/oversample",
+            format!("hsr={hidden_surface} x{oversample}"),
+            s,
+        ));
+    }
+    let mut rows = Vec::new();
+    for (knob, setting, s) in variants {
+        let sirds = from_frame(&frame, &s)?;
+        let d = sirds.disparity;
+        let opts = DecodeOptions::for_disparity(&d);
+        let decoded = decode(&sirds.pixels, sirds.width, sirds.height, &opts)?;
+        let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
+        let rt = round_trip(&decoded, &intended, &opts);
+        let ms = median_ms(iters, || from_frame(&frame, &s).is_ok());
+        rows.push(Row {
+            area: "sirds".into(),
+            knob: knob.into(),
+            setting,
+            error: Some(rt.rms),
+            error_unit: "rms decoded sep, px".into(),
+            ms,
+            note: format!(
+                "ramp 512x256: {:.1}% within ±1 px, {:.1}% matched",
+                rt.within_one * 100.0,
+                rt.matched * 100.0
+            ),
+        });
+    }
+    Ok(rows)
+}
+
+/// TIW on a 4096×3072 sphere over a ramp, in memory (the whole-process comparison with netpbm's
+/// `pamstereogram` is done with hyperfine, see the issue note).
+fn large_depth_map(iters: usize) -> Result<Vec<Row>> {
+    let depth = sphere_over_ramp(4096, 3072);
+    let d = stereolab_core::effects::sirds::Geometry::default().to_pixels()?;
+    let pattern = Pattern::BlackWhite { seed: 1 };
+    let mut rows = Vec::new();
+    for hidden_surface in [false, true] {
+        let opts = PerPixelOptions {
+            hidden_surface,
+            oversample: 1,
+        };
+        per_pixel(&depth, &d, &pattern, &opts)?;
+        let ms = median_ms(iters.min(3), || {
+            per_pixel(&depth, &d, &pattern, &opts).is_ok()
+        });
+        rows.push(Row {
+            area: "sirds".into(),
+            knob: "TIW 4096x3072".into(),
+            setting: format!("hsr={hidden_surface}"),
+            error: None,
+            error_unit: String::new(),
+            ms,
+            note: format!(
+                "{:.0} Mpixel/s, in memory (no I/O)",
+                4096.0 * 3072.0 / ms / 1e3
+            ),
+        });
+    }
+    Ok(rows)
+}
+
+/// Decoding without being told the separations: a per-pixel SIRDS of a 600×300 sphere over a
+/// ramp decoded over the range its set-up produces (the old way), the full-range search
+/// alone, and search + decode; error: RMS decoded separation; note: time against the known
+/// range, in this run.
+fn decode_search(iters: usize) -> Result<Vec<Row>> {
+    use stereolab_core::effects::sirds::decode::decode_auto;
+    use stereolab_core::effects::sirds::search::{SearchOptions, search};
+    let (w, h) = (600, 300);
+    let depth = sphere_over_ramp(w, h);
+    let d = stereolab_core::effects::sirds::Geometry::default().to_pixels()?;
+    let pixels = per_pixel(
+        &depth,
+        &d,
+        &Pattern::BlackWhite { seed: 1 },
+        &PerPixelOptions::default(),
+    )?;
+    let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
+    let known = DecodeOptions::for_disparity(&d);
+    let so = SearchOptions::default();
+    let rt_known = round_trip(&decode(&pixels, w, h, &known)?, &intended, &known);
+    let auto = decode_auto(&pixels, w, h, &so)?;
+    let rt_auto = match (&auto.decoded, &auto.options) {
+        (Some(dec), Some(o)) => Some(round_trip(dec, &intended, o)),
+        _ => None,
+    };
+    let t_known = median_ms(iters, || decode(&pixels, w, h, &known).is_ok());
+    let t_search = median_ms(iters, || search(&pixels, w, h, &so).is_ok());
+    let t_auto = median_ms(iters, || decode_auto(&pixels, w, h, &so).is_ok());
+    let row = |setting: String, rt: Option<RoundTrip>, ms: f64| Row {
+        area: "sirds".into(),
+        knob: "decode 600x300".into(),
+        setting,
+        error: rt.map(|r| r.rms),
+        error_unit: "rms decoded sep, px".into(),
+        ms,
+        note: format!(
+            "{:.2}x the known range{}",
+            ms / t_known,
+            rt.map(|r| format!(", {:.1}% within ±1 px", r.within_one * 100.0))
+                .unwrap_or_default()
+        ),
+    };
+    Ok(vec![
+        row(
+            format!(
+                "known range {}..={} px",
+                known.min_separation, known.max_separation
+            ),
+            Some(rt_known),
+            t_known,
+        ),
+        row(
+            format!("search {}..={} px", so.min_separation, w / 3),
+            None,
+            t_search,
+        ),
+        row(
+            format!(
+                "search + decode (found {:?})",
+                auto.search.found.unwrap_or((0, 0))
+            ),
+            rt_auto,
+            t_auto,
+        ),
+    ])
+}
+
+/// Median wall time of `iters` runs of a whole process (stdout into `stdout`), after one
+/// warm-up run; `Err` with what failed.
+fn process_ms(
+    iters: usize,
+    program: &Path,
+    args: &[&std::ffi::OsStr],
+    stdout: &Path,
+) -> std::result::Result<f64, String> {
+    let run = || -> std::result::Result<(), String> {
+        let out = std::fs::File::create(stdout).map_err(|e| e.to_string())?;
+        let status = std::process::Command::new(program)
+            .args(args)
+            .stdout(out)
+            .stderr(std::process::Stdio::null())
+            .status()
+            .map_err(|e| format!("{}: {e}", program.display()))?;
+        if status.success() {
+            Ok(())
+        } else {
+            Err(format!("{} exited with {status}", program.display()))
+        }
+    };
+    run()?;
+    let mut times = Vec::with_capacity(iters.max(1));
+    for _ in 0..iters.max(1) {
+        let t = std::time::Instant::now();
+        run()?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times[times.len() / 2])
+}
+
+/// TIW as a whole process against netpbm's `pamstereogram` on the same 4096×3072 16-bit PGM (a
+/// sphere over a ramp), in the same run. `pamstereogram` writes a one-channel black-and-white
+/// PAM (one byte a pixel); stereolab writes the same amount as a PGM (the goal's row), and,
+/// for comparison, an RGB PPM (three bytes a pixel). All uncompressed, all to a file. Only
+/// from the `stereolab` binary (it runs itself); a row says why when it cannot measure.
+fn netpbm(iters: usize) -> Result<Vec<Row>> {
+    let dir = std::env::temp_dir().join(format!("stereolab-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| stereolab_core::Error::io(&dir, e))?;
+    let map = dir.join("sphere_over_ramp.pgm");
+    sphere_over_ramp(4096, 3072)
+        .to_image()
+        .save(&map)
+        .map_err(|e| stereolab_core::Error::io(&map, std::io::Error::other(e.to_string())))?;
+    let ours = std::env::current_exe()
+        .map_err(|e| stereolab_core::Error::io(Path::new("current_exe"), e))?;
+    let row = |setting: &str, ms: f64, note: String| Row {
+        area: "sirds".into(),
+        knob: "TIW vs pamstereogram".into(),
+        setting: setting.into(),
+        error: None,
+        error_unit: String::new(),
+        ms,
+        note,
+    };
+    let is_stereolab = ours
+        .file_stem()
+        .is_some_and(|n| n.to_string_lossy() == "stereolab");
+    let run_ours = |ext: &str| {
+        let out = dir.join(format!("ours.{ext}"));
+        let args: Vec<&std::ffi::OsStr> = vec![
+            "sirds".as_ref(),
+            "--depth".as_ref(),
+            map.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ];
+        process_ms(iters, &ours, &args, &dir.join("ours.log"))
+    };
+    let result = if is_stereolab {
+        // Interleaved, so that a slow spell of the machine does not fall on one program only.
+        run_ours("pgm").and_then(|pgm| {
+            let netpbm = process_ms(
+                iters,
+                Path::new("pamstereogram"),
+                &[map.as_os_str()],
+                &dir.join("netpbm.pam"),
+            )?;
+            Ok((pgm, netpbm, run_ours("ppm")?))
+        })
+    } else {
+        Err("only measured from the stereolab binary".into())
+    };
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(match result {
+        Ok((pgm, netpbm, ppm)) => vec![
+            row(
+                "stereolab sirds --depth (hsr) -> PGM",
+                pgm,
+                format!(
+                    "4096x3072 16-bit PGM -> 8-bit PGM (1 byte/pixel, as netpbm's), whole process; ours/netpbm time = {:.2} (goal <= 0.5)",
+                    pgm / netpbm
+                ),
+            ),
+            row(
+                "stereolab sirds --depth (hsr) -> PPM",
+                ppm,
+                format!(
+                    "4096x3072 16-bit PGM -> PPM (3 bytes/pixel), whole process; ours/netpbm time = {:.2}",
+                    ppm / netpbm
+                ),
+            ),
+            row(
+                "pamstereogram",
+                netpbm,
+                "4096x3072 16-bit PGM -> black-and-white PAM (1 byte/pixel), whole process (netpbm, plain algorithm)".into(),
+            ),
+        ],
+        Err(why) => vec![row(
+            "pamstereogram",
+            f64::NAN,
+            format!("not measured: {why}"),
+        )],
+    })
+}
+
+/// All SIRDS rows.
+///
+/// # Errors
+/// A scene or SIRDS error.
+pub fn rows(iters: usize) -> Result<Vec<Row>> {
+    let mut rows = table_1(iters)?;
+    rows.extend(knobs(iters.min(5))?);
+    rows.extend(large_depth_map(iters)?);
+    rows.extend(decode_search(iters.min(5))?);
+    rows.extend(netpbm(iters.min(5))?);
+    Ok(rows)
+}

@@ -1,0 +1,276 @@
+//! `stereolab grade batch`: every submission in a folder, graded on a bounded number of threads,
+//! one `results.json` and `report.txt` each and a `scores.csv` of all.
+//!
+//! A submission is one subfolder of the batch folder, holding the handout's layout
+//! (`<crate>/src/stubs.rs`), directly or one folder further down (`alice/ex1_stereo/src/stubs.rs`
+//! or `alice/handout/ex1_stereo/src/stubs.rs`, as an unpacked archive often is), or under
+//! `exercises/`. Only the stubs files are read. A submission that lacks a file or does not
+//! compile gets its zero in its own results; the batch goes on.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use super::report::Report;
+use super::{Exercise, GradeOptions, Limits, grade, stubs_path};
+use stereolab_core::error::{Error, Result};
+
+/// How to grade a batch.
+#[derive(Clone, Debug)]
+pub struct BatchOptions {
+    /// The folder whose subfolders are the submissions.
+    pub submissions: PathBuf,
+    /// Where the results go (`<submission>/results.json`, `<submission>/report.txt`,
+    /// `scores.csv`).
+    pub out: PathBuf,
+    /// Which exercises.
+    pub exercises: Vec<Exercise>,
+    /// Submissions graded at once (see [`max_jobs`]).
+    pub jobs: usize,
+    /// Limits of one task's subprocess.
+    pub limits: Limits,
+    /// The grader's build folder, shared by all submissions.
+    pub work: PathBuf,
+}
+
+/// The most submissions graded at once: twice the machine's cores (a grading thread waits on
+/// cargo and on its tasks' processes much of the time), at most 64.
+pub fn max_jobs() -> usize {
+    std::thread::available_parallelism()
+        .map_or(2, |n| n.get() * 2)
+        .min(64)
+}
+
+/// One submission's outcome.
+#[derive(Clone, Debug)]
+pub struct BatchEntry {
+    /// The subfolder's name.
+    pub name: String,
+    /// Its report, or why it could not be graded at all.
+    pub report: std::result::Result<Report, String>,
+}
+
+/// The folder of `submission` that holds the exercise crates: itself, or its one subfolder
+/// that does (`None` when none or several do: the report then says what is missing).
+pub fn submission_root(submission: &Path, exercises: &[Exercise]) -> Option<PathBuf> {
+    let holds = |d: &Path| {
+        exercises
+            .iter()
+            .any(|ex| stubs_path(d, *ex, false).is_file())
+    };
+    if holds(submission) {
+        return Some(submission.to_path_buf());
+    }
+    let mut found: Vec<PathBuf> = std::fs::read_dir(submission)
+        .ok()?
+        .flatten()
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_dir()))
+        .map(|e| e.path())
+        .filter(|p| holds(p))
+        .collect();
+    (found.len() == 1).then(|| found.remove(0))
+}
+
+/// The submissions: the subfolders of `dir` (hidden ones skipped), sorted by name.
+///
+/// # Errors
+/// `dir` unreadable, or a subfolder name that is not UTF-8 (it names a results folder and a CSV
+/// row).
+pub fn submissions(dir: &Path) -> Result<Vec<(String, PathBuf)>> {
+    let mut subs = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))? {
+        let entry = entry.map_err(|e| Error::io(dir, e))?;
+        if !entry.file_type().is_ok_and(|t| t.is_dir()) {
+            continue;
+        }
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else {
+            return Err(Error::invalid(
+                "submission folder",
+                entry.path().display(),
+                "its name is not UTF-8; rename it",
+            ));
+        };
+        if !name.starts_with('.') {
+            subs.push((name.to_string(), entry.path()));
+        }
+    }
+    subs.sort();
+    Ok(subs)
+}
+
+/// Grades every submission of `opts.submissions` on `opts.jobs` threads, writing each one's
+/// `results.json` and `report.txt` as it finishes and `scores.csv` at the end; `done` is called
+/// once per submission (the progress bar). Returns the entries sorted by name.
+///
+/// # Errors
+/// Bad options (no submissions, `jobs` out of range) or an unwritable results folder; a
+/// submission's own problems are its result.
+pub fn grade_batch(
+    opts: &BatchOptions,
+    done: &(dyn Fn(&BatchEntry) + Sync),
+) -> Result<Vec<BatchEntry>> {
+    if !(1..=max_jobs()).contains(&opts.jobs) {
+        return Err(Error::invalid(
+            "--jobs",
+            opts.jobs,
+            format!("must be between 1 and {} on this machine", max_jobs()),
+        ));
+    }
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    if absolute(&opts.out).starts_with(absolute(&opts.submissions)) {
+        return Err(Error::invalid(
+            "--out",
+            opts.out.display(),
+            "must lie outside the submissions folder (it would be graded as a submission)",
+        ));
+    }
+    let subs = submissions(&opts.submissions)?;
+    if subs.is_empty() {
+        return Err(Error::invalid(
+            "SUBMISSIONS_DIR",
+            opts.submissions.display(),
+            "holds no submission folders",
+        ));
+    }
+    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<BatchEntry>> = Mutex::new(Vec::with_capacity(subs.len()));
+    let failure: Mutex<Option<Error>> = Mutex::new(None);
+    std::thread::scope(|s| {
+        for _ in 0..opts.jobs.min(subs.len()) {
+            s.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some((name, dir)) = subs.get(k) else {
+                        break;
+                    };
+                    let entry = grade_one(opts, name, dir);
+                    if let Err(e) = write_entry(&opts.out, &entry) {
+                        failure
+                            .lock()
+                            .unwrap_or_else(|e| e.into_inner())
+                            .get_or_insert(e);
+                    }
+                    done(&entry);
+                    results
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .push(entry);
+                }
+            });
+        }
+    });
+    if let Some(e) = failure.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        return Err(e);
+    }
+    let mut entries = results.into_inner().unwrap_or_else(|e| e.into_inner());
+    entries.sort_by(|a, b| a.name.cmp(&b.name));
+    let csv_path = opts.out.join("scores.csv");
+    stereolab_core::files::write_bytes(
+        &csv_path,
+        scores_csv(&opts.exercises, &entries).as_bytes(),
+    )?;
+    Ok(entries)
+}
+
+fn grade_one(opts: &BatchOptions, name: &str, dir: &Path) -> BatchEntry {
+    let root = submission_root(dir, &opts.exercises).unwrap_or_else(|| dir.to_path_buf());
+    let report = super::fixture::grading_scene()
+        .and_then(|scene| {
+            grade(
+                &GradeOptions {
+                    exercises: opts.exercises.clone(),
+                    dir: root,
+                    solution: false,
+                    limits: opts.limits,
+                    out: opts.out.join(name).join("images"),
+                    work: opts.work.clone(),
+                },
+                scene,
+            )
+        })
+        .map_err(|e| e.to_string());
+    BatchEntry {
+        name: name.to_string(),
+        report,
+    }
+}
+
+/// results.json and report.txt of one submission (each written whole or not at all).
+fn write_entry(out: &Path, entry: &BatchEntry) -> Result<()> {
+    let dir = out.join(&entry.name);
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let (json, text) = match &entry.report {
+        Ok(r) => (r.gradescope(), r.text()),
+        Err(e) => (
+            serde_json::json!({
+                "score": 0.0,
+                "output": format!("not graded: {e}"),
+                "output_format": "text",
+                "visibility": "visible",
+                "tests": [],
+            }),
+            format!("not graded: {e}\n"),
+        ),
+    };
+    let json = serde_json::to_string_pretty(&json)
+        .map_err(|e| Error::io(&dir, std::io::Error::other(e)))?;
+    stereolab_core::files::write_bytes(&dir.join("results.json"), json.as_bytes())?;
+    stereolab_core::files::write_bytes(&dir.join("report.txt"), text.as_bytes())
+}
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// `submission,<ex>…,total,max,passed`, one row per entry in the order given; scores with two
+/// decimals; a submission that could not be graded has empty scores and `error` as `passed`.
+pub fn scores_csv(exercises: &[Exercise], entries: &[BatchEntry]) -> String {
+    let mut s = String::from("submission");
+    for ex in exercises {
+        let _ = write!(s, ",{}", ex.id());
+    }
+    s.push_str(",total,max,passed\n");
+    for e in entries {
+        s.push_str(&csv_field(&e.name));
+        match &e.report {
+            Ok(r) => {
+                for ex in exercises {
+                    let score = r
+                        .exercises
+                        .iter()
+                        .find(|x| x.exercise == *ex)
+                        .map_or(0.0, super::report::ExerciseResult::score);
+                    let _ = write!(s, ",{score:.2}");
+                }
+                let _ = writeln!(s, ",{:.2},{:.2},{}", r.score(), r.max(), r.passed());
+            }
+            Err(_) => {
+                for _ in exercises {
+                    s.push(',');
+                }
+                s.push_str(",,,error\n");
+            }
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_fields_with_commas_and_quotes_are_quoted() {
+        assert_eq!(csv_field("alice"), "alice");
+        assert_eq!(csv_field("a,b"), "\"a,b\"");
+        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+    }
+}

@@ -1,0 +1,284 @@
+//! `stereolab exercises export DIR`: the student handout — the exercise crates with their stubs,
+//! tests and the stereolab library (with the grader and its assets), without the solutions.
+
+use std::path::Path;
+
+use stereolab_core::error::{Error, Result};
+
+/// Lines between these markers (inclusive) are the instructor's and are dropped from the handout.
+pub(crate) const SOLUTION_BEGIN: &str = "solution-begin";
+/// See [`SOLUTION_BEGIN`].
+pub(crate) const SOLUTION_END: &str = "solution-end";
+
+/// Removes every `solution-begin` … `solution-end` block (marker lines included).
+pub(crate) fn strip_solution(text: &str) -> String {
+    let mut out = String::new();
+    let mut skipping = false;
+    for line in text.lines() {
+        if line.contains(SOLUTION_BEGIN) {
+            skipping = true;
+        } else if line.contains(SOLUTION_END) {
+            skipping = false;
+        } else if !skipping {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
+    move |e| Error::io(path, e)
+}
+
+/// Copies `from` into `to` recursively, skipping `target/` and the files `skip` refuses.
+fn copy_tree(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()> {
+    std::fs::create_dir_all(to).map_err(io(to))?;
+    for entry in std::fs::read_dir(from).map_err(io(from))? {
+        let entry = entry.map_err(io(from))?;
+        let path = entry.path();
+        if skip(&path) || entry.file_name() == "target" {
+            continue;
+        }
+        let dest = to.join(entry.file_name());
+        if path.is_dir() {
+            copy_tree(&path, &dest, skip)?;
+        } else {
+            std::fs::copy(&path, &dest).map_err(io(&path))?;
+        }
+    }
+    Ok(())
+}
+
+/// The handout workspace's build profile: no optimization and no debug info for the grader and
+/// every dependency, proc macros included. The grader's work (64×48 fixtures, a few thousand
+/// numbers per task) takes well under a second unoptimized; what a student waits for is the
+/// first build of 106 crates (docs/performance.md, "A student's first grade").
+pub(crate) const HANDOUT_PROFILE: &str = "\
+[profile.dev]
+opt-level = 0
+debug = false
+incremental = false
+
+[profile.dev.package.\"*\"]
+opt-level = 0
+debug = false
+";
+
+/// The handout's copy of stereolab's manifest and the versions its crates share: the command's
+/// package and dependencies (whose default features compile no window, GPU, zip or allocator
+/// code), without the workspace, the repository's own tests and the profiles (the handout's
+/// workspace sets them); and the `[workspace.dependencies]` table the crates inherit from,
+/// for the handout's workspace manifest.
+fn library_manifest(text: &str, path: &Path) -> Result<(String, toml::Table)> {
+    let mut table: toml::Table =
+        toml::from_str(text).map_err(|e| Error::parse(path, None, e.message().to_string()))?;
+    let shared = table
+        .remove("workspace")
+        .and_then(|w| w.get("dependencies").and_then(|d| d.as_table()).cloned())
+        .ok_or_else(|| Error::parse(path, None, "no [workspace.dependencies] table"))?;
+    table.remove("test");
+    table.remove("profile");
+    let manifest = toml::to_string(&table).map_err(|e| Error::parse(path, None, e.to_string()))?;
+    Ok((manifest, shared))
+}
+
+/// Writes the handout for the repository at `root` into `dir`:
+/// `dir/Cargo.toml` (a workspace of the three exercises, with the handout's build profile),
+/// `dir/stereolab/` (library, CLI with the grader, docs, assets), `dir/ex*/` (stubs, student tests,
+/// the grader's entry binary; no `solution.rs`, no `solution` feature), `dir/README.md`.
+///
+/// # Errors
+/// Unreadable sources or an unwritable `dir`.
+pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
+    let manifest_path = root.join("Cargo.toml");
+    let manifest = std::fs::read_to_string(&manifest_path).map_err(io(&manifest_path))?;
+    let lib = dir.join("stereolab");
+    std::fs::create_dir_all(&lib).map_err(io(&lib))?;
+    let (package, shared) = library_manifest(&manifest, &manifest_path)?;
+    std::fs::write(lib.join("Cargo.toml"), package).map_err(io(&lib))?;
+    // The command's source and the library crates it depends on.
+    copy_tree(&root.join("src"), &lib.join("src"), &|_| false)?;
+    copy_tree(&root.join("crates"), &lib.join("crates"), &|_| false)?;
+    // The crate documentation includes docs/formulas.md, and the code cites the rest.
+    copy_tree(&root.join("docs"), &lib.join("docs"), &|_| false)?;
+    // The course decks, at the handout's top level: Markdown, figures, the npm manifest and
+    // lock file to build them; not a local `npm ci` or build.
+    copy_tree(&root.join("slides"), &dir.join("slides"), &|p| {
+        p.parent() == Some(&root.join("slides"))
+            && (p.ends_with("node_modules") || p.ends_with("build"))
+    })?;
+    // The scenes with their models and terrain, and the font the library compiles in.
+    for assets in ["assets/scenes", "assets/fonts"] {
+        copy_tree(&root.join(assets), &lib.join(assets), &|_| false)?;
+    }
+    // The lock file twice: the handout's workspace resolves from it, and the grader compiles it
+    // in (every build of a submission resolves from the same versions).
+    for (from, to) in [
+        (root.join("LICENSE"), lib.join("LICENSE")),
+        (root.join("README.md"), lib.join("README.md")),
+        (root.join("Cargo.lock"), dir.join("Cargo.lock")),
+        (root.join("Cargo.lock"), lib.join("Cargo.lock")),
+    ] {
+        std::fs::copy(&from, &to).map_err(io(&from))?;
+    }
+    // The grader's templates (manifest, lib.rs, main.rs of each exercise) and exercise-api, the
+    // one crate a student's crate depends on besides glam.
+    copy_tree(
+        &root.join("exercises/exercise-api"),
+        &lib.join("exercises/exercise-api"),
+        &|_| false,
+    )?;
+    let mut members = Vec::new();
+    for ex in super::Exercise::ALL {
+        let name = ex.crate_name();
+        let from = root.join("exercises").join(name);
+        for file in ["Cargo.toml", "src/lib.rs", "src/main.rs"] {
+            let (src, dst) = (from.join(file), lib.join("exercises").join(name).join(file));
+            if let Some(parent) = dst.parent() {
+                std::fs::create_dir_all(parent).map_err(io(parent))?;
+            }
+            std::fs::copy(&src, &dst).map_err(io(&src))?;
+        }
+        let to = dir.join(name);
+        copy_tree(&from, &to, &|p| {
+            p.file_name().is_some_and(|n| n == "solution.rs")
+        })?;
+        for file in ["Cargo.toml", "src/lib.rs"] {
+            let p = to.join(file);
+            let text = std::fs::read_to_string(&p).map_err(io(&p))?;
+            let text = text.replace(
+                "path = \"../exercise-api\"",
+                "path = \"../stereolab/exercises/exercise-api\"",
+            );
+            std::fs::write(&p, strip_solution(&text)).map_err(io(&p))?;
+        }
+        members.push(name.to_string());
+    }
+    // The handout's own profile, not the repository's (which optimizes every dependency for
+    // the test suite's renders): a student compiles the grader once and grades small pictures,
+    // so compile time is what they wait for (docs/performance.md, "A student's first grade").
+    let profiles = HANDOUT_PROFILE;
+    members.push("stereolab".to_string());
+    let workspace: toml::Table = [
+        ("members", toml::Value::from(members)),
+        ("resolver", toml::Value::from("3")),
+        ("dependencies", toml::Value::Table(shared)),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
+    let workspace = toml::to_string(&toml::Table::from_iter([(
+        "workspace".to_string(),
+        toml::Value::Table(workspace),
+    )]))
+    .map_err(|e| Error::parse(&manifest_path, None, e.to_string()))?;
+    let workspace = format!("{workspace}\n{profiles}");
+    std::fs::write(dir.join("Cargo.toml"), workspace).map_err(io(dir))?;
+    std::fs::write(dir.join("README.md"), HANDOUT_README).map_err(io(dir))?;
+    // The course's own copies of the source documents (not redistributable, so not in the
+    // repository): copied in when the instructor names the folder that holds them.
+    if let Some(docs) = documents {
+        if !docs.is_dir() {
+            return Err(Error::invalid(
+                "--documents",
+                docs.display(),
+                "not a folder: name the folder holding the course's copies of the documents \
+                 listed in docs/sources.md",
+            ));
+        }
+        copy_tree(docs, &dir.join("documents"), &|_| false)?;
+    }
+    Ok(())
+}
+
+const HANDOUT_README: &str = r#"# Stereo rendering exercises
+
+Three exercises, one crate each:
+
+| crate | topic | source (see `stereolab/docs/sources.md`) | points |
+| --- | --- | --- | --- |
+| `ex1_stereo` | stereo frusta, anaglyphs, remapping, visibility, parallax, a random-dot pair | the exercise slides, *Exercise 1: Stereoscopy* | see `grade` |
+| `ex2_chromadepth` | the ChromaDepth ramp and texgen | Bailey, Clark: *Using ChromaDepth to obtain Inexpensive Single-image Stereovision for Scientific Visualization* | 5 |
+| `ex3_sirds` | single-image random-dot stereograms | Petz, Goldlücke, Magnor: *Hardware-accelerated Autostereogram Rendering for Interactive 3D Visualization* | 5 |
+
+Complete the `todo!`s in each crate's `src/stubs.rs`. Every stub's doc comment states the task,
+its points, the formula's source and the conventions (right-handed, NDC z in [-1, 1], eye
+index 0 = left).
+
+What is here:
+- `ex1_stereo/`, `ex2_chromadepth/`, `ex3_sirds/`: your crates. **Only `src/stubs.rs` is
+  graded**: the grader builds a clean copy of each crate with your `src/stubs.rs` in it, so
+  changes to other files (and added dependencies) do not reach the grade. Your crate may use
+  `glam` and `exercise_api` (the types the stubs take and return), nothing else.
+- `slides/`: the course decks (Marp Markdown), one per topic; each exercise is introduced on the
+  slide that teaches its formula. `ex1_stereo`: `01-perception.md` (parallax),
+  `02-rig.md` (frusta, stereo matrices), `03-finalize.md` (anaglyphs), `04-remap.md`
+  (remapping, visibility, the random-dot pair); `ex2_chromadepth`: `05-chromadepth.md`; `ex3_sirds`:
+  `06-sirds.md`. Read the Markdown as it is, or build HTML/PDF as `slides/README.md` says.
+- `stereolab/`: the renderer and the grader. `stereolab/docs/sources.md` names the course's
+  source documents (title, authors, where to get them); `stereolab/docs/formulas.md` collects the
+  formulas; `stereolab/docs/anaglyph-matrices.md` holds the published anaglyph matrices the
+  bonus task needs. `documents/`, when your instructor added it, holds the documents
+  themselves.
+
+## Commands
+
+```sh
+cargo test -p ex1_stereo                                  # the worked examples of the sources
+cargo run -p stereolab -- grade ex1                       # points, hints (or ex2, ex3, all)
+cargo run -p stereolab -- render --exercise ex1 stereolab/assets/scenes/wuson.toml --out out
+```
+
+**The first `cargo run -p stereolab` compiles the grader**: stereolab with its command line
+only (no viewer window, GPU path or C allocator), and its dependencies, 106 crates (the
+repository's full build has 218), unoptimized (this workspace's profile: the grader's pictures
+are small, so compiling fast matters more than running fast). Later runs start at once. Each `grade` then builds your crates in `target/stereolab-grade/` in seconds.
+
+## How points are given
+
+- Each task is checked on many inputs (the numbers, with a tolerance printed beside every
+  failure) and, where it draws something, by an image check: your function plugged into the
+  real renderer, compared with the reference picture. The image check carries 30% of the task's
+  points, the numeric checks 70%, in proportion to the inputs you get right.
+- A mistake the grader recognizes (swapped eyes, a transposed matrix, degrees for radians, …)
+  is named in a hint. When every failing answer matches such a mistake, the task scores 0: the
+  formula is wrong, not an input.
+- The instructor may grade extra hidden inputs beside the ones you see.
+- A task whose function panics, loops (killed after 10 s), crashes or runs out of memory
+  (1 GiB) loses that task only.
+- Bonus tasks add points beyond the total.
+- Passing: at least 50% of all points and at least 2 points in each exercise.
+
+## Printing while you debug
+
+`println!` and `eprintln!` are fine: the grader shows the first lines of what each task printed
+and never reads it as an answer. Printing a lot slows a task down; remove it when you are done.
+
+## Pictures
+
+`grade` writes `expected | diff | actual` strips of failing image checks to `grade-out/`
+(cleared at each run). Open them next to the ASCII maps it prints.
+"#;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_handout_profile_compiles_everything_unoptimized_without_debug_info() {
+        let t: toml::Table = toml::from_str(HANDOUT_PROFILE).unwrap();
+        let dev = &t["profile"]["dev"];
+        let deps = &dev["package"]["*"];
+        for p in [dev, deps] {
+            assert_eq!(p["opt-level"].as_integer(), Some(0), "{t}");
+            assert_eq!(p["debug"].as_bool(), Some(false), "{t}");
+        }
+    }
+
+    #[test]
+    fn strip_solution_drops_marked_blocks_with_their_markers() {
+        let text = "a\n# solution-begin\n[features]\nsolution = []\n# solution-end\nb\n";
+        assert_eq!(strip_solution(text), "a\nb\n");
+    }
+}

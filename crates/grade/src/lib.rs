@@ -1,0 +1,315 @@
+//! The auto-grader: builds a student's exercise crate, runs each task in a subprocess, scores it
+//! with partial credit against the reference, and reports (points table, the course's passing
+//! verdict, hints naming the likely mistake, Gradescope JSON).
+//!
+//! Protocol: see [`crate::exercise::protocol`]. A task's inputs go to `<crate binary> <task>`
+//! in one subprocess; a panic costs that input, an endless loop the task (the child is killed
+//! after the time limit), NaN the inputs it spoils. The grader itself never panics on an answer.
+
+pub mod batch;
+pub(crate) mod build;
+pub mod bundle;
+pub(crate) mod child;
+pub mod ex1;
+pub mod ex2;
+pub mod ex3;
+pub mod exercise;
+pub mod export;
+pub mod fixture;
+#[cfg(feature = "gpu")]
+pub mod gpu_compare;
+pub mod report;
+pub mod score;
+pub mod spec;
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+pub use child::Limits;
+use fixture::Fixture;
+use report::{ExerciseResult, Report};
+use score::TaskResult;
+use spec::TaskSpec;
+use stereolab::compare::{compare, write_diff_strip};
+use stereolab::scene::Scene;
+use stereolab_core::error::{Error, Result};
+
+/// The exercises of the course.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exercise {
+    /// Stereo frusta, anaglyphs, remapping, parallax (the exercise slides).
+    Ex1,
+    /// ChromaDepth (the ChromaDepth article).
+    Ex2,
+    /// SIRDS (the SIRDS paper (Petz et al.)).
+    Ex3,
+}
+
+impl Exercise {
+    /// All, in course order.
+    pub const ALL: [Exercise; 3] = [Exercise::Ex1, Exercise::Ex2, Exercise::Ex3];
+
+    /// `ex1`, `ex2`, `ex3`.
+    pub(crate) fn id(self) -> &'static str {
+        match self {
+            Exercise::Ex1 => "ex1",
+            Exercise::Ex2 => "ex2",
+            Exercise::Ex3 => "ex3",
+        }
+    }
+
+    /// The crate (and its binary) under `exercises/`.
+    pub(crate) fn crate_name(self) -> &'static str {
+        match self {
+            Exercise::Ex1 => "ex1_stereo",
+            Exercise::Ex2 => "ex2_chromadepth",
+            Exercise::Ex3 => "ex3_sirds",
+        }
+    }
+
+    /// `ex1`, `ex2`, `ex3` or `all`.
+    ///
+    /// # Errors
+    /// Any other name.
+    pub fn parse_list(name: &str) -> Result<Vec<Exercise>> {
+        if name == "all" {
+            return Ok(Exercise::ALL.to_vec());
+        }
+        Exercise::ALL
+            .into_iter()
+            .find(|e| e.id() == name)
+            .map(|e| vec![e])
+            .ok_or_else(|| Error::invalid("exercise", name, "expected ex1, ex2, ex3 or all"))
+    }
+
+    /// The tasks, with reference answers computed for `fx`.
+    pub(crate) fn tasks(self, fx: &Fixture) -> Vec<TaskSpec> {
+        match self {
+            Exercise::Ex1 => ex1::tasks(fx),
+            Exercise::Ex2 => ex2::tasks(fx),
+            Exercise::Ex3 => ex3::tasks(fx),
+        }
+    }
+}
+
+/// How to grade.
+#[derive(Clone, Debug)]
+pub struct GradeOptions {
+    /// Which exercises.
+    pub exercises: Vec<Exercise>,
+    /// The submission: a folder holding `<crate>/src/stubs.rs` for each exercise (the handout's
+    /// layout; `exercises/` of the repository). Only those files are taken from it.
+    pub dir: PathBuf,
+    /// Grade `<crate>/src/solution.rs` instead of the stubs (the instructor's solution).
+    pub solution: bool,
+    /// Limits of one task's subprocess.
+    pub limits: Limits,
+    /// Where diff images of failing image checks go.
+    pub out: PathBuf,
+    /// The grader's build folder (shared compiled dependencies, one folder per build).
+    pub work: PathBuf,
+}
+
+/// Removes the pictures an earlier run left in `out` (`ex1_….png` and the like: only the
+/// grader's own names, never anything else in the folder).
+fn clear_old_pictures(out: &Path) {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        let ours = Exercise::ALL
+            .iter()
+            .any(|ex| name.starts_with(&format!("{}_", ex.id())))
+            && name.ends_with(".png");
+        if ours && e.file_type().is_ok_and(|t| t.is_file()) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// The build folder when none is given: `$CARGO_TARGET_DIR/stereolab-grade`, else
+/// `target/stereolab-grade`.
+pub fn default_work_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| PathBuf::from("target"), PathBuf::from)
+        .join("stereolab-grade")
+}
+
+/// The file of `ex` a submission in `dir` provides: `<crate>/src/stubs.rs` (or `solution.rs`),
+/// also looked for under `exercises/`.
+pub(crate) fn stubs_path(dir: &Path, ex: Exercise, solution: bool) -> PathBuf {
+    let file = if solution { "solution.rs" } else { "stubs.rs" };
+    let direct = dir.join(ex.crate_name()).join("src").join(file);
+    let nested = dir
+        .join("exercises")
+        .join(ex.crate_name())
+        .join("src")
+        .join(file);
+    if !direct.is_file() && nested.is_file() {
+        nested
+    } else {
+        direct
+    }
+}
+
+/// Builds the binary of `ex` from the submission in `dir` (see [`build`]); `Err` is what to
+/// tell the student: the compiler's messages, or the file that is missing.
+pub(crate) fn submission_binary(
+    dir: &Path,
+    ex: Exercise,
+    solution: bool,
+    work: &Path,
+) -> std::result::Result<PathBuf, String> {
+    let path = stubs_path(dir, ex, solution);
+    let stubs = stereolab_core::files::read_text(&path, build::MAX_STUBS_BYTES).map_err(|e| {
+        if solution && !path.exists() {
+            format!(
+                "no {} here: the instructor's solution is not part of a handout ({e})",
+                path.display()
+            )
+        } else {
+            format!("the submission's {}: {e}", path.display())
+        }
+    })?;
+    let sources = build::Sources::new(ex, stubs)?;
+    build::build(ex, &sources, work)
+}
+
+/// The exercises folder: `given`, else `./exercises`, else `.` when it holds `ex1_stereo`.
+///
+/// # Errors
+/// No such folder.
+pub fn exercises_dir(given: Option<PathBuf>) -> Result<PathBuf> {
+    let candidates = match given {
+        Some(g) => vec![g],
+        None => vec![PathBuf::from("exercises"), PathBuf::from(".")],
+    };
+    candidates
+        .iter()
+        .find(|d| {
+            Exercise::ALL
+                .iter()
+                .any(|ex| stubs_path(d, *ex, false).is_file())
+        })
+        .cloned()
+        .ok_or_else(|| {
+            Error::invalid(
+                "--exercises",
+                candidates[0].display(),
+                "no exercise there (expected ex1_stereo/src/stubs.rs, ex2_chromadepth/src/stubs.rs \
+                 or ex3_sirds/src/stubs.rs)",
+            )
+        })
+}
+
+fn inputs_of(spec: &TaskSpec) -> Vec<Value> {
+    let mut v: Vec<Value> = spec.cases.iter().map(|c| c.input.clone()).collect();
+    if let Some(img) = &spec.image {
+        v.extend(img.inputs.iter().cloned());
+    }
+    v.extend(spec.hidden.iter().map(|c| c.input.clone()));
+    v
+}
+
+/// Grades `opts.exercises` on `scene` (the image checks' scene; normally
+/// [`fixture::grading_scene`]).
+///
+/// # Errors
+/// Only setup problems (an exercise crate missing, the scene invalid): a student's compile
+/// error, panic, endless loop or NaN is a result in the report.
+pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
+    let fx = Fixture::new(scene)?;
+    child::become_subreaper();
+    clear_old_pictures(&opts.out);
+    let mut exercises = Vec::new();
+    for &ex in &opts.exercises {
+        let specs = ex.tasks(&fx);
+        let result = match submission_binary(&opts.dir, ex, opts.solution, &opts.work) {
+            Err(log) => ExerciseResult {
+                exercise: ex,
+                build_error: Some(log),
+                tasks: specs
+                    .iter()
+                    .map(|s| TaskResult::not_built(ex.id(), s))
+                    .collect(),
+            },
+            Ok(binary) => {
+                let mut tasks: Vec<TaskResult> = specs
+                    .iter()
+                    .map(|s| {
+                        let run = child::run(&binary, s.name, &inputs_of(s), opts.limits);
+                        score::evaluate(ex.id(), s, &run, &opts.out)
+                    })
+                    .collect();
+                score::blame_dependencies(&specs, &mut tasks);
+                ExerciseResult {
+                    exercise: ex,
+                    build_error: None,
+                    tasks,
+                }
+            }
+        };
+        exercises.push(result);
+    }
+    Ok(Report { exercises })
+}
+
+/// `stereolab render --exercise`: runs the image checks of `ex` on `scene` and writes, for every
+/// picture, `expected | diff | actual` (the reference next to the student's result) to `out`.
+/// Returns one line per picture (metrics and path).
+///
+/// # Errors
+/// A missing crate, a compile error (with the compiler's messages), an unwritable folder.
+pub fn render_exercise(
+    ex: Exercise,
+    scene: Scene,
+    dir: &Path,
+    solution: bool,
+    limits: Limits,
+    out: &Path,
+) -> Result<Vec<String>> {
+    let fx = Fixture::new(scene)?;
+    child::become_subreaper();
+    let binary = submission_binary(dir, ex, solution, &default_work_dir())
+        .map_err(|log| Error::invalid(ex.crate_name(), "cannot be built", log))?;
+    let mut lines = Vec::new();
+    for spec in ex.tasks(&fx) {
+        let Some(img) = &spec.image else { continue };
+        let run = child::run(&binary, spec.name, &img.inputs, limits);
+        let answers: Vec<Option<Vec<f64>>> = (0..img.inputs.len())
+            .map(|k| run.replies.get(k).and_then(|r| r.as_ref().ok().cloned()))
+            .collect();
+        for p in (img.build)(&answers) {
+            let m = compare(&p.expected, &p.actual)?;
+            let path = write_diff_strip(&p.expected, &p.actual, out, &p.name)?;
+            lines.push(format!(
+                "{:<34} coverage mismatch {:>6.2}%, mean channel difference {:>6.2}: {} (reference | diff | yours)",
+                p.name,
+                m.coverage_mismatch_percent(),
+                m.mean_channel_diff,
+                path.display()
+            ));
+        }
+        if let Some(e) = &run.ending {
+            lines.push(format!("{}: your program {}", spec.name, e.message));
+        }
+        let panics: Vec<&String> = run
+            .replies
+            .iter()
+            .filter_map(|r| r.as_ref().err())
+            .collect();
+        if let Some(first) = panics.first() {
+            lines.push(format!(
+                "{}: {} of {} inputs panicked, e.g. {}",
+                spec.name,
+                panics.len(),
+                img.inputs.len(),
+                first.chars().take(120).collect::<String>()
+            ));
+        }
+    }
+    Ok(lines)
+}

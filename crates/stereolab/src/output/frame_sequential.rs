@@ -1,0 +1,103 @@
+//! The `frame_sequential` output: the two eye back buffers (`BACK_LEFT`, `BACK_RIGHT`) as an
+//! animated PNG (APNG) that alternates them at the scene's rate, what a shutter-glasses display
+//! shows ([`stereolab_core::effects::frame_sequential`] is the schedule).
+//!
+//! APNG stores each frame's duration as a fraction `delay_num / delay_den` seconds (`fcTL`), so
+//! 1/120 s is exact (GIF's centiseconds could not say it). The file loops forever
+//! (`num_plays = 0`); a viewer that cannot keep up with the rate shows it slower, but the file
+//! states it. Viewers without APNG support show the first frame, the left eye.
+
+use image::RgbaImage;
+
+use crate::render::Frame;
+use stereolab_core::effects::frame_sequential::{Field, FrameSequentialSettings};
+use stereolab_core::error::{Error, Result};
+use stereolab_core::framebuffer::DrawBuffer;
+
+/// Both eyes and the order and durations they are shown in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameSequence {
+    /// `BACK_LEFT`: the left eye's image.
+    pub left: RgbaImage,
+    /// `BACK_RIGHT`: the right eye's image (same size).
+    pub right: RgbaImage,
+    /// The fields in display order.
+    pub fields: Vec<Field>,
+}
+
+impl FrameSequence {
+    /// The sequence of `frame`'s two eye buffers under `settings`.
+    ///
+    /// # Errors
+    /// An eye was not rendered (a plan bug), or settings out of range.
+    pub fn from_frame(frame: &Frame, settings: &FrameSequentialSettings) -> Result<FrameSequence> {
+        let buffer = |b: DrawBuffer| {
+            frame
+                .draw_buffer(b)
+                .map(|fb| fb.to_rgba_image())
+                .ok_or_else(|| {
+                    Error::internal(
+                        "plan",
+                        format!("frame_sequential: {} was not rendered", b.gl_name()),
+                    )
+                })
+        };
+        Ok(FrameSequence {
+            left: buffer(DrawBuffer::BackLeft)?,
+            right: buffer(DrawBuffer::BackRight)?,
+            fields: settings.fields()?,
+        })
+    }
+
+    /// The image shown in `field`.
+    pub fn image(&self, field: &Field) -> &RgbaImage {
+        match field.buffer {
+            DrawBuffer::BackLeft => &self.left,
+            DrawBuffer::BackRight => &self.right,
+        }
+    }
+
+    /// The APNG file's bytes: one full-size frame per field, each with its delay, looping
+    /// forever.
+    ///
+    /// # Errors
+    /// Different eye sizes, no fields, or an encoder error.
+    pub fn encode(&self) -> Result<Vec<u8>> {
+        if self.left.dimensions() != self.right.dimensions() {
+            return Err(Error::invalid(
+                "frame_sequential",
+                format!(
+                    "{:?} and {:?}",
+                    self.left.dimensions(),
+                    self.right.dimensions()
+                ),
+                "both eyes must have the same size",
+            ));
+        }
+        let n = u32::try_from(self.fields.len())
+            .ok()
+            .filter(|&n| n > 0)
+            .ok_or_else(|| Error::internal("frame_sequential", "no fields to write"))?;
+        let png_err =
+            |e: png::EncodingError| Error::internal("frame_sequential APNG", e.to_string());
+        let mut bytes = Vec::new();
+        {
+            let (w, h) = self.left.dimensions();
+            let mut enc = png::Encoder::new(&mut bytes, w, h);
+            enc.set_color(png::ColorType::Rgba);
+            enc.set_depth(png::BitDepth::Eight);
+            enc.set_animated(n, 0).map_err(png_err)?;
+            let mut writer = enc.write_header().map_err(png_err)?;
+            for field in &self.fields {
+                writer
+                    .set_frame_delay(field.delay_num, field.delay_den)
+                    .map_err(png_err)?;
+                writer
+                    .write_image_data(self.image(field).as_raw())
+                    .map_err(png_err)?;
+            }
+            writer.finish().map_err(png_err)?;
+        }
+        Ok(bytes)
+    }
+}

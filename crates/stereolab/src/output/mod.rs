@@ -1,0 +1,298 @@
+//! Turns a rendered [`Frame`] into the images the scene asked for, and writes them.
+
+pub mod animate;
+pub mod chromadepth;
+pub mod frame_sequential;
+pub mod report;
+pub mod shear_rotate;
+pub mod sirds;
+pub mod stereo_photo;
+
+use std::path::{Path, PathBuf};
+
+use crate::plan::{Output, View};
+use crate::render::Frame;
+use crate::scene::Scene;
+use stereo_photo::{PhotoFormat, RigMetadata, StereoPhoto};
+use stereolab_core::effects::parallax::parallax_image;
+use stereolab_core::effects::remap::{Precision, remap_color};
+use stereolab_core::effects::{anaglyph, calibration, ghosting, layout, occlusion, rds};
+use stereolab_core::error::{Error, Result};
+use stereolab_core::files;
+use stereolab_core::framebuffer::Framebuffer;
+
+/// One finished output image.
+pub enum Image {
+    /// 8-bit RGBA.
+    Rgba(image::RgbaImage),
+    /// 16-bit grayscale (depth).
+    Gray16(image::ImageBuffer<image::Luma<u16>, Vec<u16>>),
+    /// Both eyes in a stereo photo format (MPO, JPS, PNS), encoded when saved.
+    Stereo(stereo_photo::StereoPhoto),
+    /// Both eyes alternating in time (`frame_sequential`), an animated PNG when saved.
+    Sequence(frame_sequential::FrameSequence),
+}
+
+impl Image {
+    /// Writes the image as PNG (a stereo photo in its own format), all or nothing
+    /// ([`files::write_atomic`]).
+    ///
+    /// # Errors
+    /// The file cannot be written, or its name is a link or a special file.
+    pub fn save_png(&self, path: &Path) -> Result<()> {
+        match self {
+            Image::Rgba(i) => files::write_png(path, i),
+            Image::Gray16(i) => files::write_png(path, i),
+            Image::Stereo(photo) => files::write_bytes(path, &photo.encode()?),
+            Image::Sequence(seq) => files::write_bytes(path, &seq.encode()?),
+        }
+    }
+
+    /// The image as 8-bit RGBA for a screen or a page: 16-bit depth by its high byte, a stereo
+    /// photo as its file shows it (cross-eyed: the right eye on the left).
+    pub fn to_display_rgba(&self) -> image::RgbaImage {
+        match self {
+            Image::Rgba(i) => i.clone(),
+            Image::Gray16(g) => image::RgbaImage::from_fn(g.width(), g.height(), |x, y| {
+                let v = (g.get_pixel(x, y).0[0] >> 8) as u8;
+                image::Rgba([v, v, v, 255])
+            }),
+            Image::Stereo(p) => {
+                let w = p.left.width();
+                let mut out = image::RgbaImage::new(2 * w, p.left.height());
+                image::imageops::replace(&mut out, &p.right, 0, 0);
+                image::imageops::replace(&mut out, &p.left, i64::from(w), 0);
+                out
+            }
+            // The fields side by side in display order (L | R | …), as a film strip.
+            Image::Sequence(s) => {
+                let w = s.left.width();
+                let mut out = image::RgbaImage::new(w * s.fields.len() as u32, s.left.height());
+                for (i, f) in s.fields.iter().enumerate() {
+                    image::imageops::replace(&mut out, s.image(f), i64::from(w) * i as i64, 0);
+                }
+                out
+            }
+        }
+    }
+
+    /// Width and height of [`Image::to_display_rgba`].
+    pub fn display_size(&self) -> (u32, u32) {
+        match self {
+            Image::Rgba(i) => i.dimensions(),
+            Image::Gray16(i) => i.dimensions(),
+            Image::Stereo(p) => (2 * p.left.width(), p.left.height()),
+            Image::Sequence(s) => (s.left.width() * s.fields.len() as u32, s.left.height()),
+        }
+    }
+}
+
+fn need(frame: &Frame, view: View, output: Output) -> Result<&Framebuffer> {
+    frame.view(view).ok_or_else(|| {
+        Error::internal(
+            "plan",
+            format!("{}: the {view:?} pass was not run", output.name()),
+        )
+    })
+}
+
+/// Produces `output` from `frame`.
+///
+/// # Errors
+/// A pass the output needs is missing from the frame (a plan bug), or a layout error.
+pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
+    let eye = |v| need(frame, v, output);
+    Ok(match output {
+        Output::Left => Image::Rgba(eye(View::Left)?.to_rgba_image()),
+        Output::Right => Image::Rgba(eye(View::Right)?.to_rgba_image()),
+        Output::LeftDepth => Image::Gray16(eye(View::Left)?.depth_image()),
+        Output::RightDepth => Image::Gray16(eye(View::Right)?.depth_image()),
+        Output::SideBySide => {
+            Image::Rgba(layout::side_by_side(eye(View::Left)?, eye(View::Right)?)?)
+        }
+        Output::CrossEyed => {
+            Image::Rgba(layout::side_by_side(eye(View::Right)?, eye(View::Left)?)?)
+        }
+        Output::AboveBelow => {
+            Image::Rgba(layout::above_below(eye(View::Left)?, eye(View::Right)?)?)
+        }
+        Output::AboveBelowSquashed => Image::Rgba(layout::above_below_squashed(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            scene.blank_interval,
+        )?),
+        Output::InterlacedRows => Image::Rgba(layout::interleave(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            |_, y| y % 2 == 0,
+        )?),
+        Output::InterlacedColumns => Image::Rgba(layout::interleave(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            |x, _| x % 2 == 0,
+        )?),
+        Output::Checkerboard => Image::Rgba(layout::interleave(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            |x, y| (x + y) % 2 == 0,
+        )?),
+        Output::ChromaDepth
+        | Output::ChromaDepthLeft
+        | Output::ChromaDepthRight
+        | Output::ChromaDepthAnaglyph => {
+            Image::Rgba(chromadepth::produce(output, frame, &scene.chromadepth)?.to_rgba_image())
+        }
+        Output::Anaglyph(kind) => Image::Rgba(anaglyph::anaglyph(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            kind,
+            scene.finalize,
+        )?),
+        Output::RemapLeft => Image::Rgba(remap_color(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            &frame.eyes[0].mvp,
+            &frame.eyes[1].mvp,
+            Precision::default(),
+        )?),
+        Output::RemapRight => Image::Rgba(remap_color(
+            eye(View::Right)?,
+            eye(View::Left)?,
+            &frame.eyes[1].mvp,
+            &frame.eyes[0].mvp,
+            Precision::default(),
+        )?),
+        Output::Occlusion => Image::Rgba(occlusion::occlusion_image(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            [&frame.eyes[0].mvp, &frame.eyes[1].mvp],
+            Precision::default(),
+        )?),
+        Output::Parallax => Image::Rgba(parallax_image(eye(View::Left)?, &scene.parallax_rig()?)?),
+        Output::RdsLeft => Image::Rgba(rds::rds_left(scene.width, scene.height, &scene.rds)),
+        Output::RdsRight => Image::Rgba(rds_right(frame, scene, output)?),
+        Output::RdsAnaglyph => {
+            let left = rds::as_framebuffer(&rds::rds_left(scene.width, scene.height, &scene.rds));
+            let right = rds::as_framebuffer(&rds_right(frame, scene, output)?);
+            Image::Rgba(anaglyph::anaglyph(
+                &left,
+                &right,
+                anaglyph::AnaglyphKind::Gray,
+                scene.finalize,
+            )?)
+        }
+        Output::FrameSequential => Image::Sequence(frame_sequential::FrameSequence::from_frame(
+            frame,
+            &scene.frame_sequential,
+        )?),
+        Output::GhostingLeft => Image::Rgba(ghosting::ghosted(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            &scene.ghosting,
+        )?),
+        Output::GhostingRight => Image::Rgba(ghosting::ghosted(
+            eye(View::Right)?,
+            eye(View::Left)?,
+            &scene.ghosting,
+        )?),
+        Output::AboveBelowCalibration => Image::Rgba(calibration::calibration_screen(
+            scene.width,
+            scene.height,
+            scene.blank_interval,
+        )?),
+        Output::Sirds => Image::Rgba(sirds::from_frame(frame, scene)?.to_rgba_image()),
+        Output::SirdsDepth => Image::Gray16(sirds::scene_depth(frame, scene)?.0.to_image()),
+        Output::ShearVsRotate => Image::Rgba(shear_rotate::shear_vs_rotate(frame)?.0),
+        Output::SirdsFig5 => Image::Rgba(sirds::fig5_bands(frame, scene)?.to_rgba_image()),
+        Output::Mpo | Output::Jps | Output::Pns => {
+            let format = match output {
+                Output::Mpo => PhotoFormat::Mpo,
+                Output::Jps => PhotoFormat::Jps,
+                _ => PhotoFormat::Pns,
+            };
+            Image::Stereo(StereoPhoto {
+                format,
+                left: eye(View::Left)?.to_rgba_image(),
+                right: eye(View::Right)?.to_rgba_image(),
+                rig: Some(rig_metadata(scene)?),
+            })
+        }
+    })
+}
+
+/// The right image of the random-dot pair from the frame's two depth passes.
+fn rds_right(frame: &Frame, scene: &Scene, output: Output) -> Result<image::RgbaImage> {
+    rds::rds_right(
+        need(frame, View::Left, output)?,
+        need(frame, View::Right, output)?,
+        &frame.eyes[0].mvp,
+        &frame.eyes[1].mvp,
+        &scene.rds,
+    )
+}
+
+/// The MPO's baseline and convergence from the scene's rig: the resolved eye separation, and
+/// the angle between the optical axes — `2 atan((d/2)/z0)` for toe-in (the SGI course notes'
+/// rotation of each eye towards the fusion point), 0 for off-axis, parallel and image-shift
+/// (parallel axes).
+///
+/// # Errors
+/// As [`StereoRig::resolve`](stereolab_core::math::StereoRig::resolve).
+pub fn rig_metadata(scene: &Scene) -> Result<RigMetadata> {
+    use stereolab_core::math::CameraMode;
+    let r = scene.rig.resolve(&scene.camera, scene.aspect())?;
+    let convergence_deg = match scene.rig.mode {
+        CameraMode::ToeIn => {
+            2.0 * (r.eye_separation / 2.0 / r.zero_parallax_distance)
+                .atan()
+                .to_degrees()
+        }
+        CameraMode::OffAxis | CameraMode::Parallel | CameraMode::ImageShift => 0.0,
+    };
+    Ok(RigMetadata {
+        baseline: r.eye_separation,
+        convergence_deg,
+    })
+}
+
+/// Produces and writes every requested output as `DIR/<name>.png` (`.mpo`, `.jps`, `.pns` for
+/// the stereo photo formats); returns the paths.
+///
+/// # Errors
+/// The folder cannot be created, or an output fails.
+pub fn write_all(frame: &Frame, scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
+    write_all_with(frame, dir, |o| produce(o, frame, scene))
+}
+
+/// Writes every output of `frame`'s plan, made by `make`, as `DIR/<name>.png`, in plan order;
+/// returns the paths. [`write_all`] makes them with [`produce`]; the GPU backend with its
+/// WGSL passes.
+///
+/// # Errors
+/// The folder cannot be created, or an output fails.
+pub fn write_all_with(
+    frame: &Frame,
+    dir: &Path,
+    mut make: impl FnMut(Output) -> Result<Image>,
+) -> Result<Vec<PathBuf>> {
+    // Every output is made (and every final name checked) before any is written: an output
+    // that fails leaves the folder as it was.
+    let outputs = frame
+        .plan
+        .outputs
+        .iter()
+        .map(|&o| {
+            let path = dir.join(o.file_name());
+            files::check_output_path(&path)?;
+            Ok((path, make(o)?))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    outputs
+        .into_iter()
+        .map(|(path, image)| {
+            image.save_png(&path)?;
+            Ok(path)
+        })
+        .collect()
+}

@@ -1,0 +1,302 @@
+//! The scene's SIRDS from a rendered frame: the cyclopean depth pass, the scene's depth range,
+//! and the algorithm the scene chose (the strips pass or TIW), guide dots last; and the SIRDS
+//! files (PNG or PPM, streamed for large depth maps).
+
+use std::path::Path;
+
+use crate::plan::View;
+use crate::render::Frame;
+use crate::render::sirds_strips::{self, StripGeometry, StripResult};
+use crate::scene::Scene;
+use stereolab_core::effects::sirds::depthfile::{DepthMapping, DepthSamples, Near, PgmRows};
+use stereolab_core::effects::sirds::{
+    Algorithm, DepthMap, DepthRange, Disparity, DisparityModel, Filter, Settings, Sirds,
+    depth_range, pattern, per_pixel,
+};
+use stereolab_core::error::{Error, Result};
+use stereolab_core::files;
+use stereolab_core::framebuffer::Framebuffer;
+
+/// The cyclopean depth pass of `frame`.
+fn depth_pass(frame: &Frame) -> Result<&Framebuffer> {
+    frame.view(View::Center).ok_or_else(|| {
+        Error::internal(
+            "plan",
+            "sirds: the Center depth pass was not run (a SIRDS needs it)",
+        )
+    })
+}
+
+/// The depth map a SIRDS of `frame` encodes (output `sirds_depth`).
+///
+/// # Errors
+/// No center pass in the frame, or an invalid depth range.
+pub fn scene_depth(frame: &Frame, scene: &Scene) -> Result<(DepthMap, DepthRange)> {
+    let fb = depth_pass(frame)?;
+    let (near, far) = (scene.camera.near, scene.camera.far);
+    let range = depth_range(&scene.sirds, fb, near, far)?;
+    Ok((DepthMap::from_framebuffer(fb, near, far, &range), range))
+}
+
+/// Makes the scene's SIRDS from its depth pass (output `sirds`) with the algorithm the scene
+/// chose; adds guide dots if asked.
+///
+/// # Errors
+/// As [`scene_depth`], [`per_pixel::per_pixel`] and [`sirds_strips::per_vertex`].
+pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
+    let s = &scene.sirds;
+    from_frame_with(frame, scene, |g, d| {
+        sirds_strips::per_vertex(
+            g,
+            scene.width,
+            scene.height,
+            d,
+            &s.pattern,
+            &s.per_vertex,
+            false,
+        )
+    })
+}
+
+/// The three variants of the SIRDS paper's Fig. 5, top to bottom: eq. 3 (constant eye
+/// distance) with bilinear filtering, eq. 1 (constant viewing direction) bilinear, eq. 3 with
+/// nearest filtering ("without texture interpolation, discrete depth layers are visible").
+pub const FIG5_BANDS: [(DisparityModel, Filter); 3] = [
+    (DisparityModel::EyeDistance, Filter::Bilinear),
+    (DisparityModel::ViewAngle, Filter::Bilinear),
+    (DisparityModel::EyeDistance, Filter::Nearest),
+];
+
+/// Output `sirds_fig5`: the scene's per-vertex SIRDS made three times from the one depth pass,
+/// once per [`FIG5_BANDS`] variant (the scene's other `[sirds]` settings kept), each
+/// contributing a third of the rows (band `k`: rows `k·H/3 .. (k+1)·H/3`). On the ramp scene
+/// (`sirds_fig5.toml`) it is the paper's figure. `disparity` is the top band's.
+///
+/// # Errors
+/// As [`from_frame`].
+pub fn fig5_bands(frame: &Frame, scene: &Scene) -> Result<Sirds> {
+    let (w, h) = (scene.width as usize, scene.height as usize);
+    let mut bands = Vec::with_capacity(3);
+    for (model, filter) in FIG5_BANDS {
+        let mut s = scene.clone();
+        s.sirds.algorithm = Algorithm::PerVertex;
+        s.sirds.geometry.model = model;
+        s.sirds.per_vertex.filter = filter;
+        bands.push(from_frame(frame, &s)?);
+    }
+    let mut out = bands[0].clone();
+    for (k, band) in bands.iter().enumerate() {
+        let rows = k * h / 3..(k + 1) * h / 3;
+        out.pixels[rows.start * w..rows.end * w]
+            .copy_from_slice(&band.pixels[rows.start * w..rows.end * w]);
+    }
+    out.iterations = None;
+    Ok(out)
+}
+
+/// [`from_frame`] with the per-vertex strips made by `strips` from the strip geometry and the
+/// disparity (the CPU's [`sirds_strips::per_vertex`], or the GPU's ping-pong); everything else
+/// (depth range, TIW, guide dots) is the same for both.
+///
+/// # Errors
+/// As [`from_frame`], and whatever `strips` returns.
+pub fn from_frame_with(
+    frame: &Frame,
+    scene: &Scene,
+    strips: impl FnOnce(&StripGeometry, &Disparity) -> Result<StripResult>,
+) -> Result<Sirds> {
+    let s = &scene.sirds;
+    let (depth, range) = scene_depth(frame, scene)?;
+    let d = s.geometry.to_pixels()?;
+    let (mut pixels, iterations) = match s.algorithm {
+        Algorithm::PerPixel => {
+            let encoded = if s.cross_eyed {
+                depth.inverted()
+            } else {
+                depth.clone()
+            };
+            (
+                per_pixel::per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?,
+                None,
+            )
+        }
+        Algorithm::PerVertex => {
+            let g = StripGeometry::new(scene, &frame.center, &range, &d, s.cross_eyed);
+            let r = strips(&g, &d)?;
+            (r.pixels, Some(r.iterations))
+        }
+    };
+    if s.guide_dots {
+        pattern::draw_guide_dots(&mut pixels, scene.width, scene.height, d.max_separation());
+    }
+    Ok(Sirds {
+        pixels,
+        width: scene.width,
+        height: scene.height,
+        depth,
+        disparity: d,
+        iterations,
+    })
+}
+
+/// The uncompressed netpbm kinds a SIRDS is written as: binary PPM (P6, three bytes a pixel)
+/// for `.ppm`/`.pnm`, binary PGM (P5, one byte a pixel: gray patterns only) for `.pgm`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Netpbm {
+    /// P6, RGB.
+    Ppm,
+    /// P5, gray (`pgm_bytes` refuses a pixel whose channels differ).
+    Pgm,
+}
+
+impl Netpbm {
+    /// The kind `path`'s extension names (ASCII case ignored), `None` for anything else.
+    pub fn of(path: &Path) -> Option<Netpbm> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "ppm" | "pnm" => Some(Netpbm::Ppm),
+            "pgm" => Some(Netpbm::Pgm),
+            _ => None,
+        }
+    }
+
+    /// The header of a `width`×`height` image of this kind, maxval 255.
+    fn header(self, width: u32, height: u32) -> String {
+        let magic = match self {
+            Netpbm::Ppm => "P6",
+            Netpbm::Pgm => "P5",
+        };
+        format!("{magic}\n{width} {height}\n255\n")
+    }
+
+    /// `pixels` as this kind's bytes, appended to `out` (cleared first).
+    ///
+    /// # Errors
+    /// `Invalid` naming `--out` for PGM when a pixel is not gray (its R, G and B differ): a
+    /// color SIRDS needs `.ppm` or `.png`.
+    fn bytes(self, pixels: &[[u8; 4]], out: &mut Vec<u8>, path: &Path) -> Result<()> {
+        out.clear();
+        match self {
+            Netpbm::Ppm => out.extend(pixels.iter().flat_map(|p| [p[0], p[1], p[2]])),
+            Netpbm::Pgm => {
+                // One pass that vectorizes: the gray level, and whether any channel differed.
+                out.resize(pixels.len(), 0);
+                let mut differ = 0;
+                for (o, p) in out.iter_mut().zip(pixels) {
+                    *o = p[0];
+                    differ |= (p[0] ^ p[1]) | (p[1] ^ p[2]);
+                }
+                if differ == 0 {
+                    return Ok(());
+                }
+                if let Some(p) = pixels.iter().find(|p| p[0] != p[1] || p[1] != p[2]) {
+                    return Err(Error::invalid(
+                        "--out",
+                        path.display(),
+                        format!(
+                            "a PGM holds gray levels, and this SIRDS has colors (e.g. {:?}): name the file .ppm or .png",
+                            &p[..3]
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes RGBA pixels as PNG, or uncompressed as binary PPM (`.ppm`/`.pnm`) or PGM (`.pgm`,
+/// gray SIRDS only, see [`Netpbm`]), all or nothing ([`files::write_atomic`]).
+///
+/// # Errors
+/// The file cannot be written, or its name is a link or a special file; a `.pgm` of a color
+/// SIRDS.
+pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<()> {
+    if let Some(kind) = Netpbm::of(path) {
+        files::write_atomic(path, |w| {
+            w.write_all(kind.header(width, height).as_bytes())
+                .map_err(|e| Error::io(path, e))?;
+            let mut row = Vec::with_capacity(width as usize * 3);
+            for line in pixels.chunks_exact(width.max(1) as usize) {
+                kind.bytes(line, &mut row, path)?;
+                w.write_all(&row).map_err(|e| Error::io(path, e))?;
+            }
+            Ok(())
+        })
+    } else {
+        let bytes = pixels.iter().flatten().copied().collect();
+        let img = image::RgbaImage::from_raw(width, height, bytes).ok_or_else(|| {
+            Error::internal(
+                "sirds",
+                format!("{} pixels for {width}x{height}", pixels.len()),
+            )
+        })?;
+        files::write_png(path, &img)
+    }
+}
+
+/// TIW from a depth-map file straight into a PPM or PGM (`out`'s extension, see [`Netpbm`];
+/// anything else is written as PPM), a chunk of rows at a time: the depth map is never held as
+/// floats, nor the image as RGBA (a 4096×3072 map would need 100 MB for both).
+///
+/// # Errors
+/// The depth map cannot be read or is too large, or the file cannot be written; a `.pgm` of
+/// a color SIRDS.
+pub fn stream_depth_map(
+    depth: &Path,
+    near: Near,
+    settings: &Settings,
+    out: &Path,
+) -> Result<(u32, u32, DepthMapping)> {
+    // A binary PGM is read as it is used; anything else whole first.
+    let mut source = match PgmRows::open(depth, near)? {
+        Some(rows) => Ok(rows),
+        None => Err(DepthSamples::load(depth, near)?),
+    };
+    let (width, height) = match &source {
+        Ok(rows) => (rows.width, rows.height),
+        Err(whole) => (whole.width, whole.height),
+    };
+    let mut taken = 0;
+    let read = |buf: &mut [u16]| match &mut source {
+        Ok(rows) => rows.read(buf),
+        Err(whole) => {
+            buf.copy_from_slice(&whole.samples[taken..taken + buf.len()]);
+            taken += buf.len();
+            Ok(())
+        }
+    };
+    let invert = settings.cross_eyed;
+    let z_of = |v: u16| {
+        let z = v as f32 / 65535.0;
+        if invert { 1.0 - z } else { z }
+    };
+    let d = settings.geometry.to_pixels()?;
+    // The rows stream into a temporary file: a failure in TIW or in the writing leaves `out`
+    // as it was.
+    files::write_atomic(out, |writer| {
+        let kind = Netpbm::of(out).unwrap_or(Netpbm::Ppm);
+        writer
+            .write_all(kind.header(width, height).as_bytes())
+            .map_err(|e| Error::io(out, e))?;
+        let mut bytes = Vec::new();
+        stereolab_core::effects::sirds::per_pixel::per_pixel_samples(
+            width,
+            height,
+            read,
+            z_of,
+            &d,
+            &settings.pattern,
+            &settings.per_pixel,
+            |rows| {
+                kind.bytes(rows, &mut bytes, out)?;
+                writer.write_all(&bytes).map_err(|e| Error::io(out, e))
+            },
+        )
+    })?;
+    let mapping = match &source {
+        Ok(rows) => rows.mapping(),
+        Err(whole) => whole.mapping.clone(),
+    };
+    Ok((width, height, mapping))
+}

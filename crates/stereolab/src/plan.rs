@@ -1,0 +1,385 @@
+//! Outputs → the passes they need, nothing more (standing demand 3: simulate only the effects
+//! a scene calls for).
+
+use std::fmt::Write as _;
+
+use stereolab_core::effects::anaglyph::AnaglyphKind;
+use stereolab_core::error::{Error, Result};
+
+/// Everything a scene can ask `stereolab render` to write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Output {
+    /// Left eye color.
+    Left,
+    /// Right eye color.
+    Right,
+    /// Left eye depth (16-bit grayscale).
+    LeftDepth,
+    /// Right eye depth (16-bit grayscale).
+    RightDepth,
+    /// Left | right, for parallel (wall-eyed) free viewing.
+    SideBySide,
+    /// Right | left, for cross-eyed free viewing.
+    CrossEyed,
+    /// Left on top of right, each full size.
+    AboveBelow,
+    /// The StereoGraphics guide's sync-doubling format: both eyes squashed 1:2 into one frame, left on top,
+    /// separated by a black blank interval.
+    AboveBelowSquashed,
+    /// Even rows left, odd rows right (row-interleaved polarized displays).
+    InterlacedRows,
+    /// Even columns left, odd columns right (column-interleaved displays).
+    InterlacedColumns,
+    /// Left where x + y is even, right elsewhere (DLP checkerboard).
+    Checkerboard,
+    /// The ChromaDepth article's ChromaDepth image: depth as a red → green → blue ramp, one center-eye pass.
+    ChromaDepth,
+    /// The left eye's view of the ChromaDepth image through the glasses (simulated).
+    ChromaDepthLeft,
+    /// The right eye's view of the ChromaDepth image through the glasses (simulated).
+    ChromaDepthRight,
+    /// Both simulated views as a red–cyan anaglyph, for viewers without ChromaDepth glasses.
+    ChromaDepthAnaglyph,
+    /// `anaglyph_<kind>`: both eyes' colors mixed by the kind's matrices (the exercise slides).
+    Anaglyph(AnaglyphKind),
+    /// The left eye's view recolored from the right eye by remapping (the exercise slides).
+    RemapLeft,
+    /// The right eye's view recolored from the left eye.
+    RemapRight,
+    /// Per eye, what it sees that the other eye cannot (remapping + visibility check).
+    Occlusion,
+    /// The left eye's parallax `p(z) = d(1 − z0/z)` as color with a legend (the exercise slides).
+    Parallax,
+    /// Single-image random-dot stereogram of the cyclopean view (the SIRDS paper (Petz et al.)).
+    Sirds,
+    /// The depth map the SIRDS encodes (16-bit, white = near).
+    SirdsDepth,
+    /// The SIRDS paper's Fig. 5: the scene's SIRDS in three horizontal bands, eq. 3 bilinear
+    /// (top), eq. 1 bilinear (middle), eq. 3 nearest (bottom: discrete depth layers).
+    SirdsFig5,
+    /// Left and right as a CIPA DC-007 multi-picture JPEG (`mpo.mpo`), what stereo cameras
+    /// write and 3D viewers open.
+    Mpo,
+    /// Right | left side by side in one JPEG (`jps.jps`), the cross-eyed order viewers expect.
+    Jps,
+    /// Right | left side by side in one PNG (`pns.pns`).
+    Pns,
+    /// The SGI course notes' §4.1.3 "Rotate vs. Shear" side by side: the same frame from the
+    /// off-axis (shear) and toe-in (rotate) rigs, toe-in's vertical parallax per pixel, and the
+    /// difference of the two rigs' left images.
+    ShearVsRotate,
+    /// Julesz's random-dot stereo pair, left eye: a seeded random-dot texture, no shape in it.
+    RdsLeft,
+    /// The right eye's view of the left eye's dots through the remap: the scene's depth as
+    /// parallax only.
+    RdsRight,
+    /// Both random-dot images as a gray red–cyan anaglyph.
+    RdsAnaglyph,
+    /// Both eyes as an animated PNG alternating left, right, … at the scene's rate: the
+    /// quad-buffered (`BACK_LEFT` / `BACK_RIGHT`) shutter-glasses display, emulated.
+    FrameSequential,
+    /// The left eye with a share of the right eye leaking in per channel (crosstalk, the
+    /// StereoGraphics guide's ghosting).
+    GhostingLeft,
+    /// The right eye with a share of the left eye leaking in.
+    GhostingRight,
+    /// The StereoGraphics guide's above-below calibration screen: two arrows that line up when
+    /// `layout.blank_interval` matches the display's blank interval. Needs no pass.
+    AboveBelowCalibration,
+}
+
+/// Which camera a pass renders from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum View {
+    /// The left eye (index 0).
+    Left,
+    /// The right eye (index 1).
+    Right,
+    /// The cyclopean eye: the camera itself.
+    Center,
+    /// The scene's rig as off-axis (shear), left eye: one side of [`Output::ShearVsRotate`].
+    ShearLeft,
+    /// The scene's rig as off-axis (shear), right eye.
+    ShearRight,
+    /// The scene's rig as toe-in (rotate), left eye: the other side of [`Output::ShearVsRotate`].
+    RotateLeft,
+    /// The scene's rig as toe-in (rotate), right eye.
+    RotateRight,
+}
+
+/// What a pass computes per fragment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Shading {
+    /// Depth only: no fragment shading at all.
+    DepthOnly,
+    /// Shaded color (and depth).
+    Color,
+    /// ChromaDepth: color from the depth ramp (and depth), the ChromaDepth article.
+    ChromaDepth,
+}
+
+/// One rasterization pass over the whole scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Pass {
+    /// The camera.
+    pub view: View,
+    /// Depth only, or shaded.
+    pub shading: Shading,
+}
+
+impl Output {
+    /// Every output, in the order `--help` lists them.
+    pub const ALL: &'static [Output] = &[
+        Output::Left,
+        Output::Right,
+        Output::LeftDepth,
+        Output::RightDepth,
+        Output::SideBySide,
+        Output::CrossEyed,
+        Output::AboveBelow,
+        Output::AboveBelowSquashed,
+        Output::InterlacedRows,
+        Output::InterlacedColumns,
+        Output::Checkerboard,
+        Output::ChromaDepth,
+        Output::ChromaDepthLeft,
+        Output::ChromaDepthRight,
+        Output::ChromaDepthAnaglyph,
+        Output::Anaglyph(AnaglyphKind::True),
+        Output::Anaglyph(AnaglyphKind::Gray),
+        Output::Anaglyph(AnaglyphKind::Color),
+        Output::Anaglyph(AnaglyphKind::HalfColor),
+        Output::Anaglyph(AnaglyphKind::Optimized),
+        Output::Anaglyph(AnaglyphKind::DuboisRedCyan),
+        Output::Anaglyph(AnaglyphKind::DuboisRedCyanLcd),
+        Output::Anaglyph(AnaglyphKind::DuboisGreenMagenta),
+        Output::Anaglyph(AnaglyphKind::DuboisAmberBlue),
+        Output::RemapLeft,
+        Output::RemapRight,
+        Output::Occlusion,
+        Output::Parallax,
+        Output::Sirds,
+        Output::SirdsDepth,
+        Output::SirdsFig5,
+        Output::Mpo,
+        Output::Jps,
+        Output::Pns,
+        Output::ShearVsRotate,
+        Output::RdsLeft,
+        Output::RdsRight,
+        Output::RdsAnaglyph,
+        Output::FrameSequential,
+        Output::GhostingLeft,
+        Output::GhostingRight,
+        Output::AboveBelowCalibration,
+    ];
+
+    /// The name used in scene files and for the PNG written.
+    pub fn name(self) -> &'static str {
+        match self {
+            Output::Left => "left",
+            Output::Right => "right",
+            Output::LeftDepth => "left_depth",
+            Output::RightDepth => "right_depth",
+            Output::SideBySide => "side_by_side",
+            Output::CrossEyed => "cross_eyed",
+            Output::AboveBelow => "above_below",
+            Output::AboveBelowSquashed => "above_below_squashed",
+            Output::InterlacedRows => "interlaced_rows",
+            Output::InterlacedColumns => "interlaced_columns",
+            Output::Checkerboard => "checkerboard",
+            Output::ChromaDepth => "chromadepth",
+            Output::ChromaDepthLeft => "chromadepth_left",
+            Output::ChromaDepthRight => "chromadepth_right",
+            Output::ChromaDepthAnaglyph => "chromadepth_anaglyph",
+            Output::Anaglyph(kind) => kind.output_name(),
+            Output::RemapLeft => "remap_left",
+            Output::RemapRight => "remap_right",
+            Output::Occlusion => "occlusion",
+            Output::Parallax => "parallax",
+            Output::Sirds => "sirds",
+            Output::SirdsDepth => "sirds_depth",
+            Output::SirdsFig5 => "sirds_fig5",
+            Output::Mpo => "mpo",
+            Output::Jps => "jps",
+            Output::Pns => "pns",
+            Output::ShearVsRotate => "shear_vs_rotate",
+            Output::RdsLeft => "rds_left",
+            Output::RdsRight => "rds_right",
+            Output::RdsAnaglyph => "rds_anaglyph",
+            Output::FrameSequential => "frame_sequential",
+            Output::GhostingLeft => "ghosting_left",
+            Output::GhostingRight => "ghosting_right",
+            Output::AboveBelowCalibration => "above_below_calibration",
+        }
+    }
+
+    /// The file an output is written to: `<name>.png`, or `<name>.mpo|jps|pns` for the
+    /// stereo photo formats.
+    pub fn file_name(self) -> String {
+        let ext = match self {
+            Output::Mpo => "mpo",
+            Output::Jps => "jps",
+            Output::Pns => "pns",
+            _ => "png",
+        };
+        format!("{}.{ext}", self.name())
+    }
+
+    /// Parses a name as written in a scene file.
+    ///
+    /// # Errors
+    /// `Invalid` listing the known names.
+    pub fn parse(name: &str) -> Result<Output> {
+        Output::ALL
+            .iter()
+            .copied()
+            .find(|o| o.name() == name)
+            .ok_or_else(|| {
+                let known: Vec<&str> = Output::ALL.iter().map(|o| o.name()).collect();
+                Error::invalid(
+                    "outputs",
+                    format!("\"{name}\""),
+                    format!("unknown output; known: {}", known.join(", ")),
+                )
+            })
+    }
+
+    /// The passes this output reads.
+    pub fn needs(self) -> Vec<Pass> {
+        let color = |view| Pass {
+            view,
+            shading: Shading::Color,
+        };
+        let depth = |view| Pass {
+            view,
+            shading: Shading::DepthOnly,
+        };
+        match self {
+            Output::Left => vec![color(View::Left)],
+            Output::Right => vec![color(View::Right)],
+            Output::LeftDepth => vec![depth(View::Left)],
+            Output::RightDepth => vec![depth(View::Right)],
+            // One center pass, no stereo pair: the glasses make the pair (the ChromaDepth article).
+            Output::ChromaDepth
+            | Output::ChromaDepthLeft
+            | Output::ChromaDepthRight
+            | Output::ChromaDepthAnaglyph => vec![Pass {
+                view: View::Center,
+                shading: Shading::ChromaDepth,
+            }],
+            // Remapping unprojects this eye's depth and fetches the other eye's color.
+            Output::RemapLeft => vec![depth(View::Left), color(View::Right)],
+            Output::RemapRight => vec![color(View::Left), depth(View::Right)],
+            // The visibility check compares depths only.
+            Output::Occlusion => vec![depth(View::Left), depth(View::Right)],
+            // p(z) needs the left eye's depth and the rig, nothing else.
+            Output::Parallax => vec![depth(View::Left)],
+            // One depth pass of the cyclopean view; no color shading at all (the SIRDS paper (Petz et al.)).
+            Output::Sirds | Output::SirdsDepth | Output::SirdsFig5 => vec![depth(View::Center)],
+            // Both rigs' eye passes, whatever the scene's own mode: the comparison is the point.
+            Output::ShearVsRotate => vec![
+                color(View::ShearLeft),
+                color(View::ShearRight),
+                color(View::RotateLeft),
+                color(View::RotateRight),
+            ],
+            // The left eye's dots are the texture itself, whatever the scene holds.
+            Output::RdsLeft => vec![],
+            // The dots are painted, not shaded: the remap needs both eyes' depths only.
+            Output::RdsRight | Output::RdsAnaglyph => {
+                vec![depth(View::Left), depth(View::Right)]
+            }
+            // A test pattern of the layout alone: no pass at all.
+            Output::AboveBelowCalibration => vec![],
+            _ => vec![color(View::Left), color(View::Right)],
+        }
+    }
+}
+
+/// The passes a set of outputs needs. A color pass also produces depth, so a depth-only pass of
+/// the same view is dropped when a color pass of it runs anyway; two different shadings of one
+/// view (e.g. Blinn-Phong and ChromaDepth) stay separate passes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Requested outputs, deduplicated, in request order.
+    pub outputs: Vec<Output>,
+    /// Passes to run, sorted by view.
+    pub passes: Vec<Pass>,
+}
+
+impl Plan {
+    /// Builds the plan for `outputs`.
+    pub fn new(outputs: &[Output]) -> Plan {
+        let mut uniq: Vec<Output> = Vec::new();
+        for o in outputs {
+            if !uniq.contains(o) {
+                uniq.push(*o);
+            }
+        }
+        let mut passes: Vec<Pass> = uniq.iter().flat_map(|o| o.needs()).collect();
+        passes.sort();
+        passes.dedup();
+        // Fold depth-only passes into a shaded pass of the same view.
+        let mut merged: Vec<Pass> = Vec::new();
+        for p in passes {
+            let absorbs = |m: &Pass| {
+                m.view == p.view
+                    && (m.shading == Shading::DepthOnly || p.shading == Shading::DepthOnly)
+            };
+            match merged.iter_mut().find(|m| absorbs(m)) {
+                Some(m) => m.shading = m.shading.max(p.shading),
+                None => merged.push(p),
+            }
+        }
+        Plan {
+            outputs: uniq,
+            passes: merged,
+        }
+    }
+
+    /// The pass that renders `view`, if any.
+    pub fn pass(&self, view: View) -> Option<Pass> {
+        self.passes.iter().copied().find(|p| p.view == view)
+    }
+
+    /// Human-readable: which passes run, for which outputs, and which do not run.
+    pub fn explain(&self) -> String {
+        let mut s = String::from("plan:\n");
+        for p in &self.passes {
+            let users: Vec<&str> = self
+                .outputs
+                .iter()
+                .filter(|o| {
+                    o.needs().iter().any(|n| {
+                        n.view == p.view
+                            && (n.shading == p.shading || n.shading == Shading::DepthOnly)
+                    })
+                })
+                .map(|o| o.name())
+                .collect();
+            let _ = writeln!(
+                s,
+                "  pass {:?} eye, {}: for {}",
+                p.view,
+                shading_name(p.shading),
+                users.join(", ")
+            );
+        }
+        for view in [View::Left, View::Right, View::Center] {
+            if self.pass(view).is_none() {
+                let _ = writeln!(s, "  not run: {view:?} eye (no requested output needs it)");
+            }
+        }
+        let _ = writeln!(s, "  passes run: {}", self.passes.len());
+        s
+    }
+}
+
+fn shading_name(s: Shading) -> &'static str {
+    match s {
+        Shading::Color => "color + depth (shaded)",
+        Shading::DepthOnly => "depth only (no shading)",
+        Shading::ChromaDepth => "ChromaDepth ramp + depth (texgen)",
+    }
+}

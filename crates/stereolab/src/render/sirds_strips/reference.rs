@@ -1,0 +1,373 @@
+//! The strip algorithm as the SIRDS paper (Petz et al.) §3–4 states it: k render passes, one
+//! per strip, on stereolab's rasterizer. This is the definition; the fast path
+//! [`per_vertex`](super::per_vertex) (deferred texturing, strips resolved in place, AVX2) is
+//! held to it byte for byte by the tests below.
+//!
+//! Two images, as the paper's render-to-texture ping-pong (and `gpu::sirds`):
+//!
+//! - A, the image so far: the random-dot pattern at first;
+//! - per strip, one pass renders the whole scene into B (a copy of A, depth cleared) with
+//!   Fig. 4's programs (`StripPass`): every vertex shifted by `toward · d(v)/2`, every
+//!   fragment textured from A at `x − toward · d`, the depth test LESS deciding visibility;
+//! - B's strip is copied to A; the rest of B is dropped (a strip narrower than the front
+//!   separation `δ` reads only finished strips, so it never changes again, §3).
+//!
+//! A pixel that no fragment covers, or whose fragment samples outside the allowed sources,
+//! keeps A's value: still the pattern, since its strip has not run. A read of a pixel whose
+//! strip has not run sees the pattern too, because A holds only finished strips.
+//!
+//! Cost: k full renders (every triangle set up and traversed over the whole frame per strip,
+//! one strip kept), against about one for the fast path. For reading and testing, not for use.
+
+use glam::Vec4;
+
+use super::{
+    Filter, PerVertexOptions, Strip, StripGeometry, StripResult, address, checked_strips,
+    in_bounds, mix, shift, source_coordinate,
+};
+use stereolab_core::effects::sirds::disparity::Disparity;
+use stereolab_core::effects::sirds::pattern::Pattern;
+use stereolab_core::error::Result;
+use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::raster::{RasterOptions, rasterize};
+use stereolab_core::shade::{Fragment, Shader, Varyings};
+
+/// Fig. 4's vertex and fragment programs for the pass of one strip.
+struct StripPass<'a> {
+    geometry: &'a StripGeometry,
+    /// Image A, read as the texture.
+    previous: &'a [[u8; 4]],
+    width: u32,
+    strip: &'a Strip,
+    bilinear: bool,
+}
+
+impl StripPass<'_> {
+    /// The columns a fragment at column `x` with separation `sep` reads and the weight of the
+    /// second (see [`address`]), or `None` when its source `x − toward · sep` lies outside the
+    /// strip's allowed sources (the fragment is discarded, the pixel keeps its value).
+    fn source(&self, x: u32, sep: f32) -> Option<(usize, usize, f32)> {
+        let s = self.strip;
+        let p = source_coordinate(x, sep, s.toward);
+        in_bounds(p, s.lo as f32, s.hi as f32, self.bilinear).then(|| address(p, self.bilinear))
+    }
+}
+
+impl Shader for StripPass<'_> {
+    fn varying_count(&self) -> usize {
+        1
+    }
+
+    /// The vertex moved `toward · d(v)/2` pixels; its separation `d(v)` as the varying.
+    fn vertex(&self, index: u32, out: &mut Varyings) -> Vec4 {
+        let (c, s) = (
+            self.geometry.clip[index as usize],
+            self.geometry.separation[index as usize],
+        );
+        out[0] = s;
+        shift(c, s, self.strip.toward, self.width as f32)
+    }
+
+    /// The texture read: A at `x − toward · d`, nearest or linear between two pixels.
+    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
+        let (i0, i1, t) = self.source(f.x, f.varyings[0])?;
+        let w = self.width as usize;
+        let row = &self.previous[f.y as usize * w..][..w];
+        Some(mix(row[i0], row[i1], t))
+    }
+}
+
+/// The pass recording, instead of a color, the first pixel each fragment reads (its link, as
+/// the little-endian bytes of an `i32`): the depth test keeps the same fragment as in the
+/// colored pass.
+struct RecordLink<'a>(StripPass<'a>);
+
+impl Shader for RecordLink<'_> {
+    fn varying_count(&self) -> usize {
+        self.0.varying_count()
+    }
+
+    fn vertex(&self, index: u32, out: &mut Varyings) -> Vec4 {
+        self.0.vertex(index, out)
+    }
+
+    fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
+        let (i0, _, _) = self.0.source(f.x, f.varyings[0])?;
+        Some((i0 as i32).to_le_bytes())
+    }
+}
+
+/// Makes a SIRDS with the strip algorithm as k render passes: the definition the fast
+/// [`per_vertex`](super::per_vertex) is held to (same inputs, same result, byte for byte).
+///
+/// Per strip (the SIRDS paper's §3–4, Fig. 4): render the scene into B, a copy of A, with every vertex
+/// `v` at `x + toward · d(v)/2` and every fragment at `x` colored from A at
+/// `x − toward · d`; copy B's strip into A. `toward` is +1 for strips going right from the start
+/// column, −1 for those going left (center start, Fig. 7).
+///
+/// # Errors
+/// As [`per_vertex`](super::per_vertex): separations that do not fit `width`, a pattern
+/// narrower than the largest separation, a bad image size, k too small for the front
+/// separation.
+pub fn k_passes(
+    geometry: &StripGeometry,
+    width: u32,
+    height: u32,
+    d: &Disparity,
+    pattern: &Pattern,
+    opts: &PerVertexOptions,
+    record_links: bool,
+) -> Result<StripResult> {
+    let strips = checked_strips(width, height, d, pattern, opts)?;
+    let bilinear = opts.filter == Filter::Bilinear;
+    let mut a = pattern.fill(width, height);
+    // −1 (no link) where the pattern stays, as the fast path records.
+    let mut links = record_links.then(|| vec![-1i32; a.len()]);
+    for strip in &strips {
+        let pass = StripPass {
+            geometry,
+            previous: &a,
+            width,
+            strip,
+            bilinear,
+        };
+        let b = render(&pass, geometry, &a, width, height)?;
+        if let Some(links) = &mut links {
+            let none = vec![(-1i32).to_le_bytes(); a.len()];
+            let b = render(&RecordLink(pass), geometry, &none, width, height)?;
+            let b: Vec<i32> = b.iter().map(|c| i32::from_le_bytes(*c)).collect();
+            copy_strip(&b, links, strip, width);
+        }
+        copy_strip(&b, &mut a, strip, width);
+    }
+    Ok(StripResult {
+        pixels: a,
+        iterations: strips.len() as u32,
+        strip_width: strips.first().map_or(0, |s| s.width),
+        links,
+    })
+}
+
+/// One full render pass of `geometry` with `shader` into a target holding `start` (depth
+/// cleared): its colors.
+///
+/// # Errors
+/// An image size [`Framebuffer::new`] refuses.
+fn render(
+    shader: &impl Shader,
+    geometry: &StripGeometry,
+    start: &[[u8; 4]],
+    width: u32,
+    height: u32,
+) -> Result<Vec<[u8; 4]>> {
+    let mut fb = Framebuffer::new(width, height, [0, 0, 0, 255])?;
+    fb.color.copy_from_slice(start);
+    rasterize(
+        &geometry.triangles,
+        geometry.clip.len(),
+        shader,
+        &mut fb,
+        &RasterOptions::default(),
+    );
+    Ok(fb.color)
+}
+
+/// Copies the columns of `strip` from `from` to `to`, every row (`width` pixels a row).
+fn copy_strip<T: Copy>(from: &[T], to: &mut [T], strip: &Strip, width: u32) {
+    let cols = strip.x0 as usize..(strip.x0 + strip.width) as usize;
+    let rows = from
+        .chunks_exact(width as usize)
+        .zip(to.chunks_exact_mut(width as usize));
+    for (src, dst) in rows {
+        dst[cols.clone()].copy_from_slice(&src[cols.clone()]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::plan::Shading;
+    use crate::render::render_view;
+    use crate::render::sirds_strips::per_vertex;
+    use crate::scene::Scene;
+    use stereolab_core::effects::sirds::Start;
+    use stereolab_core::effects::sirds::depth_range;
+    use stereolab_core::math::StereoRig;
+    use stereolab_core::raster::avx2_available;
+
+    /// The camera of tests/sirds.rs.
+    const CAMERA: &str = "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\
+                          fov_y = 40.0\nnear = 1.0\nfar = 20.0\n";
+
+    /// A sphere over the background plane (tests/sirds.rs `SPHERE`): its `[sirds]` keys and
+    /// its mesh.
+    const SPHERE: (&str, &str) = (
+        "back = 7.0\n",
+        "[[mesh]]\nkind = \"sphere\"\nsize = 1.2\ndetail = 32\n",
+    );
+
+    /// The SIRDS paper's Fig. 5's ramp, a plane receding to the right (tests/sirds.rs `RAMP`).
+    const RAMP: (&str, &str) = (
+        "",
+        "[[mesh]]\nkind = \"plane\"\nsize = 20.0\ndetail = 16\nrotate = [0.0, 35.0, 0.0]\n",
+    );
+
+    /// The strip geometry and the disparity of `scene` at `width × height` and `dpi` (72:
+    /// separations of 72 to 90 px, 24: 24 to 30 px), from its cyclopean depth pass (as
+    /// `from_frame` builds them).
+    fn inputs(
+        (sirds, mesh): (&str, &str),
+        (width, height): (u32, u32),
+        dpi: f32,
+        cross_eyed: bool,
+    ) -> (StripGeometry, Disparity) {
+        let text = format!(
+            "outputs = [\"sirds\"]\n[image]\nwidth = {width}\nheight = {height}\n{CAMERA}\
+             [sirds]\ndpi = {dpi:.1}\n{sirds}{mesh}"
+        );
+        let s = Scene::from_toml(&text, Path::new("test.toml"), Path::new("."), &[])
+            .expect("valid scene");
+        let center = StereoRig::center(&s.camera, s.aspect()).expect("camera");
+        let d = s.sirds.geometry.to_pixels().expect("geometry");
+        let (fb, _) = render_view(&s, &center, Shading::DepthOnly).expect("depth pass");
+        let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far).expect("range");
+        let g = StripGeometry::new(&s, &center, &range, &d, cross_eyed);
+        (g, d)
+    }
+
+    /// Where two results differ: the count of differing pixels and links, and the first few
+    /// differing pixels as `(x, y)`.
+    fn differences(want: &StripResult, got: &StripResult, width: u32) -> Option<String> {
+        let w = width as usize;
+        let at = |i: usize| (i % w, i / w);
+        let pixels: Vec<usize> = (0..want.pixels.len())
+            .filter(|&i| want.pixels[i] != got.pixels[i])
+            .collect();
+        let links = match (&want.links, &got.links) {
+            (Some(a), Some(b)) => a.iter().zip(b).filter(|(a, b)| a != b).count(),
+            _ => usize::MAX,
+        };
+        let same = (want.iterations, want.strip_width) == (got.iterations, got.strip_width);
+        if pixels.is_empty() && links == 0 && same {
+            return None;
+        }
+        let first: Vec<_> = pixels.iter().take(5).map(|&i| at(i)).collect();
+        Some(format!(
+            "{} pixels differ (first at {first:?}), {links} links, k {} vs {}",
+            pixels.len(),
+            want.iterations,
+            got.iterations
+        ))
+    }
+
+    /// The fast path (scalar and AVX2 loops) gives the k passes' pixels and links byte for byte:
+    /// a sphere and a ramp, both starts, both filters, odd sizes, the fewest strips the
+    /// geometry allows (71 px), strips narrower than one AVX2 vector (6 px), 43 and 96 strips,
+    /// 1 px strips, and a cross-eyed geometry.
+    #[test]
+    fn fast_strips_are_the_k_passes_byte_for_byte() {
+        let test = "fast_strips_are_the_k_passes_byte_for_byte";
+        let avx2 = avx2_available();
+        if !avx2 {
+            eprintln!(
+                "{test}: no AVX2 here (or STEREOLAB_SCALAR set): the SIMD-on case runs the \
+                 scalar loops, only those are compared with the k passes"
+            );
+        }
+        let pattern = Pattern::Color { seed: 11 };
+        // (name, scene, size, dpi, k, cross-eyed): k `None` gives the widest strips
+        // (⌊δ⌋ − 1: 71 px at 72 dpi, 23 px at 24 dpi), 96 px at k 16 strips of 6 px, narrower
+        // than one AVX2 vector, at k 96 strips of 1 px, 257 px at k 43 strips of 6 px.
+        let cases = [
+            ("sphere", SPHERE, (257, 131), 72.0, None, false),
+            ("ramp", RAMP, (257, 131), 72.0, None, false),
+            ("sphere", SPHERE, (96, 67), 24.0, None, false),
+            ("sphere", SPHERE, (96, 67), 24.0, Some(16), false),
+            ("ramp", RAMP, (96, 67), 24.0, Some(96), false),
+            ("sphere", SPHERE, (257, 131), 36.0, Some(43), false),
+            ("ramp", RAMP, (96, 67), 24.0, Some(16), true),
+        ];
+        let mut failures = Vec::new();
+        let mut compared = 0;
+        for (name, scene, (w, h), dpi, iterations, cross_eyed) in cases {
+            let (g, d) = inputs(scene, (w, h), dpi, cross_eyed);
+            for start in [Start::Left, Start::Center] {
+                for filter in [Filter::Nearest, Filter::Bilinear] {
+                    let opts = PerVertexOptions {
+                        start,
+                        filter,
+                        iterations,
+                        ..PerVertexOptions::default()
+                    };
+                    let want = k_passes(&g, w, h, &d, &pattern, &opts, true).expect("k passes");
+                    // Not vacuous: most pixels copy another one.
+                    let linked = want.links.iter().flatten().filter(|&&l| l >= 0).count();
+                    assert!(
+                        linked * 2 > want.pixels.len(),
+                        "{name} {w}x{h} {start:?}: only {linked} pixels linked"
+                    );
+                    for simd in [false, true] {
+                        let got = per_vertex(
+                            &g,
+                            w,
+                            h,
+                            &d,
+                            &pattern,
+                            &PerVertexOptions {
+                                simd: simd && avx2,
+                                ..opts
+                            },
+                            true,
+                        )
+                        .expect("fast strips");
+                        compared += 1;
+                        if let Some(diff) = differences(&want, &got, w) {
+                            failures.push(format!(
+                                "{name} {w}x{h} {dpi} dpi k {iterations:?} cross-eyed \
+                                 {cross_eyed} {start:?} {filter:?} simd {simd}: {diff}"
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            failures.is_empty(),
+            "{} of {compared} runs differ from the k passes:\n{}",
+            failures.len(),
+            failures.join("\n")
+        );
+    }
+
+    /// Bad inputs: the k passes refuse what the fast path refuses, with the same message.
+    #[test]
+    fn k_passes_refuse_what_the_fast_path_refuses() {
+        let (g, d) = inputs(SPHERE, (96, 67), 72.0, false);
+        let pattern = Pattern::Gray { seed: 1 };
+        for (w, iterations) in [(96, Some(0)), (96, Some(1)), (80, None)] {
+            let opts = PerVertexOptions {
+                iterations,
+                ..Default::default()
+            };
+            let want = per_vertex(
+                &g,
+                w,
+                67,
+                &d,
+                &pattern,
+                &PerVertexOptions {
+                    simd: false,
+                    ..opts
+                },
+                false,
+            );
+            let got = k_passes(&g, w, 67, &d, &pattern, &opts, false);
+            let message = |r: Result<StripResult>| r.err().map(|e| e.to_string());
+            let (want, got) = (message(want), message(got));
+            assert!(want.is_some(), "w {w}, k {iterations:?}: accepted");
+            assert_eq!(got, want, "w {w}, k {iterations:?}");
+        }
+    }
+}

@@ -1,0 +1,284 @@
+//! One viewer frame: the plan for the one output shown, its passes, the output image, and the
+//! readouts that teach (passes run and their times, the parallax range against the budget).
+//! All of it is the library's own work ([`Plan::new`], [`stereolab::render()`],
+//! [`output::produce`], [`stereolab::info::parallax_range`]); the viewer adds timing and nothing else.
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+
+use stereolab::info::{ParallaxRange, parallax_range};
+use stereolab::output::{self, Image};
+use stereolab::plan::{Output, Plan, Shading, View};
+use stereolab::render::chromadepth::resolve_texgen;
+use stereolab::render::{Frame, render};
+use stereolab::scene::Scene;
+use stereolab_core::effects::parallax::ParallaxRig;
+use stereolab_core::error::Result;
+use stereolab_core::framebuffer::Framebuffer;
+
+use super::session::{Params, point_parallax_pixels, unproject};
+
+/// A finished frame and what the viewer shows beside it.
+pub struct Shown {
+    /// The parameters it was rendered with.
+    pub params: Params,
+    /// The output image, as `stereolab render` would write it.
+    pub image: Image,
+    /// The rendered passes (framebuffers with depth, matrices): what a click looks into.
+    pub frame: Frame,
+    /// Each pass: a name (`Left Color`) and its time.
+    pub passes: Vec<(String, Duration)>,
+    /// Making the output from the passes (finalize, layouts, ChromaDepth glasses, SIRDS
+    /// strips or TIW).
+    pub effect: Duration,
+    /// Passes and effect together: the library's render, what `stereolab render` spends.
+    pub total: Duration,
+    /// What the viewer adds to each frame: the readouts below (parallax range of every vertex,
+    /// the per-pixel budget, the ChromaDepth range, the clicked point).
+    pub readouts: Duration,
+    /// Parallax of every vertex seen by both eyes (`stereolab info`'s range); also the
+    /// vertical parallax toe-in makes.
+    pub range: ParallaxRange,
+    /// Window violations (border pixels with negative parallax: left, right, top, bottom) of
+    /// an eye the plan rendered, if any did.
+    pub window_violations: Option<[usize; 4]>,
+    /// Screen parallax in pixels of the point last clicked, under this frame's rig.
+    pub picked_parallax: Option<f32>,
+    /// Image width (the parallax readouts' pixels are of this width).
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The ChromaDepth D1, D2 (set, or fitted to the bounding sphere) a ChromaDepth pass uses.
+    pub chromadepth: Option<[f32; 2]>,
+}
+
+/// Renders `scene` (already set to `params`) for its one output and measures the readouts;
+/// `picked` is the world point last clicked.
+///
+/// # Errors
+/// Whatever rendering or the output fails with (an invalid rig, a ChromaDepth range outside
+/// the clip planes, …).
+pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Result<Shown> {
+    let plan = Plan::new(&[params.output]);
+    let start = Instant::now();
+    let frame = render(scene, &plan)?;
+    let passes_done = Instant::now();
+    let image = output::produce(params.output, &frame, scene)?;
+    let effect = passes_done.elapsed();
+    let total = start.elapsed();
+    let readouts_start = Instant::now();
+    let passes = frame
+        .passes
+        .iter()
+        .map(|p| (format!("{:?} {:?}", p.pass.view, p.pass.shading), p.time))
+        .collect();
+    let range = parallax_range(scene)?;
+    let rig = scene.parallax_rig()?;
+    let window_violations = [View::Left, View::Right]
+        .into_iter()
+        .find_map(|v| frame.view(v))
+        .map(|fb| window_violations(fb, &rig));
+    // The D1/D2 a ChromaDepth pass uses (set, or fitted to the bounding sphere), also for the
+    // other outputs, so the sliders start where the ramp would be; `None` where no range fits.
+    let chromadepth = match frame.plan.pass(View::Center) {
+        Some(p) if p.shading == Shading::ChromaDepth => {
+            let t = resolve_texgen(scene, &frame.center, &scene.chromadepth)?;
+            Some([t.d1, t.d2])
+        }
+        _ => resolve_texgen(scene, &frame.center, &scene.chromadepth)
+            .ok()
+            .map(|t| [t.d1, t.d2]),
+    };
+    let picked_parallax = picked.and_then(|p| point_parallax_pixels(&frame.eyes, p, scene.width));
+    let readouts = readouts_start.elapsed();
+    Ok(Shown {
+        params: params.clone(),
+        image,
+        frame,
+        passes,
+        effect,
+        total,
+        readouts,
+        range,
+        window_violations,
+        picked_parallax,
+        width: scene.width,
+        height: scene.height,
+        chromadepth,
+    })
+}
+
+/// The StereoGraphics guide's window violations of one eye's framebuffer: border pixels with
+/// negative parallax (in front of the screen, cut by the window's edge), per side (left, right,
+/// top, bottom). The same count as
+/// [`budget_of`](stereolab_core::effects::parallax::budget_of)`(fb, rig).window_violations`, which maps
+/// every pixel's parallax; this looks at the border pixels only, as only they can violate
+/// (a unit test holds the two equal).
+pub fn window_violations(fb: &Framebuffer, rig: &ParallaxRig) -> [usize; 4] {
+    let (w, h) = (fb.width as usize, fb.height as usize);
+    let negative = |x: usize, y: usize| {
+        fb.depth
+            .get(y * w + x)
+            .and_then(|&d| rig.parallax_pixels(d))
+            .is_some_and(|p| p < 0.0)
+    };
+    let column = |x: usize| (0..h).filter(|&y| negative(x, y)).count();
+    let row = |y: usize| (0..w).filter(|&x| negative(x, y)).count();
+    if w == 0 || h == 0 {
+        return [0; 4];
+    }
+    [column(0), column(w - 1), row(0), row(h - 1)]
+}
+
+/// `image` as egui's texture pixels, made on the worker thread so the window only moves it
+/// into its texture. An RGBA output is converted in one pass over its bytes (no intermediate
+/// copy); depth (16 bits, shown by the high byte) and stereo photos go through
+/// [`Image::to_display_rgba`] first.
+pub fn display_image(image: &Image) -> eframe::egui::ColorImage {
+    use eframe::egui::ColorImage;
+    match image {
+        Image::Rgba(i) => ColorImage::from_rgba_unmultiplied(
+            [i.width() as usize, i.height() as usize],
+            i.as_raw(),
+        ),
+        other => {
+            let rgba = other.to_display_rgba();
+            ColorImage::from_rgba_unmultiplied(
+                [rgba.width() as usize, rgba.height() as usize],
+                rgba.as_raw(),
+            )
+        }
+    }
+}
+
+impl Shown {
+    /// Width of the output image (side by side is twice the scene's width).
+    pub fn image_width(&self) -> u32 {
+        self.image.display_size().0
+    }
+
+    /// Height of the output image.
+    pub fn image_height(&self) -> u32 {
+        self.image.display_size().1
+    }
+
+    /// The scene's width / height.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// The ChromaDepth range of this frame's camera (set, or fitted), if one fits.
+    pub fn chromadepth_range(&self) -> Option<[f32; 2]> {
+        self.chromadepth
+    }
+
+    /// The world point under pixel (`x`, `y`) of the output image, if the model is there: the
+    /// pixel is traced back to the pass it came from (the left half of a side-by-side image is
+    /// the left eye, …) and that pass's depth is unprojected.
+    pub fn pick(&self, x: u32, y: u32) -> Option<Vec3> {
+        let (w, h) = (self.width, self.height);
+        let (view, px, py) = match self.params.output {
+            Output::SideBySide => (if x < w { View::Left } else { View::Right }, x % w, y),
+            Output::CrossEyed => (if x < w { View::Right } else { View::Left }, x % w, y),
+            Output::AboveBelow => (if y < h { View::Left } else { View::Right }, x, y % h),
+            // Both views squashed 1:2, the left on top: a rough pick in the top view.
+            Output::AboveBelowSquashed => (View::Left, x, (y * 2).min(h - 1)),
+            _ => {
+                let view = [View::Left, View::Center, View::Right]
+                    .into_iter()
+                    .find(|&v| self.frame.view(v).is_some())?;
+                (view, x, y)
+            }
+        };
+        let fb = self.frame.view(view)?;
+        if px >= fb.width || py >= fb.height {
+            return None;
+        }
+        let d = *fb.depth.get((py * fb.width + px) as usize)?;
+        (d < 1.0).then(|| {
+            unproject(
+                &self.frame.matrices(view).mvp,
+                px,
+                py,
+                d,
+                fb.width,
+                fb.height,
+            )
+        })
+    }
+
+    /// The passes run, one per line with its time, then the effect and the total.
+    pub fn timing_lines(&self) -> Vec<String> {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let mut lines: Vec<String> = self
+            .passes
+            .iter()
+            .map(|(name, t)| format!("pass {name}: {:.1} ms", ms(*t)))
+            .collect();
+        lines.push(format!(
+            "{}: {:.1} ms",
+            self.params.output.name(),
+            ms(self.effect)
+        ));
+        lines.push(format!("library frame: {:.1} ms", ms(self.total)));
+        lines.push(format!("readouts: {:.1} ms", ms(self.readouts)));
+        lines
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stereolab_core::effects::parallax::budget_of;
+    use stereolab_core::math::{Camera, StereoRig, ZeroParallax};
+
+    /// The border-only count is the per-pixel budget's count, on framebuffers whose depths are
+    /// scattered over the whole range (background included), for several zero-parallax planes.
+    #[test]
+    fn window_violations_count_as_the_budget_does() {
+        let camera = Camera {
+            eye: [0.0, 0.0, 5.0],
+            target: [0.0; 3],
+            up: [0.0, 1.0, 0.0],
+            fov_y: 50.0,
+            near: 1.0,
+            far: 20.0,
+        };
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for (w, h, z0) in [(7, 5, 2.0), (16, 9, 6.0), (1, 1, 10.0), (33, 2, 19.0)] {
+            let depth: Vec<f32> = (0..w * h)
+                .map(|_| {
+                    let d = next();
+                    if d > 0.8 { 1.0 } else { d * 1.2 }
+                })
+                .map(|d: f32| d.min(1.0))
+                .collect();
+            let fb = Framebuffer {
+                width: w,
+                height: h,
+                color: vec![[0; 4]; (w * h) as usize],
+                depth,
+            };
+            let rig = StereoRig {
+                zero_parallax: ZeroParallax::Distance(z0),
+                ..StereoRig::default()
+            };
+            let prig = ParallaxRig::new(&rig, &camera, w, h).unwrap();
+            let expected = budget_of(&fb, &prig).unwrap().window_violations;
+            assert_eq!(window_violations(&fb, &prig), expected, "{w}x{h} z0 {z0}");
+            if z0 > 5.0 && w > 2 {
+                assert!(
+                    expected.iter().sum::<usize>() > 0,
+                    "{w}x{h}: nothing to count"
+                );
+            }
+        }
+    }
+}

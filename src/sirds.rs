@@ -1,0 +1,437 @@
+//! `stereolab sirds`: autostereograms from a scene or a depth-map image, animations, decoding.
+
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use stereolab::output::animate::{AnimationOptions, animate};
+use stereolab::output::sirds::{from_frame, save, stream_depth_map};
+use stereolab::plan::{Output, Plan};
+use stereolab::render::render;
+use stereolab_core::effects::sirds::decode::depth_from_separation;
+use stereolab_core::effects::sirds::depthfile::Near;
+use stereolab_core::effects::sirds::{DepthMap, Settings, SirdsSpec, from_depth_map};
+use stereolab_core::{Error, Result};
+
+/// Arguments of `stereolab sirds`.
+#[derive(clap::Args, Debug)]
+pub struct SirdsArgs {
+    /// Scene file (TOML): its geometry and `[sirds]` table.
+    pub scene: Option<PathBuf>,
+    /// Make a SIRDS of this depth-map image instead with the per-pixel algorithm: 8- or 16-bit
+    /// PNG, netpbm PGM/PPM/PAM (full scale: v / max), or float PFM (its own min..max).
+    #[arg(long, conflicts_with = "scene")]
+    pub depth: Option<PathBuf>,
+    /// With --depth: which values are near, `white` (larger; netpbm, stereolab) or `black`
+    /// (smaller; distance maps, Z-buffers).
+    #[arg(long, default_value = "white", value_parser = ["white", "black"], requires = "depth")]
+    pub near: String,
+    /// Decode this autostereogram: write the depth it encodes to --out and say whether it is
+    /// one at all. With a scene (its `[sirds]` table) or `--set sirds.*` flags the decoder is
+    /// told the viewing set-up: it decodes over that model's separations (eq. 1 or eq. 3,
+    /// wall- or cross-eyed) instead of searching for them.
+    #[arg(long, conflicts_with_all = ["depth", "frames"])]
+    pub decode: Option<PathBuf>,
+    /// Output file: .png, or .ppm / .pgm (uncompressed; .pgm for gray patterns, one byte a
+    /// pixel); with --frames a .gif. Default sirds.png, or sirds.gif with --frames.
+    #[arg(long, short)]
+    pub out: Option<PathBuf>,
+    /// Override a `[sirds]` field, e.g. --set sirds.dpi=100 (repeatable; with a scene any
+    /// scene field).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Animate: this many frames of the model turning once, written as a GIF.
+    #[arg(long, requires = "scene")]
+    pub frames: Option<u32>,
+    /// Animation: keep one random-dot seed in every frame (default: a new pattern per frame).
+    #[arg(long, requires = "frames")]
+    pub fixed_seed: bool,
+    /// With --decode: also write the views the viewer's eyes see (left.png, right.png) and a
+    /// red–cyan anaglyph of them (anaglyph.png) into this folder.
+    #[arg(long, requires = "decode", value_name = "DIR")]
+    pub pair: Option<PathBuf>,
+}
+
+/// Settings from `--set sirds.key=value` alone (no scene file).
+fn settings_from_sets(sets: &[String]) -> Result<Settings> {
+    let mut text = String::new();
+    for s in sets {
+        let (k, v) = s
+            .split_once('=')
+            .ok_or_else(|| Error::invalid("--set", s, "expected key=value"))?;
+        let k = k.trim().trim_start_matches("sirds.");
+        let v = v.trim();
+        // Bare words (nearest, color) become TOML strings.
+        let value = if toml::from_str::<toml::Table>(&format!("v = {v}")).is_ok() {
+            v.to_string()
+        } else {
+            format!("\"{v}\"")
+        };
+        text.push_str(&format!("{k} = {value}\n"));
+    }
+    let spec: SirdsSpec = toml::from_str(&text)
+        .map_err(|e| Error::invalid("--set", sets.join(" "), e.message().to_string()))?;
+    // Paths typed on the command line are the user's own: not confined.
+    Settings::from_spec(
+        &spec,
+        &stereolab_core::files::InputRoot::anywhere(Path::new(".")),
+    )
+}
+
+/// Whether `path` ends in one of `extensions` (ASCII case ignored).
+fn has_extension(path: &Path, extensions: &[&str]) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
+}
+
+/// Runs `stereolab sirds`.
+///
+/// # Errors
+/// Any input, render or write error.
+pub fn run(args: &SirdsArgs) -> Result<()> {
+    out!("{}", report(args)?);
+    Ok(())
+}
+
+/// What `stereolab sirds` prints, after doing the work.
+fn report(args: &SirdsArgs) -> Result<String> {
+    // An animation is a GIF (default sirds.gif), everything else an image (default sirds.png):
+    // a GIF under another name would be a wrong container.
+    let out = match (&args.out, args.frames) {
+        (Some(out), Some(_)) if !has_extension(out, &["gif"]) => {
+            return Err(Error::invalid(
+                "--out",
+                out.display(),
+                "an animation (--frames) is written as GIF: name the file .gif",
+            ));
+        }
+        (Some(out), _) => out.clone(),
+        (None, Some(_)) => PathBuf::from("sirds.gif"),
+        (None, None) => PathBuf::from("sirds.png"),
+    };
+    if let Some(path) = &args.decode {
+        return decode_report(args, path, &out);
+    }
+    if let Some(path) = &args.depth {
+        let settings = settings_from_sets(&args.sets)?;
+        let near = Near::parse(&args.near)?;
+        let d = settings.geometry.to_pixels()?;
+        let netpbm = stereolab::output::sirds::Netpbm::of(&out).is_some();
+        let (w, h, mapping) = super::with_spinner("making the autostereogram", || {
+            if netpbm && !settings.guide_dots {
+                stream_depth_map(path, near, &settings, &out)
+            } else {
+                let (map, mapping) = DepthMap::load_with(path, near)?;
+                let sirds = from_depth_map(map, &settings)?;
+                save(&sirds.pixels, sirds.width, sirds.height, &out)?;
+                Ok((sirds.width, sirds.height, mapping))
+            }
+        })?;
+        return Ok(format!(
+            "per-pixel SIRDS of {} ({w}x{h}), separations {:.1}..{:.1} px\n  depth map {mapping}\n  wrote {}\n",
+            path.display(),
+            d.min_separation(),
+            d.max_separation(),
+            out.display()
+        ));
+    }
+    let scene_path = args
+        .scene
+        .as_ref()
+        .ok_or_else(|| Error::invalid("sirds", "no input", "give a scene, --depth or --decode"))?;
+    let scene = super::load_scene(scene_path, &args.sets, None)?;
+    if let Some(frames) = args.frames {
+        let opts = AnimationOptions {
+            frames,
+            fixed_seed: args.fixed_seed,
+            ..AnimationOptions::default()
+        };
+        let bar = ProgressBar::new(u64::from(frames));
+        bar.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        animate(&scene, &opts, &out, |done, _| {
+            bar.set_position(u64::from(done))
+        })?;
+        bar.finish_and_clear();
+        return Ok(format!(
+            "animated {frames} frames of {}\n  wrote {}\n",
+            scene_path.display(),
+            out.display()
+        ));
+    }
+    let frame = render(&scene, &Plan::new(&[Output::Sirds]))?;
+    let sirds = from_frame(&frame, &scene)?;
+    save(&sirds.pixels, sirds.width, sirds.height, &out)?;
+    Ok(format!(
+        "{:?} SIRDS of {} ({}x{}){}\n  wrote {}\n",
+        scene.sirds.algorithm,
+        scene_path.display(),
+        sirds.width,
+        sirds.height,
+        sirds
+            .iterations
+            .map(|k| format!(", k = {k} strip iterations"))
+            .unwrap_or_default(),
+        out.display()
+    ))
+}
+
+/// `stereolab sirds --decode`: searches the full plausible separation range, decodes, writes
+/// the depth (and with `--pair` the two views and their anaglyph); returns the report.
+fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
+    use stereolab_core::effects::sirds::decode::{decode_auto, nearness_linear};
+    use stereolab_core::effects::sirds::search::SearchOptions;
+
+    // Told the set-up: by the scene's [sirds] table (with --set applied), or by --set alone.
+    let told = args.scene.is_some() || !args.sets.is_empty();
+    let settings = match &args.scene {
+        Some(scene) => super::load_scene(scene, &args.sets, None)?.sirds,
+        None => settings_from_sets(&args.sets)?,
+    };
+    let img = stereolab_core::framebuffer::open_image(path, "image")?.to_rgba8();
+    let (w, h) = img.dimensions();
+    let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    if told {
+        return decode_told(args, path, out, &settings, &pixels, w, h);
+    }
+    let auto = super::with_spinner(&format!("decoding {}", path.display()), || {
+        decode_auto(&pixels, w, h, &SearchOptions::default())
+    })
+    .map_err(|e| e.in_file(path))?;
+    let search = &auto.search;
+    let mut report = format!(
+        "{}: searched separations {}..={} px",
+        path.display(),
+        search.searched.0,
+        search.searched.1
+    );
+    if search.strips.0 < search.strips.1 {
+        report += &format!(
+            " in {} of its {} strips of 7 rows (the work budget)",
+            search.strips.0, search.strips.1
+        );
+    }
+    let (Some(decoded), Some((lo, hi))) = (&auto.decoded, search.found) else {
+        return Err(Error::invalid(
+            "--decode",
+            path.display(),
+            format!(
+                "{report}: only {:.1}% of the image repeats, in no region consistently: not an autostereogram (no consistent repetition), nothing written",
+                search.matched_share * 100.0
+            ),
+        ));
+    };
+    // The regions that made the range (not those left out as harmonics).
+    let dominant: Vec<u32> = search
+        .regions
+        .iter()
+        .map(|r| r.dominant)
+        .filter(|d| (lo..=hi).contains(d))
+        .collect();
+    report += &format!(
+        "\n  found {lo}..={hi} px (dominant repeat per region: {}..={} px in {} regions)\n",
+        dominant.iter().min().copied().unwrap_or(lo),
+        dominant.iter().max().copied().unwrap_or(hi),
+        dominant.len()
+    );
+    // Depth: through the viewing model when the user named the set-up (--set), else linear
+    // in the range found (near repeats sooner when wall-eyed, later when cross-eyed).
+    // Not told the set-up: depth linear in the range found (near repeats sooner when
+    // wall-eyed, later when cross-eyed).
+    let (near, far) = if settings.cross_eyed {
+        (hi as f32, lo as f32)
+    } else {
+        (lo as f32, hi as f32)
+    };
+    report += &format!(
+        "  depth: linear in separation, {near} px = white (near) .. {far} px = black (far)\n"
+    );
+    let z = nearness_linear(decoded, near, far);
+    let range = auto
+        .options
+        .map_or((lo, hi), |o| (o.min_separation, o.max_separation));
+    report += &finish_decode(args, out, &pixels, (w, h), decoded, z, range, &settings)?;
+    Ok(report)
+}
+
+/// `--decode` told the viewing set-up (a scene or `--set sirds.*`): decodes over the
+/// separations the model can produce ([`DecodeOptions::for_disparity`]), no search, and maps
+/// separation to depth through the model (eq. 1 or eq. 3; cross-eyed inverts depth).
+#[allow(clippy::too_many_arguments)]
+fn decode_told(
+    args: &SirdsArgs,
+    path: &Path,
+    out: &Path,
+    settings: &Settings,
+    pixels: &[[u8; 4]],
+    w: u32,
+    h: u32,
+) -> Result<String> {
+    use stereolab_core::effects::sirds::decode::{
+        DecodeOptions, Decoded, decode, matched_share_where_all_fit,
+    };
+    let d = settings.geometry.to_pixels()?;
+    let opts = DecodeOptions::for_disparity(&d);
+    let decoded = super::with_spinner(&format!("decoding {}", path.display()), || {
+        decode(pixels, w, h, &opts)
+    })
+    .map_err(|e| e.in_file(path))?;
+    let mut report = format!(
+        "{}: told the viewing set-up ({}): the {} model, {}, separations {:.1}..{:.1} px\n  \
+         depth: through that model\n",
+        path.display(),
+        if args.scene.is_some() {
+            "the scene's [sirds]"
+        } else {
+            "--set"
+        },
+        match d.model {
+            stereolab_core::effects::sirds::DisparityModel::ViewAngle =>
+                "eq. 1 (constant view angle)",
+            stereolab_core::effects::sirds::DisparityModel::EyeDistance =>
+                "eq. 3 (constant eye distance)",
+        },
+        if settings.cross_eyed {
+            "cross-eyed"
+        } else {
+            "wall-eyed"
+        },
+        d.min_separation(),
+        d.max_separation(),
+    );
+    let z = depth_from_separation(&decoded, &d)
+        .into_iter()
+        .map(|z| if settings.cross_eyed { 1.0 - z } else { z })
+        .collect();
+    let range = (opts.min_separation, opts.max_separation);
+    // Judged where every separation of the model fits (see matched_share_where_all_fit).
+    let share = matched_share_where_all_fit(&decoded, &opts);
+    report += &format!(
+        "  {:.1}% of the pixels where every separation of the model fits matched\n",
+        share * 100.0
+    );
+    let judged = Decoded {
+        matched_share: share,
+        ..decoded
+    };
+    report += &finish_decode(args, out, pixels, (w, h), &judged, z, range, settings)?;
+    Ok(report)
+}
+
+/// Writes the decoded depth (and with `--pair` the views and their anaglyph); returns the
+/// verdict and what was written.
+#[allow(clippy::too_many_arguments)]
+fn finish_decode(
+    args: &SirdsArgs,
+    out: &Path,
+    pixels: &[[u8; 4]],
+    (w, h): (u32, u32),
+    decoded: &stereolab_core::effects::sirds::decode::Decoded,
+    z: Vec<f32>,
+    (lo, hi): (u32, u32),
+    settings: &Settings,
+) -> Result<String> {
+    use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
+    use stereolab_core::effects::sirds::pair::views;
+    let z = z
+        .into_iter()
+        .map(|z| {
+            if z.is_finite() {
+                z.clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    write_depth(
+        &DepthMap {
+            width: w,
+            height: h,
+            z,
+        },
+        out,
+    )?;
+    let mut report = format!(
+        "  {:.1}% of pixels matched a separation in {lo}..={hi} px: {}\n  wrote {}\n",
+        decoded.matched_share * 100.0,
+        if decoded.is_autostereogram() {
+            "an autostereogram"
+        } else {
+            "not an autostereogram (no consistent repetition)"
+        },
+        out.display()
+    );
+    if let Some(dir) = &args.pair {
+        let v = views(pixels, decoded, settings.cross_eyed)?;
+        let fb = |color: Vec<[u8; 4]>| -> Result<stereolab_core::framebuffer::Framebuffer> {
+            let mut fb = stereolab_core::framebuffer::Framebuffer::new(w, h, [0, 0, 0, 255])?;
+            fb.color = color;
+            Ok(fb)
+        };
+        let (left, right) = (fb(v.left)?, fb(v.right)?);
+        let ana = anaglyph(
+            &left,
+            &right,
+            AnaglyphKind::DuboisRedCyan,
+            AnaglyphOptions::default(),
+        )?;
+        let names = [
+            dir.join("left.png"),
+            dir.join("right.png"),
+            dir.join("anaglyph.png"),
+        ];
+        for p in &names {
+            stereolab_core::files::check_output_path(p)?;
+        }
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        stereolab_core::files::write_png(&names[0], &left.to_rgba_image())?;
+        stereolab_core::files::write_png(&names[1], &right.to_rgba_image())?;
+        stereolab_core::files::write_png(&names[2], &ana)?;
+        report += &format!(
+            "  stereo pair ({} viewing, background at zero parallax: {:.1} px)\n",
+            if settings.cross_eyed {
+                "cross-eyed"
+            } else {
+                "wall-eyed"
+            },
+            v.zero_parallax_separation
+        );
+        for p in names {
+            report += &format!("  wrote {}\n", p.display());
+        }
+    }
+    Ok(report)
+}
+
+/// Writes a decoded depth map (white = near) as `out`'s extension asks: PNG (16-bit), a .pgm
+/// as netpbm's binary P5 at 16 bits, a .ppm as binary P6 (8-bit gray in RGB).
+fn write_depth(map: &DepthMap, out: &Path) -> Result<()> {
+    let depth = map.to_image();
+    let format = image::ImageFormat::from_path(out)
+        .map_err(|e| Error::invalid("--out", out.display(), format!("no image format: {e}")))?;
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    let encoded = if format == image::ImageFormat::Pnm {
+        // The image crate would pick PAM for 16-bit gray: a .ppm gets binary P6 (8-bit gray
+        // in RGB), a .pgm binary P5 at 16 bits, as netpbm writes them.
+        use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
+        if has_extension(out, &["pgm"]) {
+            // P5 with maxval 65535: two bytes a sample, most significant first (netpbm).
+            let (w, h) = depth.dimensions();
+            let b = bytes.get_mut();
+            b.extend_from_slice(format!("P5\n{w} {h}\n65535\n").as_bytes());
+            b.extend(depth.as_raw().iter().flat_map(|v| v.to_be_bytes()));
+            Ok(())
+        } else {
+            let sub = PnmSubtype::Pixmap(SampleEncoding::Binary);
+            image::DynamicImage::ImageLuma16(depth)
+                .into_rgb8()
+                .write_with_encoder(PnmEncoder::new(&mut bytes).with_subtype(sub))
+        }
+    } else {
+        image::DynamicImage::ImageLuma16(depth).write_to(&mut bytes, format)
+    };
+    encoded.map_err(|e| Error::invalid("--out", out.display(), e.to_string()))?;
+    stereolab_core::files::write_bytes(out, bytes.get_ref())
+}
