@@ -269,7 +269,7 @@ fn main() -> ExitCode {
 
 #[cfg(test)]
 mod tests {
-    //! The command line's parser, fuzzed (issue 14): any argument list gives a parsed command
+    //! The command line's parser, fuzzed: any argument list gives a parsed command
     //! or clap's error, never a panic (`PROPTEST_CASES` sets the count, docs/reliability.md).
 
     use clap::{CommandFactory, Parser};

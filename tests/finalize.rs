@@ -1,4 +1,4 @@
-//! The finalize pass (issue 3): anaglyphs, remapping, the visibility check and occlusion map,
+//! The finalize pass: anaglyphs, remapping, the visibility check and occlusion map,
 //! parallax as color and the StereoGraphics guide's budget. Helpers here; tests in `tests/finalize/`.
 
 mod anaglyph;

@@ -1,4 +1,4 @@
-//! Fuzzing on stable Rust (issue 14): arbitrary bytes and arbitrary structured values fed to
+//! Fuzzing on stable Rust: arbitrary bytes and arbitrary structured values fed to
 //! the scene, OBJ, CSV and image readers must give a value or a clean error, never a panic or a
 //! hang. CI runs proptest's default 256 cases per reader; the long run is
 //! `PROPTEST_CASES=1000000 cargo test --release --test main fuzz` (docs/reliability.md). A

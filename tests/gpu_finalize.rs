@@ -1,4 +1,4 @@
-//! Finalize parity apart from raster parity (issue 6): the CPU path's own eye framebuffers go
+//! Finalize parity apart from raster parity: the CPU path's own eye framebuffers go
 //! into the CPU finalize functions and into their WGSL mirrors (`stereolab_gpu::effects`), so a
 //! difference here is the effect's alone, never rasterization's.
 //!
@@ -72,7 +72,7 @@ fn diff(expected: &RgbaImage, actual: &RgbaImage) -> (u8, usize) {
         })
 }
 
-/// Issue 6's target, "finalize outputs within 1/255 given identical inputs". Measured: the
+/// The target: finalize outputs within 1/255 given identical inputs. Measured: the
 /// anaglyphs differ by at most 1 step (see the test's printed counts); only llvmpipe's `pow`
 /// (`exp2(y·log2 x)`) and its reciprocal-based division can land on the other side of a
 /// rounding boundary k + ½.

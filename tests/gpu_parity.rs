@@ -190,10 +190,10 @@ fn assert_same_coverage(name: &str, cpu: &Framebuffer, gpu: &Framebuffer) {
 /// difference is a rounding at a .5 boundary after pow/sqrt/rcp that llvmpipe computes with
 /// different precision than libm (docs/gpu-parity.md), never more than one step.
 const GRID_MAX_CHANNEL_DIFF: u8 = 1;
-/// Depth where both cover: the target of issue 6. Measured here before issue 20: 9.6e-7 on
-/// the real model, 4.3e-7 on the clipped scene, up to 3.8e-6 on grid scenes whose triangles
-/// are no steeper than 1.6 depth units per pixel; since the CPU evaluates depth as llvmpipe
-/// does, 0 on the real model (bit-identical) and a difference only on clipped triangles.
+/// Depth where both cover. The CPU evaluates depth as llvmpipe does, so the real model's depth
+/// is bit-identical (0) and only clipped triangles differ; a depth plane evaluated otherwise
+/// differs by 9.6e-7 on the real model, 4.3e-7 on the clipped scene and up to 3.8e-6 on grid
+/// scenes whose triangles are no steeper than 1.6 depth units per pixel.
 const MAX_DEPTH_DIFF: f32 = 1e-5;
 /// Depth error per unit of depth slope, in pixels: both paths evaluate a float depth plane,
 /// from different reference points, so the difference is the slope times a position error of
@@ -321,7 +321,7 @@ fn shipped_scenes() -> Vec<std::path::PathBuf> {
     v
 }
 
-/// ≥ 99.9% identical coverage (issue 6). Measured here on wuson.toml at 1024×768: 0 of
+/// ≥ 99.9% identical coverage. Measured here on wuson.toml at 1024×768: 0 of
 /// 786 432 pixels differ in either eye; the bound leaves room for other CPUs' rounding.
 const SHIPPED_COVERAGE_PERCENT: f64 = 0.1;
 /// Channel differences on shipped scenes. Measured on wuson.toml: max 1 (11 pixels per eye),
@@ -339,8 +339,7 @@ const CHROMADEPTH_MEAN_CHANNEL_DIFF: f64 = 0.002;
 const CHROMADEPTH_MIN_PSNR: f64 = 55.0;
 
 /// The occlusion map's WGSL mirror on the CPU's own eyes (`compare_finalize`). Measured on
-/// anaglyph.toml at 1024×768: identical until the depth plane followed llvmpipe (issue 20);
-/// since then one pixel of 2 × 786 432 gets another class (max 118, mean 0.00006, PSNR 71 dB):
+/// anaglyph.toml at 1024×768, with the depth plane evaluated as llvmpipe does: one pixel of 2 × 786 432 gets another class (max 118, mean 0.00006, PSNR 71 dB):
 /// its remapped depth lies within rounding of the visibility tolerance, where the WGSL's f32
 /// arithmetic and the CPU's part-f64 arithmetic decide differently. Bounds with room for a
 /// few more such pixels.
@@ -441,7 +440,7 @@ fn shipped_scenes_match_coverage_depth_and_color() {
 
 /// Share of the pixels both paths cover whose depth is the same `f32` on both. In every
 /// shipped scene whose passes clip no triangle, that share is 100%: the CPU's depth plane
-/// follows llvmpipe's setup and evaluation (issue 20). Triangles cut by the near or far plane
+/// follows llvmpipe's setup and evaluation. Triangles cut by the near or far plane
 /// go through the CPU's clipper, not a mirror of lavapipe's `draw_pipe_clip.c`, so their new
 /// vertices differ in the last bits; the scenes that clip are measured and printed, and their
 /// depth difference is bounded by `MAX_DEPTH_DIFF` in `shipped_scenes_match_coverage_depth_and_color`.

@@ -1,4 +1,4 @@
-//! SIRDS strips on the GPU (issue 6, the SIRDS paper's §3–4): the WGSL render-to-texture ping-pong
+//! SIRDS strips on the GPU (the SIRDS paper's §3–4): the WGSL render-to-texture ping-pong
 //! against the CPU strip algorithm on the same `StripGeometry`, and the GPU SIRDS decoded.
 //! Compiled only with `--features gpu`; skips without an adapter, fails when `CI` is set (the
 //! helper of tests/gpu_parity.rs).

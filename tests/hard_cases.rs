@@ -1,4 +1,4 @@
-//! Issue 18's adversarial inputs, tried as a user would with `--set`: each must end in a refusal
+//! Adversarial inputs, tried as a user would with `--set`: each must end in a refusal
 //! (non-zero exit, the field and the remedy named) or a warning in the CLI output, never in a
 //! silently wrong image with exit 0.
 
@@ -775,8 +775,8 @@ fn catalogue_coordinates_far_from_the_origin_against_the_f64_reference() {
 
 /// The parallax budget is read back from the depth buffer; where one depth step is worth
 /// more than 0.1 px of parallax (`info::DEPTH_STEP_PARALLAX_WARN`), its figures are uncertain
-/// by that much and the report says so (issue 18: at near 1e-6 / far 1e7 the budget said
-/// −0.86 px where the vertices give −0.5 px, silently). A well-set near plane stays silent.
+/// by that much and the report says so (at near 1e-6 / far 1e7 the budget reads
+/// −0.86 px where the vertices give −0.5 px). A well-set near plane stays silent.
 #[test]
 fn a_budget_read_from_a_too_coarse_depth_buffer_says_it_is_uncertain() {
     let out = render(

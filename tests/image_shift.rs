@@ -1,4 +1,4 @@
-//! Issue 17 item 1: image-shift stereo (the StereoGraphics guide (Akka) §6): the parallel eyes
+//! Image-shift stereo (the StereoGraphics guide (Akka) §6): the parallel eyes
 //! shifted apart when viewported by whole pixels. Measured on the images: the columns only one
 //! eye covers, zero parallax at z0 within half a pixel, and each eye is the parallel eye moved.
 

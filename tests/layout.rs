@@ -15,7 +15,7 @@ fn pair(w: u32, h: u32) -> (Framebuffer, Framebuffer) {
 }
 
 #[test]
-fn seed003_above_below_1024x768_with_blank_40_has_364_row_views() {
+fn guides_above_below_1024x768_with_blank_40_has_364_row_views() {
     let (l, r) = pair(1024, 768);
     let img = layout::above_below_squashed(&l, &r, 40).unwrap();
     assert_eq!(img.dimensions(), (1024, 768));

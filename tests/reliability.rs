@@ -1,4 +1,4 @@
-//! Nothing lost, nothing half-written (issue 14, items 1, 2, 5 and 9): every output goes through
+//! Nothing lost, nothing half-written: every output goes through
 //! a temporary file renamed into place only when complete, a link planted in the output folder
 //! is refused, every output of a render is made before any is written, and a closed or full
 //! standard output ends the command cleanly instead of a panic.
@@ -169,7 +169,7 @@ fn stereolab_within(args: &[&str], secs: u64) -> Option<Output> {
     None
 }
 
-/// Issue 14 item 3: a FIFO blocked forever and `/dev/zero` grew past 6 GB; both are refused
+/// A FIFO would block forever and `/dev/zero` would grow past 6 GB; both are refused
 /// before a byte is read.
 #[cfg(target_os = "linux")]
 #[test]
@@ -204,8 +204,8 @@ fn fifos_and_devices_as_inputs_are_refused_at_once() {
     }
 }
 
-/// Issue 14 item 8: `layout.blank_interval = 4294967295` wrapped past the check (and panicked
-/// in a debug build); now it is refused, naming the field.
+/// `layout.blank_interval = 4294967295` must not wrap past the check (or panic in a debug
+/// build): it is refused, naming the field.
 #[test]
 fn a_huge_blank_interval_is_refused_not_wrapped() {
     let dir = out_dir("reliability-blank");
@@ -239,8 +239,8 @@ fn a_huge_blank_interval_is_refused_not_wrapped() {
     );
 }
 
-/// Issue 14 item 10: `--frames 3 -o x.png` wrote a GIF under a PNG name, and `--decode … -o
-/// x.ppm` wrote a PAM. An animation must be named .gif; a decoded depth map is a real PPM (P6)
+/// No GIF under a PNG name (`--frames 3 -o x.png`) and no PAM under a PPM name (`--decode …
+/// -o x.ppm`): an animation must be named .gif; a decoded depth map is a real PPM (P6)
 /// or, for .pgm, a 16-bit PGM (P5).
 #[test]
 fn each_output_gets_the_container_its_name_says() {
@@ -309,9 +309,8 @@ fn png_header_only(width: u32, height: u32) -> Vec<u8> {
     png
 }
 
-/// Issue 14 item 6 (part): `sirds --decode` of a 20000×20000 PNG of 388 KB grew past 4.6 GB,
-/// `compare` of two such images to 15.3 GB. The size is now read from the header and refused
-/// before decoding; `--frames` has a limit.
+/// A 20000×20000 PNG of 388 KB would take `sirds --decode` past 4.6 GB and `compare` of two
+/// such images to 15.3 GB. The size is read from the header and refused before decoding; `--frames` has a limit.
 #[test]
 fn oversized_images_are_refused_from_their_header() {
     let dir = out_dir("reliability-huge");
@@ -369,7 +368,7 @@ fn scene_reading(dir: &Path, kind: &str, path: &str, extra: &str) -> PathBuf {
     scene
 }
 
-/// Issue 14 item 4: a scene reads only files in its own folder tree unless
+/// A scene reads only files in its own folder tree unless
 /// `--allow-outside-paths` is given (absolute paths, `..`, links out of the tree, pattern
 /// images), and what an error quotes of a file is short and escaped.
 #[cfg(unix)]
@@ -424,7 +423,7 @@ fn scenes_read_only_their_own_folder_tree_and_errors_quote_little() {
     );
 }
 
-/// Issue 14 item 6: a small scene asking for millions of triangles is refused before anything
+/// A small scene asking for millions of triangles is refused before anything
 /// is built, naming the field, the count, the budget and the flag; the flag moves the budget.
 #[test]
 fn a_scene_over_its_triangle_budget_is_refused_before_it_is_built() {
@@ -453,8 +452,8 @@ fn a_scene_over_its_triangle_budget_is_refused_before_it_is_built() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("budget of 10"));
 }
 
-/// Issue 14 item 7: 16-bit images (depth maps) are compared at 16 bits; two maps 100 levels
-/// apart used to compare as identical after the reduction to 8 bits.
+/// 16-bit images (depth maps) are compared at 16 bits: two maps 100 levels apart would
+/// compare as identical after a reduction to 8 bits.
 #[test]
 fn sixteen_bit_images_are_compared_at_their_own_depth() {
     let dir = out_dir("reliability-16bit");
@@ -483,10 +482,10 @@ fn sixteen_bit_images_are_compared_at_their_own_depth() {
     assert!(stdout.contains("max diff 0 of 65535 levels"), "{stdout}");
 }
 
-/// Issue 14 item 11: messages that misled now name the input, the field or flag, the value and
+/// Messages name the input, the field or flag, the value and
 /// the remedy.
 #[test]
-fn misleading_messages_now_name_the_real_problem() {
+fn misleading_messages_name_the_real_problem() {
     let dir = out_dir("reliability-messages");
     let wuson = s(&asset("scenes/wuson.toml"));
     let afile = dir.join("afile");
@@ -556,8 +555,8 @@ fn misleading_messages_now_name_the_real_problem() {
     }
 }
 
-/// Issue 14 item 11: a GPU run that succeeds printed Mesa's "XDG_RUNTIME_DIR is invalid or not
-/// set" twice when the variable was missing; it now prints nothing on stderr.
+/// A GPU run that succeeds prints nothing on stderr, not even Mesa's "XDG_RUNTIME_DIR is
+/// invalid or not set" when the variable is missing.
 #[cfg(feature = "gpu")]
 #[test]
 fn a_successful_gpu_run_prints_no_errors_without_a_runtime_dir() {

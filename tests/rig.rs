@@ -7,7 +7,7 @@ use stereolab_core::math::{
     Camera, CameraMode, Lighting, Separation, StereoRig, ZeroParallax, frustum, project_ndc,
 };
 
-fn seed003_camera() -> Camera {
+fn guide_camera() -> Camera {
     // The StereoGraphics guide's §5: camera at (0, 0, 9) looking at the xy plane; fov 90° so the plane spans ±9.
     Camera {
         eye: [0.0, 0.0, 9.0],
@@ -29,8 +29,8 @@ fn rig(mode: CameraMode, separation: f32, z0: f32) -> StereoRig {
 }
 
 #[test]
-fn seed003_worked_example_projects_to_5_875_and_6_125() {
-    let cam = seed003_camera();
+fn guides_worked_example_projects_to_5_875_and_6_125() {
+    let cam = guide_camera();
     let eyes = rig(CameraMode::OffAxis, 1.0, 9.0).eyes(&cam, 1.0).unwrap();
     // NDC → coordinates on the zero-parallax plane z = 0, which spans ±9 (tan 45° · 9).
     let on_plane = |m: &glam::Mat4| project_ndc(m, Vec3::new(8.0, -5.0, -3.0)).unwrap().xy() * 9.0;
@@ -46,7 +46,7 @@ fn seed003_worked_example_projects_to_5_875_and_6_125() {
 }
 
 #[test]
-fn frustum_matches_seed004_entries() {
+fn frustum_matches_the_exercise_slides_entries() {
     let (l, r, b, t, n, f) = (-0.3f32, 0.5, -0.2, 0.4, 0.7, 11.0);
     let m = frustum(l, r, b, t, n, f);
     let expect = [
@@ -71,8 +71,8 @@ fn frustum_matches_seed004_entries() {
 }
 
 #[test]
-fn off_axis_frustum_shift_is_seed003_asymmetry() {
-    let cam = seed003_camera();
+fn off_axis_frustum_shift_is_the_guides_frustum_asymmetry() {
+    let cam = guide_camera();
     let mut r = rig(CameraMode::OffAxis, 0.8, 6.0);
     r.user_balance = 1.5;
     let eyes = r.eyes(&cam, 1.0).unwrap();
@@ -84,8 +84,8 @@ fn off_axis_frustum_shift_is_seed003_asymmetry() {
 }
 
 #[test]
-fn auto_separation_is_twice_seed003_camera_offset() {
-    let cam = seed003_camera();
+fn auto_separation_is_twice_the_guides_camera_offset() {
+    let cam = guide_camera();
     let r = StereoRig {
         separation: Separation::Auto,
         zero_parallax: ZeroParallax::Distance(9.0),
@@ -104,7 +104,7 @@ fn auto_separation_is_twice_seed003_camera_offset() {
 
 #[test]
 fn zero_parallax_fraction_is_between_near_and_far() {
-    let cam = seed003_camera();
+    let cam = guide_camera();
     let r = StereoRig {
         zero_parallax: ZeroParallax::Fraction(0.25),
         ..StereoRig::default()
@@ -116,7 +116,7 @@ fn zero_parallax_fraction_is_between_near_and_far() {
 
 #[test]
 fn per_eye_and_cyclopic_share_mvp_but_not_modelview() {
-    let cam = seed003_camera();
+    let cam = guide_camera();
     let mut r = rig(CameraMode::OffAxis, 1.0, 9.0);
     let per_eye = r.eyes(&cam, 1.0).unwrap();
     r.lighting = Lighting::Cyclopic;
@@ -130,7 +130,7 @@ fn per_eye_and_cyclopic_share_mvp_but_not_modelview() {
 
 #[test]
 fn toe_in_rotates_each_eye_by_atan_half_iod_over_fusion() {
-    let cam = seed003_camera();
+    let cam = guide_camera();
     let eyes = rig(CameraMode::ToeIn, 1.0, 9.0).eyes(&cam, 1.0).unwrap();
     for (i, e) in eyes.iter().enumerate() {
         // The eye's forward axis is −Z of its view; its angle to the camera's −Z axis.
@@ -146,7 +146,7 @@ fn toe_in_rotates_each_eye_by_atan_half_iod_over_fusion() {
 
 #[test]
 fn toe_in_has_vertical_parallax_off_center() {
-    let cam = seed003_camera();
+    let cam = guide_camera();
     let eyes = rig(CameraMode::ToeIn, 1.0, 9.0).eyes(&cam, 1.0).unwrap();
     let vertical_px = |p: Vec3| {
         let (l, r) = (
@@ -169,7 +169,7 @@ fn toe_in_has_vertical_parallax_off_center() {
 proptest! {
     #[test]
     fn off_axis_zero_parallax_plane_lands_on_same_pixel(x in -8.0f32..8.0, y in -8.0f32..8.0, d in 0.01f32..2.0) {
-        let cam = seed003_camera();
+        let cam = guide_camera();
         let eyes = rig(CameraMode::OffAxis, d, 9.0).eyes(&cam, 1.0).unwrap();
         let p = Vec3::new(x, y, 0.0);
         let (l, r) = (project_ndc(&eyes[0].mvp, p).unwrap(), project_ndc(&eyes[1].mvp, p).unwrap());
@@ -178,7 +178,7 @@ proptest! {
 
     #[test]
     fn off_axis_has_no_vertical_parallax(x in -8.0f32..8.0, y in -8.0f32..8.0, z in -80.0f32..7.0, d in 0.01f32..2.0) {
-        let cam = seed003_camera();
+        let cam = guide_camera();
         let eyes = rig(CameraMode::OffAxis, d, 9.0).eyes(&cam, 1.0).unwrap();
         let p = Vec3::new(x, y, z);
         let (l, r) = (project_ndc(&eyes[0].mvp, p).unwrap(), project_ndc(&eyes[1].mvp, p).unwrap());
@@ -199,7 +199,7 @@ fn invalid_field(e: Error) -> String {
 
 #[test]
 fn bad_rig_parameters_name_their_field() {
-    let cam = seed003_camera();
+    let cam = guide_camera();
     assert_eq!(
         invalid_field(
             rig(CameraMode::OffAxis, -0.1, 9.0)
@@ -239,7 +239,7 @@ fn bad_rig_parameters_name_their_field() {
         "stereo.user_balance"
     );
     let bad = |f: fn(&mut Camera)| {
-        let mut c = seed003_camera();
+        let mut c = guide_camera();
         f(&mut c);
         invalid_field(
             rig(CameraMode::OffAxis, 1.0, 9.0)

@@ -1,4 +1,4 @@
-//! Issue 17 items 6 and 8: shear vs rotate side by side (the SGI course notes §4.1.3), and the
+//! Shear vs rotate side by side (the SGI course notes §4.1.3), and the
 //! viewer at one eye (§4.1.1).
 
 use glam::Vec3;

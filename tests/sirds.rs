@@ -1,4 +1,4 @@
-//! SIRDS (issue 5, the SIRDS paper (Petz et al.)): disparity formulas, constraints, decode round trips, left vs
+//! SIRDS (the SIRDS paper (Petz et al.)): disparity formulas, constraints, decode round trips, left vs
 //! center start, SIRDS vs noise, bad input, CLI, plan.
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! Issue 17, item 14: the SIRDS paper's experiments as outputs. Fig. 5's three bands, Fig. 6's
+//! The SIRDS paper's experiments as outputs. Fig. 5's three bands, Fig. 6's
 //! centre start from an initialization texture, and the depth error of large triangles.
 
 use stereolab::output::sirds::{FIG5_BANDS, fig5_bands, from_frame, scene_depth};

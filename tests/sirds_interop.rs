@@ -1,4 +1,4 @@
-//! Issue 21, part 1 and 2: autostereograms made by other tools (netpbm's `pamstereogram`) and
+//! Autostereograms made by other tools (netpbm's `pamstereogram`) and
 //! by stereolab with any set-up, decoded without being told the separations; noise stays
 //! noise; an autostereogram back to a stereo pair.
 
@@ -74,7 +74,7 @@ fn pamstereogram(depth: &Path, args: &[&str], out: &Path) {
     std::fs::write(out, &output.stdout).expect("write stereogram");
 }
 
-/// The foreign-stereogram test of issue 21's "Done means". `pamstereogram` (netpbm 10.x, its
+/// A foreign stereogram decoded untold. `pamstereogram` (netpbm 10.x, its
 /// defaults: 2.56 in eyes at 100 DPI, wall-eyed, depth of field 1/3) puts the far plane at
 /// 128 px and the nearest point at 102 px ("Near pattern width: 102" with `-verbose`); the
 /// decoder is told none of it. Measured here: found 102..=128 px in both, 80% (b/w) and 73%
@@ -319,7 +319,7 @@ fn pfm(channels: usize, w: usize, rows_top_first: &[Vec<f32>], little: bool) -> 
     bytes
 }
 
-/// Issue 21, part 4: every format maps as docs/interop.md says, both ways round.
+/// Every format maps as docs/interop.md says, both ways round.
 #[test]
 fn depth_maps_from_any_format_map_as_documented() {
     use stereolab_core::effects::sirds::depthfile::{DepthSamples, Near};

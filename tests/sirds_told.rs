@@ -1,4 +1,4 @@
-//! Issue 17, items 11 and 13: the SIRDS decoder told the viewing set-up by a scene or flags
+//! The SIRDS decoder told the viewing set-up by a scene or flags
 //! (an eq. 1 autostereogram beyond the searched range decodes); and measured properties of
 //! what worked untested: parallel cameras, guide dots, cross-eyed SIRDS, a pattern image.
 

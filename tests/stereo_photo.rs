@@ -1,4 +1,4 @@
-//! Issue 21, part 3: the `mpo`, `jps` and `pns` outputs, read back by an independent reader
+//! The `mpo`, `jps` and `pns` outputs, read back by an independent reader
 //! (ExifTool, Debian's `libimage-exiftool-perl`) and by `stereolab compare`.
 
 use std::path::{Path, PathBuf};

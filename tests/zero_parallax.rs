@@ -1,4 +1,4 @@
-//! Issue 17: `zero_parallax = "auto"` and `"fit"`, the budget's two remedies, and the
+//! `zero_parallax = "auto"` and `"fit"`, the budget's two remedies, and the
 //! field-of-view advice (the StereoGraphics guide (Akka) §7–8).
 
 use glam::Vec3;

@@ -294,7 +294,7 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
         r.note = "random colors, no equal neighbours".into();
         rows.push(with_throughput(r, copy));
     }
-    // The scalar loop, what a CPU without AVX2 runs (the same bytes), on the kind goal 1 uses.
+    // The scalar loop, what a CPU without AVX2 runs (the same bytes), on the kind the one-submission yardstick uses.
     let (scalar_ms, copy) = with_copy(iters, px * 8, &mut || {
         anaglyph_with(left, right, kind, AnaglyphOptions::default(), false).map(drop)
     })?;

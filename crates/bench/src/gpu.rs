@@ -174,7 +174,7 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// The stereo pair + Dubois anaglyph frame (issue 19, goal 2), timed round-robin in one run:
+/// The stereo pair + Dubois anaglyph frame with the eyes kept on the GPU, timed round-robin in one run:
 /// - the CPU path (passes + `anaglyph`);
 /// - the GPU path through the host, as `render --backend gpu` makes it: passes, readback of
 ///   both eyes (color and depth), then the WGSL anaglyph pass with its upload and readback;

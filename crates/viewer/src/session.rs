@@ -140,7 +140,7 @@ impl Session {
         })
     }
 
-    /// Sets `scene` (the one this session was opened with, or one already changed by an
+    /// Sets `scene` (the one the viewer was opened with, or one already changed by an
     /// earlier call) to `p`. Only fields change; the meshes stay where they are.
     pub fn apply(&self, p: &Params, scene: &mut Scene) {
         scene.outputs = vec![p.output];

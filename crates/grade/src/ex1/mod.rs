@@ -73,7 +73,7 @@ fn camera(setup: &StereoSetup, eye: [f32; 3], target: [f32; 3]) -> Camera {
 /// The setups the numeric stereo checks use: the fixture's, the StereoGraphics guide's worked example, and a
 /// wide, close one.
 fn setups(fx: &Fixture) -> Vec<(StereoSetup, Camera)> {
-    let seed003 = StereoSetup {
+    let guide = StereoSetup {
         fov_y_degrees: 90.0,
         aspect: 1.0,
         near: 1.0,
@@ -91,7 +91,7 @@ fn setups(fx: &Fixture) -> Vec<(StereoSetup, Camera)> {
     };
     vec![
         (fx.setup, fx.scene.camera.clone()),
-        (seed003, camera(&seed003, [0.0, 0.0, 9.0], [0.0, 0.0, 0.0])),
+        (guide, camera(&guide, [0.0, 0.0, 9.0], [0.0, 0.0, 0.0])),
         (wide, camera(&wide, [3.0, 2.0, -1.0], [0.0, 0.5, 0.0])),
     ]
 }

@@ -1,6 +1,6 @@
 //! Exercise 1's `rds_right` task: the right image of Julesz's random-dot stereo pair (the SIRDS
 //! paper (Petz et al.), §1), built by the student from their own `remap_right_to_left` and
-//! `visible` (issue 17, item 3). The library's version is [`stereolab_core::effects::rds`].
+//! `visible`. The library's version is [`stereolab_core::effects::rds`].
 //!
 //! A case is a whole pair: both eyes' depth buffers rendered by stereolab, their MVPs, the left
 //! random dots and the fresh dots, and the depth tolerance. The answer is the right image's dots

@@ -173,7 +173,7 @@ impl Disparity {
     /// `t_far − z (t_far − t_near)`, evaluated in f64 and rounded once. In f32 the difference
     /// `t_far − t_near` rounds to a multiple of `ulp(t_far)`, so with `sirds.depth_far_in = 1e8`
     /// (`t_far` = 7.2e9 px, ulp 512) the front `z = 1` landed at 512 px instead of
-    /// `t_near` = 576 px: a front separation of 67 px instead of 72 (issue 18).
+    /// `t_near` = 576 px: a front separation of 67 px instead of 72.
     #[inline]
     pub fn depth_of(&self, z: f32) -> f32 {
         let (t_far, t_near) = (f64::from(self.t_far), f64::from(self.t_near));
