@@ -40,7 +40,7 @@ use stereolab_core::{Error, Result};
 /// few MB; glibc serves those with mmap and hands them back to the OS on free, so each frame
 /// page-faulted its 12.6 MB of targets back in: a 1024×768 stereo pair took 23 ms with glibc
 /// against 9.0–9.7 ms with mimalloc, which keeps the pages (same run, `examples`-style loop).
-/// A C library, so a feature of its own (`mimalloc`, on by default) that the student handout
+/// A C library, so a feature of its own (`mimalloc`, off by default) that the student handout
 /// leaves off: it would only lengthen a student's first build.
 #[cfg(feature = "mimalloc")]
 #[global_allocator]
