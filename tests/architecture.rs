@@ -251,7 +251,9 @@ fn top_level_modules_import_each_other_one_way_only() {
         let mut upward = Vec::new();
         for (m, deps) in &g {
             let Some(lm) = layer_of(layers, m) else {
-                panic!("{dir}: module `{m}` has no layer: add it to CRATES in tests/architecture.rs");
+                panic!(
+                    "{dir}: module `{m}` has no layer: add it to CRATES in tests/architecture.rs"
+                );
             };
             for d in deps {
                 let ld = layer_of(layers, d).unwrap_or(usize::MAX);

@@ -63,7 +63,10 @@ fn bundle_manifest(text: &str, path: &Path) -> Result<String> {
         .ok_or_else(|| Error::parse(path, None, "no [workspace.dependencies] table"))?;
     table.insert(
         "workspace".into(),
-        toml::Value::Table(toml::Table::from_iter([("dependencies".to_string(), shared)])),
+        toml::Value::Table(toml::Table::from_iter([(
+            "dependencies".to_string(),
+            shared,
+        )])),
     );
     toml::to_string(&table).map_err(|e| Error::parse(path, None, e.to_string()))
 }
