@@ -718,7 +718,7 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
     for f in ["slides/node_modules", "slides/build"] {
         assert!(!handout.join(f).exists(), "{f} copied into the handout");
     }
-    // The documents are named by title, never by the team's file numbers ("seed 003").
+    // The documents are named by title, never by the team's file numbers.
     for f in files_under(&handout) {
         let in_student_part = !f.starts_with(handout.join("stereolab"));
         if in_student_part && f.extension().is_some_and(|e| e == "rs" || e == "md") {

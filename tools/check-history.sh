@@ -20,7 +20,7 @@ patterns=(
     '\bbranch(es)? `[^`]+`'
     '\b(on|in|from|the) (the )?branch [`"]?[a-z0-9_.-]+/?[a-z0-9_.-]*[`"]?'
     '\bh-(finalize|sirds|gpu|docs|perf|raster)\b'
-    '\bseed0[0-9]{2}'
+    'seed ?0[0-9]{2}'
     '\b[0-9]{1,2}:[0-9]{2} UTC\b'
     '\bUTC on [0-9]{4}-[0-9]{2}-[0-9]{2}\b'
     '\bbefore (this|the) change\b'

@@ -197,8 +197,9 @@ impl Scene {
                 ));
             }
             (Some(file::SeparationSpec::Value(d)), None) => ZeroParallax::Distance(*d),
-            // "auto": the camera target's distance along the view direction (seed 003 §7's
-            // centre of interest); "fit" is resolved below, once the meshes are loaded.
+            // "auto": the camera target's distance along the view direction (the centre of
+            // interest of the StereoGraphics guide's §7); "fit" is resolved below, once the
+            // meshes are loaded.
             (Some(file::SeparationSpec::Word(w)), None) if w == "auto" || w == "fit" => {
                 zero_parallax_word = Some(w.clone());
                 let dir = Vec3::from(f.camera.target) - Vec3::from(f.camera.eye);
