@@ -119,7 +119,7 @@ fn an_eye_separation_that_overflows_the_cameras_is_refused_in_every_mode() {
         &["stereo.mode=\"toe-in\"", "stereo.eye_separation=1e20"],
     );
     assert_refused(&out, &["stereo.eye_separation", "non-finite", "\"auto\""]);
-    // Render refuses it too (before: NaN cameras, empty images, exit 0).
+    // Render refuses it too (rather than NaN cameras, empty images and exit 0).
     let out = render(
         "anaglyph.toml",
         "hard-toe-in",

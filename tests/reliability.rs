@@ -52,8 +52,8 @@ fn a_link_planted_in_the_output_folder_is_refused_and_nothing_is_written() {
     let dir = out_dir("reliability-link");
     let victim = dir.join("victim.txt");
     std::fs::write(&victim, b"keep me").expect("victim");
-    // The third output's name is a link: before, left.png and right.png were written and the
-    // link followed; now the run fails before writing anything.
+    // The third output's name is a link: the run fails before writing anything (not left.png
+    // and right.png first, then following the link).
     std::os::unix::fs::symlink(&victim, dir.join("side_by_side.png")).expect("symlink");
     let out = render_small(&dir, &[]);
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -22,7 +22,7 @@ patterns=(
     '\bh-(finalize|sirds|gpu|docs|perf|raster)\b'
     'seed ?0[0-9]{2}'
     '\b[0-9]{1,2}:[0-9]{2} UTC\b'
-    '\bUTC on [0-9]{4}-[0-9]{2}-[0-9]{2}\b'
+    '\b(UTC|run|measured|runs?) (on |\()?20[0-9]{2}-[0-9]{2}-[0-9]{2}\b'
     '\bbefore (this|the) change\b'
     '\b(in|of|since) (the )?(previous|last|earlier) sessions?\b'
 )

@@ -18,8 +18,8 @@ pub(crate) fn available() -> bool {
 /// came from is what a masked store does, and LLVM rewrites it into one; this keeps the full
 /// store. Only an instruction choice: the bytes are the same without it. Measured in the depth
 /// pass, the gain was within noise (the hot load stayed as hot: it waits on the cache, not on
-/// store forwarding), so the depth pass no longer uses it; the strip pass
-/// (`effects/sirds/per_vertex/avx2.rs`) still does.
+/// store forwarding), so the depth pass does not use it; the strip pass
+/// (`render/sirds_strips/avx2.rs` in the `stereolab` crate) does.
 ///
 /// # Safety
 /// The CPU must have AVX2 and FMA ([`super::avx2_available`]).

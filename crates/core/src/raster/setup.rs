@@ -45,10 +45,10 @@ impl WindowVertex {
     ///   LLVM fuses into one FMA instruction on a CPU that has it.
     ///
     /// `x` and `y` (coverage and varyings) are computed the same way, then clamped to the
-    /// viewport. They used to keep the division `(x/w)` of OpenGL's formula; snapped to 1/256
-    /// pixel the last bit almost never matters, but on one shipped view (`wuson_zero_parallax_fit`)
-    /// it did: a snapped vertex landed on the other side of a pixel centre, and a different
-    /// triangle won that pixel on the GPU.
+    /// viewport. They do not keep the division `(x/w)` of OpenGL's formula: snapped to 1/256
+    /// pixel the last bit almost never matters, but on one shipped view
+    /// (`wuson_zero_parallax_fit`) it does: with the division a snapped vertex lands on the
+    /// other side of a pixel centre, and a different triangle wins that pixel on the GPU.
     pub(crate) fn from_clip(v: &ClipVertex, width: u32, height: u32) -> Option<Self> {
         let p = v.pos;
         if p.w <= 0.0 {
