@@ -40,7 +40,7 @@ const CRATES: &[(&str, &[&[&str]])] = &[
         ],
     ),
     (
-        "crates/stereolab/src",
+        "crates/pipeline/src",
         &[
             &["plan"],
             &["scene"],
@@ -179,8 +179,8 @@ fn referenced(code: &str, path: &[String]) -> BTreeSet<String> {
 /// top-level modules it names.
 fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
     let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    for file in rust_files(&src) {
-        let rel = file.strip_prefix(&src).unwrap();
+    for file in rust_files(src) {
+        let rel = file.strip_prefix(src).unwrap();
         if rel == Path::new("lib.rs") {
             continue; // it declares the modules
         }
