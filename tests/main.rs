@@ -11,6 +11,7 @@ mod determinism;
 mod display;
 mod figures;
 mod finalize;
+mod formulas_doc;
 mod fuzz;
 mod gallery;
 mod golden;

@@ -116,7 +116,6 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     // in (every build of a submission resolves from the same versions).
     for (from, to) in [
         (root.join("LICENSE"), lib.join("LICENSE")),
-        (root.join("README.md"), lib.join("README.md")),
         (root.join("Cargo.lock"), dir.join("Cargo.lock")),
         (root.join("Cargo.lock"), lib.join("Cargo.lock")),
     ] {
@@ -231,9 +230,9 @@ cargo run -p stereolab -- render --exercise ex1 stereolab/assets/scenes/wuson.to
 ```
 
 **The first `cargo run -p stereolab` compiles the grader**: stereolab with its command line
-only (no viewer window, GPU path or C allocator), and its dependencies, 106 crates (the
-repository's full build has 218), unoptimized (this workspace's profile: the grader's pictures
-are small, so compiling fast matters more than running fast). Later runs start at once. Each `grade` then builds your crates in `target/stereolab-grade/` in seconds.
+only (no viewer window, GPU path or C allocator) and its dependencies, unoptimized (this
+workspace's profile: the grader's pictures are small, so compiling fast matters more than
+running fast). Later runs start at once. Each `grade` then builds your crates in `target/stereolab-grade/` in seconds.
 
 ## How points are given
 
