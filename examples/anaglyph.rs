@@ -7,7 +7,7 @@ use stereolab::scene::Mesh;
 use stereolab_core::Framebuffer;
 use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
 use stereolab_core::math::{Camera, StereoRig};
-use stereolab_core::raster::{RasterOptions, rasterize};
+use stereolab_core::raster::{RasterOptions, rasterize_blinn_phong};
 use stereolab_core::shade::{BlinnPhong, Light};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -39,7 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             Light::default(),
         );
         let opts = RasterOptions::default();
-        rasterize(
+        rasterize_blinn_phong(
             &torus.triangles,
             torus.positions.len(),
             &shader,

@@ -7,7 +7,7 @@
 //!
 //! `stereolab-core`, lowest first:
 //! - `error`: the one error type.
-//! - `files`: bounded reads and all-or-nothing writes.
+//! - `files`, `eye`: bounded reads and all-or-nothing writes; which eye (left or right).
 //! - `math`, `framebuffer`, `shade`, `text`: matrices and the rig, the render target (and the
 //!   image sizes it accepts), the shader stages, text in pictures.
 //! - `raster`, `reference`: fixed-point setup and traversal (knows nothing of scenes or
@@ -33,7 +33,7 @@ const CRATES: &[(&str, &[&[&str]])] = &[
         "crates/core/src",
         &[
             &["error"],
-            &["files"],
+            &["files", "eye"],
             &["math", "framebuffer", "shade", "text"],
             &["raster", "reference"],
             &["effects"],

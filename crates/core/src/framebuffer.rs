@@ -3,6 +3,7 @@
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::eye::Eye;
 
 /// Largest image side we accept.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
@@ -24,11 +25,6 @@ pub struct Framebuffer {
     pub depth: Vec<f32>,
 }
 
-/// Index of the left eye in an eye pair (the exercise slides: 0 = left, 1 = right).
-pub const LEFT: usize = 0;
-/// Index of the right eye in an eye pair.
-pub const RIGHT: usize = 1;
-
 /// The stereo draw buffers of a quad-buffered OpenGL context, by the names the SGI course notes
 /// (`glDrawBuffer(GL_BACK_LEFT)` … `glDrawBuffer(GL_BACK_RIGHT)`, §4.1.2) and the StereoGraphics
 /// guide (§3–4: "you can specify your drawing buffer as GL_BACK_LEFT or GL_BACK_RIGHT, which will
@@ -37,9 +33,9 @@ pub const RIGHT: usize = 1;
 /// `render` returns them by these names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DrawBuffer {
-    /// `GL_BACK_LEFT`: the left eye's back buffer (eye index [`LEFT`]).
+    /// `GL_BACK_LEFT`: the left eye's back buffer ([`Eye::Left`]).
     BackLeft,
-    /// `GL_BACK_RIGHT`: the right eye's back buffer (eye index [`RIGHT`]).
+    /// `GL_BACK_RIGHT`: the right eye's back buffer ([`Eye::Right`]).
     BackRight,
 }
 
@@ -49,11 +45,11 @@ pub const BACK_LEFT: DrawBuffer = DrawBuffer::BackLeft;
 pub const BACK_RIGHT: DrawBuffer = DrawBuffer::BackRight;
 
 impl DrawBuffer {
-    /// The eye index of the buffer: [`LEFT`] (0) or [`RIGHT`] (1).
-    pub fn eye(self) -> usize {
+    /// The eye whose buffer this is.
+    pub fn eye(self) -> Eye {
         match self {
-            DrawBuffer::BackLeft => LEFT,
-            DrawBuffer::BackRight => RIGHT,
+            DrawBuffer::BackLeft => Eye::Left,
+            DrawBuffer::BackRight => Eye::Right,
         }
     }
 
@@ -66,7 +62,8 @@ impl DrawBuffer {
     }
 }
 
-/// The two eye framebuffers, index 0 left and 1 right as in the exercise slides.
+/// The two eye framebuffers, indexed by [`Eye::index`]: 0 left, 1 right as in the exercise
+/// slides.
 pub type EyePair = [Framebuffer; 2];
 
 impl Framebuffer {

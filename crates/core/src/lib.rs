@@ -8,7 +8,7 @@
 //! [`effects::anaglyph::anaglyph`]. Scene files, the plan and the outputs are the `stereolab`
 //! crate's; `examples/` in the repository has small complete programs.
 //!
-//! Modules import lower ones only: [`error`] → [`files`] → [`math`], [`framebuffer`],
+//! Modules import lower ones only: [`error`] → [`files`], [`eye`] → [`math`], [`framebuffer`],
 //! [`shade`], [`text`] → [`raster`], [`reference`](mod@reference) → [`effects`] (`tests/architecture.rs`).
 //!
 #![doc = include_str!("../../../docs/formulas.md")]
@@ -16,6 +16,7 @@
 
 pub mod effects;
 pub mod error;
+pub mod eye;
 pub mod files;
 pub mod framebuffer;
 pub mod math;
@@ -25,4 +26,5 @@ pub mod shade;
 pub mod text;
 
 pub use error::{Error, Result};
+pub use eye::Eye;
 pub use framebuffer::{EyePair, Framebuffer};

@@ -38,12 +38,6 @@ pub trait Shader: Sync {
     fn writes_color(&self) -> bool {
         true
     }
-    /// This program when it is [`BlinnPhong`], whose fragment stage the rasterizer also has
-    /// eight pixels wide (AVX2, the same bytes); `None` for every other program, which runs
-    /// through [`Shader::fragment`] one pixel at a time.
-    fn as_blinn_phong(&self) -> Option<&BlinnPhong<'_>> {
-        None
-    }
 }
 
 /// A point light and the ambient term, in world space.
@@ -175,10 +169,6 @@ impl Shader for BlinnPhong<'_> {
         let c = self.color * (self.light.ambient + (1.0 - self.light.ambient) * diffuse)
             + Vec3::splat(spec);
         Some(to_rgba8(c))
-    }
-
-    fn as_blinn_phong(&self) -> Option<&BlinnPhong<'_>> {
-        Some(self)
     }
 }
 

@@ -3,6 +3,7 @@
 
 use std::fmt::Write as _;
 
+use stereolab_core::Eye;
 use stereolab_core::effects::anaglyph::AnaglyphKind;
 use stereolab_core::error::{Error, Result};
 
@@ -105,6 +106,16 @@ pub enum View {
     RotateLeft,
     /// The scene's rig as toe-in (rotate), right eye.
     RotateRight,
+}
+
+impl From<Eye> for View {
+    /// The pass of one eye of the scene's rig.
+    fn from(eye: Eye) -> View {
+        match eye {
+            Eye::Left => View::Left,
+            Eye::Right => View::Right,
+        }
+    }
 }
 
 /// What a pass computes per fragment.

@@ -5,6 +5,7 @@
 //! column vectors (`P * MV * v`).
 
 mod rig;
+pub mod stereo;
 
 pub use rig::{
     Camera, CameraMode, EyeMatrices, ImageShift, Lighting, ResolvedRig, Separation, StereoRig,

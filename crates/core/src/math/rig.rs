@@ -3,8 +3,14 @@
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
+use super::stereo::{
+    auto_eye_separation, cyclopic_projection, eye_translation, frustum_asymmetry,
+    image_shift_translation, off_axis_frustum, toe_in_view, view_width_at,
+    zero_parallax_at_fraction,
+};
 use super::{frustum, look_at};
 use crate::error::{Error, Result};
+use crate::eye::Eye;
 
 /// A mono camera: where it is, where it looks, and its symmetric frustum.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -334,31 +340,47 @@ impl StereoRig {
     /// # Errors
     /// Negative or non-finite separation, zero parallax outside (near, far), factors outside 0..2.
     pub fn resolve(&self, camera: &Camera, aspect: f32) -> Result<ResolvedRig> {
+        self.check(camera)?;
         let z0 = match self.zero_parallax {
-            ZeroParallax::Distance(z) => {
-                if !(z > camera.near && z < camera.far) {
-                    return Err(Error::invalid(
-                        "stereo.zero_parallax",
-                        z,
-                        format!(
-                            "must lie strictly between camera.near ({}) and camera.far ({})",
-                            camera.near, camera.far
-                        ),
-                    ));
-                }
-                z
-            }
-            ZeroParallax::Fraction(t) => {
-                if !(t > 0.0 && t < 1.0) {
-                    return Err(Error::invalid(
-                        "stereo.zero_parallax_fraction",
-                        t,
-                        "must lie strictly between 0 and 1",
-                    ));
-                }
-                camera.near + t * (camera.far - camera.near)
-            }
+            ZeroParallax::Distance(z) => z,
+            ZeroParallax::Fraction(t) => zero_parallax_at_fraction(camera.near, camera.far, t),
         };
+        let xrange = view_width_at(z0, camera.fov_y, aspect);
+        let separation = match self.separation {
+            Separation::Absolute(d) => d,
+            Separation::Auto => auto_eye_separation(xrange),
+        };
+        Ok(ResolvedRig {
+            eye_separation: separation * self.user_offset,
+            zero_parallax_distance: z0,
+            xrange,
+        })
+    }
+
+    /// Checks the rig's fields against `camera`: the zero-parallax distance strictly between
+    /// near and far (or its fraction strictly between 0 and 1), the user factors in 0..2, an
+    /// absolute separation finite and ≥ 0.
+    fn check(&self, camera: &Camera) -> Result<()> {
+        match self.zero_parallax {
+            ZeroParallax::Distance(z) if !(z > camera.near && z < camera.far) => {
+                return Err(Error::invalid(
+                    "stereo.zero_parallax",
+                    z,
+                    format!(
+                        "must lie strictly between camera.near ({}) and camera.far ({})",
+                        camera.near, camera.far
+                    ),
+                ));
+            }
+            ZeroParallax::Fraction(t) if !(t > 0.0 && t < 1.0) => {
+                return Err(Error::invalid(
+                    "stereo.zero_parallax_fraction",
+                    t,
+                    "must lie strictly between 0 and 1",
+                ));
+            }
+            _ => {}
+        }
         for (name, v) in [
             ("stereo.user_offset", self.user_offset),
             ("stereo.user_balance", self.user_balance),
@@ -371,25 +393,16 @@ impl StereoRig {
                 ));
             }
         }
-        let xrange = 2.0 * z0 * (camera.fov_y.to_radians() * 0.5).tan() * aspect;
-        let base = match self.separation {
-            Separation::Absolute(d) => {
-                if !(d >= 0.0 && d.is_finite()) {
-                    return Err(Error::invalid(
-                        "stereo.eye_separation",
-                        d,
-                        "must be a finite distance ≥ 0",
-                    ));
-                }
-                d
-            }
-            Separation::Auto => 2.0 * xrange * 0.035,
-        };
-        Ok(ResolvedRig {
-            eye_separation: base * self.user_offset,
-            zero_parallax_distance: z0,
-            xrange,
-        })
+        if let Separation::Absolute(d) = self.separation
+            && !(d >= 0.0 && d.is_finite())
+        {
+            return Err(Error::invalid(
+                "stereo.eye_separation",
+                d,
+                "must be a finite distance ≥ 0",
+            ));
+        }
+        Ok(())
     }
 
     /// The two eyes' matrices, index 0 left, 1 right, for an image of aspect `width/height`.
@@ -477,8 +490,8 @@ impl StereoRig {
         camera.validate()?;
         let r = self.resolve(camera, aspect)?;
         let eyes = [
-            self.eye(camera, aspect, &r, -1.0, shift),
-            self.eye(camera, aspect, &r, 1.0, shift),
+            self.eye(camera, aspect, &r, Eye::Left, shift),
+            self.eye(camera, aspect, &r, Eye::Right, shift),
         ];
         // Every range check can pass and the matrices still overflow (toe-in's look-at squares
         // the eye offset): refuse them here, before anything renders with NaN cameras.
@@ -500,17 +513,18 @@ impl StereoRig {
         Ok(eyes)
     }
 
-    /// One eye; `side` is −1 for left, +1 for right; `shift` the image-shift pixels and the
-    /// image width (image-shift only).
+    /// One eye's matrices; `shift` the image-shift pixels and the image width (image-shift
+    /// only). Each step is one of the formulas in [`super::stereo`].
     fn eye(
         &self,
         camera: &Camera,
         aspect: f32,
         r: &ResolvedRig,
-        side: f32,
+        eye: Eye,
         shift: Option<(ImageShift, u32)>,
     ) -> EyeMatrices {
         let half = 0.5 * r.eye_separation;
+        let z0 = r.zero_parallax_distance;
         // The viewer's modelview (the camera's), and the rig's: centred between the eyes. With
         // the viewer at the left eye the rig's midpoint is d/2 to the camera's right.
         let viewer_mv = camera.view();
@@ -520,43 +534,34 @@ impl StereoRig {
         };
         let (w, h) = camera.near_half_extents(aspect);
         let (n, f) = (camera.near, camera.far);
-        // Eye offset along the camera's x axis, in eye space.
-        let t = Mat4::from_translation(Vec3::new(-side * half, 0.0, 0.0));
+        let symmetric = [-w, w, -h, h, n, f];
         let (eye_view, fr) = match self.mode {
             CameraMode::OffAxis => {
-                // The StereoGraphics guide (Akka): FrustumAsymmetry = −offset · balance · n/z0, positive for the left eye.
-                let shift = -side * half * self.user_balance * n / r.zero_parallax_distance;
-                (t * mv, [-w + shift, w + shift, -h, h, n, f])
+                let asymmetry = frustum_asymmetry(eye, half, self.user_balance, n, z0);
+                (
+                    eye_translation(eye, half) * mv,
+                    off_axis_frustum(w, h, n, f, asymmetry),
+                )
             }
             // Image-shift renders the parallel eyes; the shift comes after the projection.
-            CameraMode::Parallel | CameraMode::ImageShift => (t * mv, [-w, w, -h, h, n, f]),
-            CameraMode::ToeIn => {
-                // The SGI course notes, per-eye look-at: both eyes aim at the fusion point on the center line.
-                let inv = mv.inverse();
-                let eye = inv.transform_point3(Vec3::new(side * half, 0.0, 0.0));
-                let fusion = inv.transform_point3(Vec3::new(0.0, 0.0, -r.zero_parallax_distance));
-                let up = inv.transform_vector3(Vec3::Y);
-                (look_at(eye, fusion, up), [-w, w, -h, h, n, f])
+            CameraMode::Parallel | CameraMode::ImageShift => {
+                (eye_translation(eye, half) * mv, symmetric)
             }
+            CameraMode::ToeIn => (toe_in_view(mv, eye, half, z0), symmetric),
         };
         let mut p = frustum(fr[0], fr[1], fr[2], fr[3], fr[4], fr[5]);
-        // The StereoGraphics guide §6: "apply an offset (towards the left for the left-camera
-        // rendering, towards the right for the right-camera rendering) when viewporting": a
-        // move of k whole pixels is the NDC translation 2k/W after the projection.
         let mut viewport_shift = 0i32;
         if let (CameraMode::ImageShift, Some((s, width))) = (self.mode, shift) {
-            viewport_shift = if side < 0.0 {
-                -(s.left as i32)
-            } else {
-                s.right as i32
+            // The left image moves left by its share of the whole-pixel shift, the right one right.
+            viewport_shift = match eye {
+                Eye::Left => -(s.left as i32),
+                Eye::Right => s.right as i32,
             };
-            let ndc = 2.0 * viewport_shift as f32 / width as f32;
-            p = Mat4::from_translation(Vec3::new(ndc, 0.0, 0.0)) * p;
+            p = image_shift_translation(viewport_shift, width) * p;
         }
         let (view, projection) = match self.lighting {
             Lighting::PerEye => (eye_view, p),
-            // Cyclopic: both eyes shade in the viewer's eye space.
-            Lighting::Cyclopic => (viewer_mv, p * eye_view * viewer_mv.inverse()),
+            Lighting::Cyclopic => (viewer_mv, cyclopic_projection(p, eye_view, viewer_mv)),
         };
         EyeMatrices {
             view,

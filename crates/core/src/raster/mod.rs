@@ -22,7 +22,12 @@ pub use traverse::{Band, SmallBox, traverse};
 use rayon::prelude::*;
 
 use crate::framebuffer::Framebuffer;
-use crate::shade::{Shader, Varyings};
+use crate::shade::{BlinnPhong, Shader, Varyings};
+#[cfg(target_arch = "x86_64")]
+use shade_avx2::Uniforms as BlinnPhongUniforms;
+/// No vector fragment stage off x86-64.
+#[cfg(not(target_arch = "x86_64"))]
+enum BlinnPhongUniforms {}
 
 /// Whether this CPU can run the AVX2 loops (x86-64 with AVX2 and POPCNT). They run where
 /// this holds and the options allow them ([`RasterOptions::simd`], the strips'
@@ -103,6 +108,37 @@ pub fn rasterize<S: Shader>(
     fb: &mut Framebuffer,
     opts: &RasterOptions,
 ) -> RasterStats {
+    rasterize_bands(triangles, vertex_count, shader, None, fb, opts)
+}
+
+/// [`rasterize`] with [`BlinnPhong`]: the same pixels and depths, its fragment stage eight
+/// pixels wide (AVX2) where [`RasterOptions::simd`] and the CPU allow it and the specular
+/// exponent is a whole number (`shade_avx2`, held to [`BlinnPhong`]'s own stage by
+/// `avx2_blinn_phong_matches_traverse`).
+pub fn rasterize_blinn_phong(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    shader: &BlinnPhong,
+    fb: &mut Framebuffer,
+    opts: &RasterOptions,
+) -> RasterStats {
+    #[cfg(target_arch = "x86_64")]
+    let uniforms = shade_avx2::Uniforms::of(shader);
+    #[cfg(not(target_arch = "x86_64"))]
+    let uniforms: Option<BlinnPhongUniforms> = None;
+    rasterize_bands(triangles, vertex_count, shader, uniforms.as_ref(), fb, opts)
+}
+
+/// Setup once, then the bands in parallel; `blinn_phong`: the AVX2 fragment stage's uniforms
+/// when the shader is [`BlinnPhong`].
+fn rasterize_bands<S: Shader>(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    shader: &S,
+    blinn_phong: Option<&BlinnPhongUniforms>,
+    fb: &mut Framebuffer,
+    opts: &RasterOptions,
+) -> RasterStats {
     if opts.depth != DepthMode::Standard {
         return depth_modes::rasterize(triangles, vertex_count, shader, fb, opts);
     }
@@ -124,14 +160,14 @@ pub fn rasterize<S: Shader>(
                 color,
                 depth,
             };
-            traverse_band(bin, shader, &mut band, opts)
+            traverse_band(bin, shader, blinn_phong, &mut band, opts)
         })
         .sum();
     stats
 }
 
 /// [`traverse`] of `triangles`, in order, over `band`; returns the fragments written. A
-/// Blinn-Phong pass ([`Shader::as_blinn_phong`]) with the depth test on goes through the AVX2
+/// Blinn-Phong pass ([`rasterize_blinn_phong`]) with the depth test on goes through the AVX2
 /// fragment stage `shade_avx2::shade_triangle` under the same conditions, with the same color
 /// and depth bits (`avx2_blinn_phong_matches_traverse`). In a
 /// depth-only pass (the shader writes no color, depth test on) where [`RasterOptions::simd`]
@@ -142,6 +178,7 @@ pub fn rasterize<S: Shader>(
 fn traverse_band<S: Shader>(
     triangles: &[&SetupTriangle],
     shader: &S,
+    blinn_phong: Option<&BlinnPhongUniforms>,
     band: &mut Band,
     opts: &RasterOptions,
 ) -> usize {
@@ -155,7 +192,7 @@ fn traverse_band<S: Shader>(
             .sum();
     }
     #[cfg(target_arch = "x86_64")]
-    if let Some(u) = shader.as_blinn_phong().and_then(shade_avx2::Uniforms::of)
+    if let Some(u) = blinn_phong
         && opts.depth_test
         && opts.simd
         && avx2_available()
@@ -164,7 +201,7 @@ fn traverse_band<S: Shader>(
         // which `avx2_available` has just found on this CPU (`avx2::available`).
         return triangles
             .iter()
-            .map(|t| unsafe { shade_avx2::shade_triangle(t, &u, band, opts.perspective_correct) })
+            .map(|t| unsafe { shade_avx2::shade_triangle(t, u, band, opts.perspective_correct) })
             .sum();
     }
     triangles
@@ -484,7 +521,8 @@ mod tests {
                 ..RasterOptions::default()
             };
             let mut fast = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
-            let stats = rasterize(&triangles, positions.len(), &shader, &mut fast, &opts);
+            let stats =
+                rasterize_blinn_phong(&triangles, positions.len(), &shader, &mut fast, &opts);
             let mut plain = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
             let scalar = RasterOptions {
                 simd: false,

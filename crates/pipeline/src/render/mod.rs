@@ -16,7 +16,7 @@ use crate::scene::Scene;
 use stereolab_core::error::Result;
 use stereolab_core::framebuffer::Framebuffer;
 use stereolab_core::math::{CameraMode, EyeMatrices, StereoRig};
-use stereolab_core::raster::{RasterStats, rasterize};
+use stereolab_core::raster::{RasterStats, rasterize, rasterize_blinn_phong};
 use stereolab_core::shade::{BlinnPhong, DepthOnly};
 
 /// What one pass produced.
@@ -64,10 +64,7 @@ impl Frame {
         &self,
         buffer: stereolab_core::framebuffer::DrawBuffer,
     ) -> Option<&Framebuffer> {
-        self.view(match buffer {
-            stereolab_core::framebuffer::DrawBuffer::BackLeft => View::Left,
-            stereolab_core::framebuffer::DrawBuffer::BackRight => View::Right,
-        })
+        self.view(buffer.eye().into())
     }
 
     /// The matrices of `view`; `None` for a shear/rotate view the plan did not run.
@@ -213,7 +210,7 @@ pub fn render_view(
                     o.color,
                     scene.light,
                 );
-                rasterize(
+                rasterize_blinn_phong(
                     &mesh.triangles,
                     mesh.positions.len(),
                     &shader,

@@ -27,14 +27,9 @@ use crate::framebuffer::Framebuffer;
 /// Dominant wavelengths (nm) taken for the R, G, B primaries (sRGB's primaries).
 pub const PRIMARY_WAVELENGTHS_NM: [f32; 3] = [612.0, 547.0, 465.0];
 
-/// Which eye's view to simulate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Eye {
-    /// Left eye: the lens bends the view to the right (towards the nose).
-    Left,
-    /// Right eye: the lens bends the view to the left.
-    Right,
-}
+/// Which eye's view to simulate: the left eye's lens bends the view to the right (towards the
+/// nose), the right eye's to the left.
+pub use crate::eye::Eye;
 
 /// Each primary's shift as a fraction of the reddest shift: `(λ_c − λ_B)/(λ_R − λ_B)`.
 pub fn channel_weights() -> [f32; 3] {
@@ -80,10 +75,8 @@ pub fn glasses_pair(fb: &Framebuffer, max_shift_px: f32) -> [Framebuffer; 2] {
 
 /// Moves every pixel of `fb` by its entry in `shifts`, inward for `eye` (see [`glasses_view`]).
 fn warp(fb: &Framebuffer, eye: Eye, shifts: &[f32]) -> Framebuffer {
-    let direction = match eye {
-        Eye::Left => 1.0,
-        Eye::Right => -1.0,
-    };
+    // Inward: the left eye's view moves right, the right eye's left.
+    let direction = -eye.sign();
     let w = fb.width as usize;
     let mut out = fb.clone();
     // Per destination: the source index and its shift.
