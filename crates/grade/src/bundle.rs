@@ -50,11 +50,12 @@ fn add_file(root: &Path, rel: &str, files: &mut Files) -> Result<()> {
 }
 
 /// stereolab's manifest for the bundle: a workspace of its own (no exercise crates as members,
-/// no repository tests), the same dependencies and profiles.
+/// no repository tests or examples), the same dependencies and profiles.
 fn bundle_manifest(text: &str, path: &Path) -> Result<String> {
     let mut table: toml::Table =
         toml::from_str(text).map_err(|e| Error::parse(path, None, e.message().to_string()))?;
     table.remove("test");
+    table.remove("example");
     // A workspace of its own: the versions the crates share, the crates as path dependencies.
     let shared = table
         .get("workspace")

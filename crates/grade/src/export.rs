@@ -67,7 +67,7 @@ debug = false
 
 /// The handout's copy of stereolab's manifest and the versions its crates share: the command's
 /// package and dependencies (whose default features compile no window, GPU, zip or allocator
-/// code), without the workspace, the repository's own tests and the profiles (the handout's
+/// code), without the workspace, the repository's own tests and examples and the profiles (the handout's
 /// workspace sets them); and the `[workspace.dependencies]` table the crates inherit from,
 /// for the handout's workspace manifest.
 fn library_manifest(text: &str, path: &Path) -> Result<(String, toml::Table)> {
@@ -78,6 +78,7 @@ fn library_manifest(text: &str, path: &Path) -> Result<(String, toml::Table)> {
         .and_then(|w| w.get("dependencies").and_then(|d| d.as_table()).cloned())
         .ok_or_else(|| Error::parse(path, None, "no [workspace.dependencies] table"))?;
     table.remove("test");
+    table.remove("example");
     table.remove("profile");
     let manifest = toml::to_string(&table).map_err(|e| Error::parse(path, None, e.to_string()))?;
     Ok((manifest, shared))

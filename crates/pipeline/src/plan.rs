@@ -185,56 +185,101 @@ impl Output {
         Output::AboveBelowCalibration,
     ];
 
-    /// The name used in scene files and for the PNG written.
-    pub fn name(self) -> &'static str {
+    /// Everything this output is, in one row: its name, its file, the passes it reads.
+    /// [`output::produce`](crate::output::produce) makes it from those passes.
+    pub fn spec(self) -> OutputSpec {
+        use View::{Center, Left, Right, RotateLeft, RotateRight, ShearLeft, ShearRight};
+        const PAIR: &[Pass] = &[color(Left), color(Right)];
+        const CENTER_DEPTH: &[Pass] = &[depth(Center)];
+        // One center pass, no stereo pair: the glasses make the pair (the ChromaDepth article).
+        const CHROMADEPTH: &[Pass] = &[Pass {
+            view: Center,
+            shading: Shading::ChromaDepth,
+        }];
+        let png = |name, needs| OutputSpec {
+            name,
+            extension: "png",
+            needs,
+        };
         match self {
-            Output::Left => "left",
-            Output::Right => "right",
-            Output::LeftDepth => "left_depth",
-            Output::RightDepth => "right_depth",
-            Output::SideBySide => "side_by_side",
-            Output::CrossEyed => "cross_eyed",
-            Output::AboveBelow => "above_below",
-            Output::AboveBelowSquashed => "above_below_squashed",
-            Output::InterlacedRows => "interlaced_rows",
-            Output::InterlacedColumns => "interlaced_columns",
-            Output::Checkerboard => "checkerboard",
-            Output::ChromaDepth => "chromadepth",
-            Output::ChromaDepthLeft => "chromadepth_left",
-            Output::ChromaDepthRight => "chromadepth_right",
-            Output::ChromaDepthAnaglyph => "chromadepth_anaglyph",
-            Output::Anaglyph(kind) => kind.output_name(),
-            Output::RemapLeft => "remap_left",
-            Output::RemapRight => "remap_right",
-            Output::Occlusion => "occlusion",
-            Output::Parallax => "parallax",
-            Output::Sirds => "sirds",
-            Output::SirdsDepth => "sirds_depth",
-            Output::SirdsFig5 => "sirds_fig5",
-            Output::Mpo => "mpo",
-            Output::Jps => "jps",
-            Output::Pns => "pns",
-            Output::ShearVsRotate => "shear_vs_rotate",
-            Output::RdsLeft => "rds_left",
-            Output::RdsRight => "rds_right",
-            Output::RdsAnaglyph => "rds_anaglyph",
-            Output::FrameSequential => "frame_sequential",
-            Output::GhostingLeft => "ghosting_left",
-            Output::GhostingRight => "ghosting_right",
-            Output::AboveBelowCalibration => "above_below_calibration",
+            Output::Left => png("left", const { &[color(Left)] }),
+            Output::Right => png("right", const { &[color(Right)] }),
+            Output::LeftDepth => png("left_depth", const { &[depth(Left)] }),
+            Output::RightDepth => png("right_depth", const { &[depth(Right)] }),
+            Output::SideBySide => png("side_by_side", PAIR),
+            Output::CrossEyed => png("cross_eyed", PAIR),
+            Output::AboveBelow => png("above_below", PAIR),
+            Output::AboveBelowSquashed => png("above_below_squashed", PAIR),
+            Output::InterlacedRows => png("interlaced_rows", PAIR),
+            Output::InterlacedColumns => png("interlaced_columns", PAIR),
+            Output::Checkerboard => png("checkerboard", PAIR),
+            Output::ChromaDepth => png("chromadepth", CHROMADEPTH),
+            Output::ChromaDepthLeft => png("chromadepth_left", CHROMADEPTH),
+            Output::ChromaDepthRight => png("chromadepth_right", CHROMADEPTH),
+            Output::ChromaDepthAnaglyph => png("chromadepth_anaglyph", CHROMADEPTH),
+            Output::Anaglyph(kind) => png(kind.output_name(), PAIR),
+            // Remapping unprojects this eye's depth and fetches the other eye's color.
+            Output::RemapLeft => png("remap_left", const { &[depth(Left), color(Right)] }),
+            Output::RemapRight => png("remap_right", const { &[color(Left), depth(Right)] }),
+            // The visibility check compares depths only.
+            Output::Occlusion => png("occlusion", const { &[depth(Left), depth(Right)] }),
+            // p(z) needs the left eye's depth and the rig, nothing else.
+            Output::Parallax => png("parallax", const { &[depth(Left)] }),
+            // One depth pass of the cyclopean view; no color shading at all (the SIRDS paper
+            // (Petz et al.)).
+            Output::Sirds => png("sirds", CENTER_DEPTH),
+            Output::SirdsDepth => png("sirds_depth", CENTER_DEPTH),
+            Output::SirdsFig5 => png("sirds_fig5", CENTER_DEPTH),
+            Output::Mpo => OutputSpec {
+                name: "mpo",
+                extension: "mpo",
+                needs: PAIR,
+            },
+            Output::Jps => OutputSpec {
+                name: "jps",
+                extension: "jps",
+                needs: PAIR,
+            },
+            Output::Pns => OutputSpec {
+                name: "pns",
+                extension: "pns",
+                needs: PAIR,
+            },
+            // Both rigs' eye passes, whatever the scene's own mode: the comparison is the point.
+            Output::ShearVsRotate => png(
+                "shear_vs_rotate",
+                const {
+                    &[
+                        color(ShearLeft),
+                        color(ShearRight),
+                        color(RotateLeft),
+                        color(RotateRight),
+                    ]
+                },
+            ),
+            // The left eye's dots are the texture itself, whatever the scene holds.
+            Output::RdsLeft => png("rds_left", &[]),
+            // The dots are painted, not shaded: the remap needs both eyes' depths only.
+            Output::RdsRight => png("rds_right", const { &[depth(Left), depth(Right)] }),
+            Output::RdsAnaglyph => png("rds_anaglyph", const { &[depth(Left), depth(Right)] }),
+            Output::FrameSequential => png("frame_sequential", PAIR),
+            Output::GhostingLeft => png("ghosting_left", PAIR),
+            Output::GhostingRight => png("ghosting_right", PAIR),
+            // A test pattern of the layout alone: no pass at all.
+            Output::AboveBelowCalibration => png("above_below_calibration", &[]),
         }
+    }
+
+    /// The name used in scene files and for the file written.
+    pub fn name(self) -> &'static str {
+        self.spec().name
     }
 
     /// The file an output is written to: `<name>.png`, or `<name>.mpo|jps|pns` for the
     /// stereo photo formats.
     pub fn file_name(self) -> String {
-        let ext = match self {
-            Output::Mpo => "mpo",
-            Output::Jps => "jps",
-            Output::Pns => "pns",
-            _ => "png",
-        };
-        format!("{}.{ext}", self.name())
+        let spec = self.spec();
+        format!("{}.{}", spec.name, spec.extension)
     }
 
     /// Parses a name as written in a scene file.
@@ -258,53 +303,34 @@ impl Output {
 
     /// The passes this output reads.
     pub fn needs(self) -> Vec<Pass> {
-        let color = |view| Pass {
-            view,
-            shading: Shading::Color,
-        };
-        let depth = |view| Pass {
-            view,
-            shading: Shading::DepthOnly,
-        };
-        match self {
-            Output::Left => vec![color(View::Left)],
-            Output::Right => vec![color(View::Right)],
-            Output::LeftDepth => vec![depth(View::Left)],
-            Output::RightDepth => vec![depth(View::Right)],
-            // One center pass, no stereo pair: the glasses make the pair (the ChromaDepth article).
-            Output::ChromaDepth
-            | Output::ChromaDepthLeft
-            | Output::ChromaDepthRight
-            | Output::ChromaDepthAnaglyph => vec![Pass {
-                view: View::Center,
-                shading: Shading::ChromaDepth,
-            }],
-            // Remapping unprojects this eye's depth and fetches the other eye's color.
-            Output::RemapLeft => vec![depth(View::Left), color(View::Right)],
-            Output::RemapRight => vec![color(View::Left), depth(View::Right)],
-            // The visibility check compares depths only.
-            Output::Occlusion => vec![depth(View::Left), depth(View::Right)],
-            // p(z) needs the left eye's depth and the rig, nothing else.
-            Output::Parallax => vec![depth(View::Left)],
-            // One depth pass of the cyclopean view; no color shading at all (the SIRDS paper (Petz et al.)).
-            Output::Sirds | Output::SirdsDepth | Output::SirdsFig5 => vec![depth(View::Center)],
-            // Both rigs' eye passes, whatever the scene's own mode: the comparison is the point.
-            Output::ShearVsRotate => vec![
-                color(View::ShearLeft),
-                color(View::ShearRight),
-                color(View::RotateLeft),
-                color(View::RotateRight),
-            ],
-            // The left eye's dots are the texture itself, whatever the scene holds.
-            Output::RdsLeft => vec![],
-            // The dots are painted, not shaded: the remap needs both eyes' depths only.
-            Output::RdsRight | Output::RdsAnaglyph => {
-                vec![depth(View::Left), depth(View::Right)]
-            }
-            // A test pattern of the layout alone: no pass at all.
-            Output::AboveBelowCalibration => vec![],
-            _ => vec![color(View::Left), color(View::Right)],
-        }
+        self.spec().needs.to_vec()
+    }
+}
+
+/// One output's row: what [`Output::spec`] gives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OutputSpec {
+    /// The name in scene files and of the file written.
+    pub name: &'static str,
+    /// The file's extension: `png`, or the stereo photo format's.
+    pub extension: &'static str,
+    /// The passes the output reads (none for the random-dot texture and the calibration screen).
+    pub needs: &'static [Pass],
+}
+
+/// A shaded pass of `view` (color and depth).
+const fn color(view: View) -> Pass {
+    Pass {
+        view,
+        shading: Shading::Color,
+    }
+}
+
+/// A depth-only pass of `view`.
+const fn depth(view: View) -> Pass {
+    Pass {
+        view,
+        shading: Shading::DepthOnly,
     }
 }
 

@@ -22,41 +22,16 @@ pub struct Texgen {
 }
 
 impl Texgen {
-    /// The plane for the depth range `d1 .. d2` (eye-space distances in front of the eye).
-    ///
-    /// Decision for D1 > D2: an error, not a reversed ramp. ChromaDepth glasses always put red
-    /// in front, so a reversed ramp shows the scene's depth inside out; swapped values are far
-    /// more often a slip than an intent.
+    /// The plane [`eye_plane`] for the depth range `d1 .. d2` (eye-space distances in front of
+    /// the eye), the range checked first.
     ///
     /// # Errors
     /// `Invalid` naming `chromadepth.d1`/`d2` when either is not finite, when `d1 == d2` (the
     /// plane would divide by zero) or when `d1 > d2`.
     pub fn from_range(d1: f32, d2: f32) -> Result<Texgen> {
-        for (name, v) in [("chromadepth.d1", d1), ("chromadepth.d2", d2)] {
-            if !v.is_finite() {
-                return Err(Error::invalid(name, v, "must be a finite distance"));
-            }
-        }
-        if d1 == d2 {
-            return Err(Error::invalid(
-                "chromadepth.d2",
-                d2,
-                format!("equals chromadepth.d1 ({d1}): the ramp needs D2 - D1 != 0"),
-            ));
-        }
-        if d1 > d2 {
-            return Err(Error::invalid(
-                "chromadepth.d1",
-                d1,
-                format!(
-                    "is beyond chromadepth.d2 ({d2}): D1 is where red (near) starts and must be \
-                     nearer than D2; swap them (a reversed ramp would show depth inside out)"
-                ),
-            ));
-        }
-        let span = d2 - d1;
+        check_range(d1, d2)?;
         Ok(Texgen {
-            plane: Vec4::new(0.0, 0.0, -1.0 / span, -d1 / span),
+            plane: eye_plane(d1, d2),
             d1,
             d2,
         })
@@ -80,6 +55,50 @@ impl Texgen {
 /// the ChromaDepth article warns about.
 pub fn eye_plane_specified_under(plane: Vec4, modelview: Mat4) -> Vec4 {
     modelview.inverse().transpose() * plane
+}
+
+/// The eye-linear texgen plane `(A, B, C, D)` that maps the eye-space distance `D1` to `s = 0`
+/// and `D2` to `s = 1` (the ChromaDepth article, "Creating ChromaDepth Scenes with OpenGL"):
+/// `A = B = 0`, `C = −1/(D2 − D1)`, `D = −D1/(D2 − D1)`, so `s = (−z − D1)/(D2 − D1)` for an
+/// eye-space point at `z` (the camera looks down −Z).
+pub fn eye_plane(d1: f32, d2: f32) -> Vec4 {
+    let span = d2 - d1;
+    Vec4::new(0.0, 0.0, -1.0 / span, -d1 / span)
+}
+
+/// Checks a ramp range: both distances finite, `D1` nearer than `D2`.
+///
+/// `D1 > D2` is an error, not a reversed ramp: ChromaDepth glasses always put red in front, so
+/// a reversed ramp shows the scene's depth inside out; swapped values are far more often a slip
+/// than an intent.
+///
+/// # Errors
+/// `Invalid` naming `chromadepth.d1`/`d2` when either is not finite, when `d1 == d2` (the
+/// plane would divide by zero) or when `d1 > d2`.
+fn check_range(d1: f32, d2: f32) -> Result<()> {
+    for (name, v) in [("chromadepth.d1", d1), ("chromadepth.d2", d2)] {
+        if !v.is_finite() {
+            return Err(Error::invalid(name, v, "must be a finite distance"));
+        }
+    }
+    if d1 == d2 {
+        return Err(Error::invalid(
+            "chromadepth.d2",
+            d2,
+            format!("equals chromadepth.d1 ({d1}): the ramp needs D2 - D1 != 0"),
+        ));
+    }
+    if d1 > d2 {
+        return Err(Error::invalid(
+            "chromadepth.d1",
+            d1,
+            format!(
+                "is beyond chromadepth.d2 ({d2}): D1 is where red (near) starts and must be \
+                 nearer than D2; swap them (a reversed ramp would show depth inside out)"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A sphere around the scene's center: the center of the world-space bounding box and the
