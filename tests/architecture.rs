@@ -7,7 +7,8 @@
 //!
 //! `stereolab-core`, lowest first:
 //! - `error`: the one error type.
-//! - `files`, `eye`: bounded reads and all-or-nothing writes; which eye (left or right).
+//! - `files`, `eye`, `simd`: bounded reads and all-or-nothing writes; which eye (left or
+//!   right); the one question to the CPU about its vector instructions.
 //! - `math`, `framebuffer`, `shade`, `text`: matrices and the rig, the render target (and the
 //!   image sizes it accepts), the shader stages, text in pictures.
 //! - `raster`, `reference`: fixed-point setup and traversal (knows nothing of scenes or
@@ -33,7 +34,7 @@ const CRATES: &[(&str, &[&[&str]])] = &[
         "crates/core/src",
         &[
             &["error"],
-            &["files", "eye"],
+            &["files", "eye", "simd"],
             &["math", "framebuffer", "shade", "text"],
             &["raster", "reference"],
             &["effects"],

@@ -8,7 +8,7 @@
 //! [`effects::anaglyph::anaglyph`]. Scene files, the plan and the outputs are the `stereolab`
 //! crate's; `examples/` in the repository has small complete programs.
 //!
-//! Modules import lower ones only: [`error`] → [`files`], [`eye`] → [`math`], [`framebuffer`],
+//! Modules import lower ones only: [`error`] → [`files`], [`eye`], [`simd`] → [`math`], [`framebuffer`],
 //! [`shade`], [`text`] → [`raster`], [`reference`](mod@reference) → [`effects`] (`tests/architecture.rs`).
 //!
 #![doc = include_str!("../../../docs/formulas.md")]
@@ -23,6 +23,7 @@ pub mod math;
 pub mod raster;
 pub mod reference;
 pub mod shade;
+pub mod simd;
 pub mod text;
 
 pub use error::{Error, Result};

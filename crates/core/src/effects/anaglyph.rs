@@ -342,7 +342,7 @@ pub fn anaglyph_with(
         unsafe { par_fill_rows(left.color.len(), w, fill) }
     } else {
         #[cfg(target_arch = "x86_64")]
-        let simd = simd && avx2::available();
+        let simd = simd && crate::simd::avx2_available();
         #[cfg(not(target_arch = "x86_64"))]
         let _ = simd;
         let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {

@@ -176,7 +176,7 @@ impl ParallaxRig {
 /// the values. Eight at a time on AVX2 (`avx2::drawn_extremes`), else [`drawn_extremes_scalar`].
 fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
     #[cfg(target_arch = "x86_64")]
-    if avx2::available() {
+    if crate::simd::avx2_available() {
         // SAFETY: the CPU has AVX2 (checked above), the function's only requirement. The same
         // result as the scalar fold (`avx2_drawn_extremes_match_scalar`).
         return unsafe { avx2::drawn_extremes(c) };
@@ -414,7 +414,7 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
     }
     let (w, n) = (fb.width as usize, fb.depth.len());
     #[cfg(target_arch = "x86_64")]
-    let simd = simd && avx2::available();
+    let simd = simd && crate::simd::avx2_available();
     #[cfg(not(target_arch = "x86_64"))]
     let simd = simd && false;
     // The AVX2 rows' affine form of the color scale, once per image.

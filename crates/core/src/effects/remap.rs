@@ -260,18 +260,6 @@ pub fn remap_color_with(
     Ok(RgbaImage::from_raw(w, h, bytes).expect("4 bytes per pixel"))
 }
 
-/// Whether this CPU runs the eight-wide remap rows (AVX2); the bytes are the same either way.
-fn simd_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        avx2::available()
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 /// [`remap_color`] one row at a time: the remapper, and each column's normalized device x
 /// computed once per image instead of once per pixel (the same expression, so the same value).
 struct RowProgram<'a> {
@@ -287,7 +275,7 @@ impl<'a> RowProgram<'a> {
     /// has AVX2 and every texel index fits an `i32`.
     fn new(remapper: &'a Remapper, simd: bool) -> Self {
         let pixels = remapper.width as u64 * remapper.height as u64;
-        let simd = simd && simd_available() && pixels < i32::MAX as u64;
+        let simd = simd && crate::simd::avx2_available() && pixels < i32::MAX as u64;
         let (mut ndc_x64, mut ndc_x32) = (Vec::new(), Vec::new());
         if simd {
             let cols = 0..remapper.width;
@@ -319,7 +307,7 @@ impl<'a> RowProgram<'a> {
         #[cfg(target_arch = "x86_64")]
         if self.simd {
             let r = self.remapper;
-            // SAFETY: `simd` is set only where `avx2::available` found AVX2, the rows' only
+            // SAFETY: `simd` is set only where `avx2_available` found AVX2, the rows' only
             // safety condition. The same bytes as the loop below
             // (`avx2_rows_match_remap_color_pixel`).
             return unsafe {

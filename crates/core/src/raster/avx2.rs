@@ -6,14 +6,6 @@ use std::arch::x86_64::*;
 
 use super::{Band, Plane, SetupTriangle};
 
-/// Whether this CPU runs the AVX2 loops (AVX2, FMA for the depth plane, POPCNT); the bytes are
-/// the same either way.
-pub(crate) fn available() -> bool {
-    is_x86_feature_detected!("avx2")
-        && is_x86_feature_detected!("fma")
-        && is_x86_feature_detected!("popcnt")
-}
-
 /// `v` unchanged, opaque to the optimizer. A lane blend of a loaded vector stored back where it
 /// came from is what a masked store does, and LLVM rewrites it into one; this keeps the full
 /// store. Only an instruction choice: the bytes are the same without it. Measured in the depth

@@ -29,20 +29,9 @@ use shade_avx2::Uniforms as BlinnPhongUniforms;
 #[cfg(not(target_arch = "x86_64"))]
 enum BlinnPhongUniforms {}
 
-/// Whether this CPU can run the AVX2 loops (x86-64 with AVX2 and POPCNT). They run where
-/// this holds and the options allow them ([`RasterOptions::simd`], the strips'
-/// `PerVertexOptions::simd`); the bytes are the same either way (unit tests hold each loop to
-/// its scalar twin), only the speed differs.
-pub fn avx2_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        avx2::available()
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
+/// Whether this CPU can run the AVX2 loops; they run where this holds and the options allow
+/// them ([`RasterOptions::simd`], the strips' `PerVertexOptions::simd`).
+pub use crate::simd::avx2_available;
 
 /// Rasterizer knobs. The defaults are what lavapipe does.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -14,11 +14,6 @@ use std::mem::MaybeUninit;
 
 use super::AnaglyphMatrices;
 
-/// Whether the CPU runs [`row`].
-pub(super) fn available() -> bool {
-    is_x86_feature_detected!("avx2")
-}
-
 /// `v.clamp(0, 1)` per lane, as `f32::clamp`: `maxps`/`minps` return their second operand when
 /// the operands compare equal or either is NaN, so with `v` second a NaN is kept and −0 stays
 /// −0 (`f32::clamp` returns `v` unless `v < 0` or `v > 1`).
@@ -120,7 +115,7 @@ mod tests {
     /// `clamp01` is `f32::clamp(0, 1)` bit for bit, on the values where the two could differ.
     #[test]
     fn clamp01_is_f32_clamp() {
-        if !available() {
+        if !crate::simd::avx2_available() {
             eprintln!("clamp01_is_f32_clamp: NOT RUN: no AVX2 here");
             return;
         }
@@ -147,7 +142,7 @@ mod tests {
     /// mid-vector), black, white and every gray.
     #[test]
     fn avx2_rows_match_anaglyph_pixel() {
-        if !available() {
+        if !crate::simd::avx2_available() {
             eprintln!("avx2_rows_match_anaglyph_pixel: NOT RUN: no AVX2 here, nothing to compare");
             return;
         }

@@ -20,11 +20,6 @@ use std::mem::MaybeUninit;
 
 use super::{PARALLAX_BACKGROUND, ParallaxRig};
 
-/// Whether the CPU runs [`row`].
-pub(super) fn available() -> bool {
-    is_x86_feature_detected!("avx2")
-}
-
 /// `f64::clamp(v, lo, hi)` per lane, NaN kept.
 #[target_feature(enable = "avx2")]
 #[inline]
@@ -383,7 +378,7 @@ mod tests {
     /// across [0, 1] with the background, on rows of every tail length.
     #[test]
     fn avx2_rows_match_parallax_color() {
-        if !available() {
+        if !crate::simd::avx2_available() {
             eprintln!("avx2_rows_match_parallax_color: NOT RUN: no AVX2 here, nothing to compare");
             return;
         }
@@ -445,7 +440,7 @@ mod tests {
     /// cannot pass).
     #[test]
     fn affine_colors_match_parallax_color_on_dense_intervals() {
-        if !available() {
+        if !crate::simd::avx2_available() {
             eprintln!("affine_colors_match_parallax_color_on_dense_intervals: NOT RUN: no AVX2");
             return;
         }
@@ -525,7 +520,7 @@ mod tests {
     /// negative, just above 1, +∞) wherever it lies.
     #[test]
     fn avx2_drawn_extremes_match_scalar() {
-        if !available() {
+        if !crate::simd::avx2_available() {
             eprintln!("avx2_drawn_extremes_match_scalar: NOT RUN: no AVX2 here");
             return;
         }
@@ -576,7 +571,7 @@ mod tests {
     /// largest double below ½, the ends of the byte, values beyond it and NaN.
     #[test]
     fn round_to_byte_is_round_as_u8() {
-        if !available() {
+        if !crate::simd::avx2_available() {
             eprintln!("round_to_byte_is_round_as_u8: NOT RUN: no AVX2 here");
             return;
         }

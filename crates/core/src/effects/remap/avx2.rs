@@ -19,11 +19,6 @@ use super::{Precision, Remapper};
 use crate::effects::occlusion::{BACKGROUND_COLOR, OUT_OF_VIEW_COLOR};
 use crate::framebuffer::Framebuffer;
 
-/// Whether the CPU runs [`row_f64`] and [`row_f32`].
-pub(super) fn available() -> bool {
-    is_x86_feature_detected!("avx2")
-}
-
 /// The texel part of four remapped points: `τ` (per lane, f64) to the other eye's window
 /// position, `floor`, the bounds test. Returns the lanes inside the image (bit k for lane k)
 /// and each lane's row-major texel index (meaningful only where inside; `W·H < 2³¹`).
@@ -331,7 +326,7 @@ mod tests {
     /// just above 1 or +∞ somewhere.
     #[test]
     fn avx2_rows_match_remap_color_pixel() {
-        if !available() {
+        if !crate::simd::avx2_available() {
             eprintln!(
                 "avx2_rows_match_remap_color_pixel: NOT RUN: no AVX2 here, nothing to compare"
             );
