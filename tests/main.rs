@@ -28,6 +28,7 @@ mod hard_cases;
 mod image_shift;
 mod layout;
 mod obj_corpus;
+mod readme;
 mod reliability;
 mod rig;
 mod scene_hashes;
