@@ -366,9 +366,8 @@ fn finish_decode(
     if let Some(dir) = &args.pair {
         let v = views(pixels, decoded, settings.cross_eyed)?;
         let fb = |color: Vec<[u8; 4]>| -> Result<stereolab_core::framebuffer::Framebuffer> {
-            let mut fb = stereolab_core::framebuffer::Framebuffer::new(w, h, [0, 0, 0, 255])?;
-            fb.color = color;
-            Ok(fb)
+            let depth = vec![1.0; color.len()];
+            stereolab_core::framebuffer::Framebuffer::from_buffers(w, h, color, depth)
         };
         let (left, right) = (fb(v.left)?, fb(v.right)?);
         let ana = anaglyph(

@@ -212,7 +212,7 @@ fn ramp_clamps_beyond_d2_and_before_d1() {
         .expect("valid scene");
         let c = StereoRig::center(&s.camera, s.aspect()).expect("camera");
         let (fb, _) = render_center_with(&s, &c, &s.chromadepth).expect("renders");
-        assert!(fb.color.iter().all(|p| *p == want), "plane at {distance}");
+        assert!(fb.color().iter().all(|p| *p == want), "plane at {distance}");
     }
 }
 
@@ -300,7 +300,8 @@ fn per_vertex_and_per_pixel_texgen_agree_on_a_camera_facing_plane() {
         render_center_with(&s, &c, &settings)
             .expect("renders")
             .0
-            .color
+            .into_buffers()
+            .0
     };
     assert_eq!(image(TexgenMode::PerVertex), image(TexgenMode::PerPixel));
 }
@@ -346,7 +347,7 @@ fn lit_chromadepth_keeps_the_hue() {
         .expect("renders")
         .0;
     let (mut compared, mut darker) = (0, 0);
-    for (u, l) in a.color.iter().zip(&b.color) {
+    for (u, l) in a.color().iter().zip(b.color()) {
         let hue = |p: &[u8; 4]| ramp::hue_degrees(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32));
         // Dim pixels lose hue precision to 8-bit rounding: compare where a channel is ≥ 64.
         if u[..3] == [0, 0, 0] || *l[..3].iter().max().expect("3") < 64 {
@@ -433,7 +434,7 @@ fn glasses_disparity_order_matches_depth_order() {
     // Each square is one color (camera-facing): find its columns on the middle row.
     let row = s.height / 2;
     let mean_x = |fb: &stereolab_core::Framebuffer, color: [u8; 4]| {
-        let xs: Vec<u32> = (0..fb.width)
+        let xs: Vec<u32> = (0..fb.width())
             .filter(|&x| fb.pixel(x, row) == color)
             .collect();
         assert!(!xs.is_empty(), "color {color:?} visible");
@@ -461,9 +462,9 @@ fn glasses_disparity_order_matches_depth_order() {
     let anaglyph =
         stereolab::output::chromadepth::produce(Output::ChromaDepthAnaglyph, &frame, &color)
             .expect("ok");
-    for (i, p) in anaglyph.color.iter().enumerate() {
-        assert_eq!(p[0], left.color[i][0]);
-        assert_eq!(p[1..3], right.color[i][1..3]);
+    for (i, p) in anaglyph.color().iter().enumerate() {
+        assert_eq!(p[0], left.color()[i][0]);
+        assert_eq!(p[1..3], right.color()[i][1..3]);
     }
     let gray = stereolab::output::chromadepth::produce(
         Output::ChromaDepthAnaglyph,
@@ -479,7 +480,7 @@ fn glasses_disparity_order_matches_depth_order() {
     )
     .expect("same size");
     assert!(
-        gray.color
+        gray.color()
             .iter()
             .zip(expected.pixels())
             .all(|(a, b)| *a == b.0),
@@ -504,7 +505,7 @@ fn glasses_shift_falls_with_depth_on_the_fault_valley() {
     let shifts = glasses::shift_map(&fb, 10.0);
     // Mean shift per depth decile of the covered pixels must fall from near to far.
     let mut covered: Vec<(f32, f32)> = fb
-        .depth
+        .depth()
         .iter()
         .zip(&shifts)
         .filter(|(d, _)| **d < 1.0)
@@ -523,10 +524,10 @@ fn glasses_shift_falls_with_depth_on_the_fault_valley() {
 fn glasses_views_move_inward() {
     // One red pixel column on black: the left view moves it right, the right view left.
     let mut fb = stereolab_core::Framebuffer::new(21, 1, [0, 0, 0, 255]).expect("size");
-    fb.color[10] = [255, 0, 0, 255];
+    fb.color_mut()[10] = [255, 0, 0, 255];
     let l = glasses::glasses_view(&fb, Eye::Left, 3.0);
     let r = glasses::glasses_view(&fb, Eye::Right, 3.0);
-    let at = |f: &stereolab_core::Framebuffer| f.color.iter().position(|p| p[0] == 255);
+    let at = |f: &stereolab_core::Framebuffer| f.color().iter().position(|p| p[0] == 255);
     assert_eq!(at(&l), Some(13));
     assert_eq!(at(&r), Some(7));
 }
@@ -660,7 +661,7 @@ fn shipped_chromadepth_scenes_render_every_output() {
         // The automatic range spans the ramp: both strong reds and strong blues appear.
         let fb = &frame.passes[0].framebuffer;
         let hues: Vec<f32> = fb
-            .color
+            .color()
             .iter()
             .filter_map(|p| ramp::hue_degrees(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32)))
             .collect();

@@ -78,19 +78,17 @@ fn check(name: &str, counts: &[u32], expected: impl Fn(usize) -> u32, width: u32
     let exp: Vec<bool> = (0..counts.len()).map(|i| expected(i) > 0).collect();
     let act: Vec<bool> = counts.iter().map(|&c| c > 0).collect();
     let to_fb = |cov: &[bool]| {
-        let mut fb = Framebuffer::new(width, height, [0, 0, 0, 255]).unwrap();
-        for (i, &c) in cov.iter().enumerate() {
-            if c {
-                fb.color[i] = [255, 255, 255, 255];
-                fb.depth[i] = 0.5;
-            }
-        }
-        fb
+        let color = cov
+            .iter()
+            .map(|&c| if c { [255; 4] } else { [0, 0, 0, 255] })
+            .collect();
+        let depth = cov.iter().map(|&c| if c { 0.5 } else { 1.0 }).collect();
+        Framebuffer::from_buffers(width, height, color, depth).unwrap()
     };
     let mut actual_fb = to_fb(&act);
     for (i, &c) in counts.iter().enumerate() {
         if c > 1 {
-            actual_fb.color[i] = [255, 0, 255, 255]; // double hits in magenta
+            actual_fb.color_mut()[i] = [255, 0, 255, 255]; // double hits in magenta
         }
     }
     let path =
@@ -353,19 +351,21 @@ fn triangles_crossing_the_near_plane_or_behind_the_eye_match_the_clipped_result(
     for (k, tri) in cases.iter().enumerate() {
         let fb = eye_triangle(*tri, w, h);
         assert!(
-            fb.depth
+            fb.depth()
                 .iter()
                 .all(|d| d.is_finite() && (0.0..=1.0).contains(d)),
             "case {k}: depth out of range"
         );
         let poly = clip_near(tri, 1.0);
-        let mut expected = Framebuffer::new(w, h, [0, 0, 0, 255]).unwrap();
+        let mut depth = vec![1.0f32; (w * h) as usize];
         for i in 1..poly.len() - 1 {
             let part = eye_triangle([poly[0], poly[i], poly[i + 1]], w, h);
-            for (e, p) in expected.depth.iter_mut().zip(&part.depth) {
+            for (e, p) in depth.iter_mut().zip(part.depth()) {
                 *e = e.min(*p);
             }
         }
+        let expected =
+            Framebuffer::from_buffers(w, h, vec![[0, 0, 0, 255]; (w * h) as usize], depth).unwrap();
         let (a, b) = (
             stereolab::compare::coverage(&expected),
             stereolab::compare::coverage(&fb),
@@ -441,7 +441,8 @@ proptest! {
         let mut whole = Framebuffer::new(W, H, [0, 0, 0, 255]).unwrap();
         rasterize(&tris, shader.clip.len(), &shader, &mut whole, &opts);
         let (setups, _) = setup_triangles(&tris, shader.clip.len(), &shader, W, H, &opts);
-        let mut tiled = Framebuffer::new(W, H, [0, 0, 0, 255]).unwrap();
+        let n = (W * H) as usize;
+        let (mut tiled_color, mut tiled_depth) = (vec![[0, 0, 0, 255]; n], vec![1.0f32; n]);
         for y0 in (0..H).step_by(tile_h as usize) {
             for x0 in (0..W).step_by(tile_w as usize) {
                 let (tw, th) = (tile_w.min(W - x0), tile_h.min(H - y0));
@@ -453,15 +454,16 @@ proptest! {
                 }
                 for r in 0..th {
                     for c in 0..tw {
-                        let i = tiled.index(x0 + c, y0 + r);
-                        tiled.color[i] = color[(r * tw + c) as usize];
-                        tiled.depth[i] = depth[(r * tw + c) as usize];
+                        let i = ((y0 + r) * W + x0 + c) as usize;
+                        tiled_color[i] = color[(r * tw + c) as usize];
+                        tiled_depth[i] = depth[(r * tw + c) as usize];
                     }
                 }
             }
         }
-        prop_assert_eq!(&tiled.color, &whole.color);
+        let tiled = Framebuffer::from_buffers(W, H, tiled_color, tiled_depth).unwrap();
+        prop_assert_eq!(tiled.color(), whole.color());
         let bits = |d: &[f32]| d.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-        prop_assert_eq!(bits(&tiled.depth), bits(&whole.depth));
+        prop_assert_eq!(bits(tiled.depth()), bits(whole.depth()));
     }
 }

@@ -19,10 +19,10 @@ fn render_bytes(threads: usize) -> Vec<Vec<u8>> {
         .passes
         .iter()
         .flat_map(|p| {
-            let color: Vec<u8> = p.framebuffer.color.iter().flatten().copied().collect();
+            let color: Vec<u8> = p.framebuffer.color().iter().flatten().copied().collect();
             let depth: Vec<u8> = p
                 .framebuffer
-                .depth
+                .depth()
                 .iter()
                 .flat_map(|d| d.to_le_bytes())
                 .collect();

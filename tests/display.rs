@@ -206,8 +206,8 @@ fn ghosting_leaks_the_set_share_of_the_other_eye_in_linear_light() {
     );
     let out = rgba(produce(Output::GhostingLeft, &frame, &scene).unwrap());
     // A pixel that is background (black) in the left eye and bright in the right eye.
-    let (x, y) = (0..l.height)
-        .flat_map(|y| (0..l.width).map(move |x| (x, y)))
+    let (x, y) = (0..l.height())
+        .flat_map(|y| (0..l.width()).map(move |x| (x, y)))
         .find(|&(x, y)| l.pixel(x, y)[..3] == [0, 0, 0] && r.pixel(x, y)[1] > 200)
         .expect("a ghost pixel");
     let dec = |v: u8| stereolab_core::effects::anaglyph::srgb_to_linear(v as f32 / 255.0);
@@ -221,8 +221,8 @@ fn ghosting_leaks_the_set_share_of_the_other_eye_in_linear_light() {
         );
     }
     // Where the right eye is black nothing leaks.
-    let (bx, by) = (0..l.height)
-        .flat_map(|y| (0..l.width).map(move |x| (x, y)))
+    let (bx, by) = (0..l.height())
+        .flat_map(|y| (0..l.width()).map(move |x| (x, y)))
         .find(|&(x, y)| r.pixel(x, y)[..3] == [0, 0, 0] && l.pixel(x, y)[..3] != [0, 0, 0])
         .expect("a pixel the right eye leaves black");
     assert_eq!(out.get_pixel(bx, by).0, l.pixel(bx, by));
@@ -325,19 +325,19 @@ fn window_violations_are_marked_on_the_parallax_image() {
     let fb = frame.view(View::Left).unwrap();
     let rig = scene.parallax_rig().unwrap();
     let map = parallax_map(fb, &rig).unwrap();
-    let b = budget(&map, fb.width, fb.height);
+    let b = budget(&map, fb.width(), fb.height());
     assert!(b.window_violations[0] > 10, "{:?}", b.window_violations);
     let img = parallax_image(fb, &rig).unwrap();
-    let band = violation_band(fb.width);
+    let band = violation_band(fb.width());
     let yellow = |x: u32, y: u32| img.get_pixel(x, y).0 == VIOLATION_COLOR;
-    let marked_rows = (0..fb.height).filter(|&y| yellow(0, y)).count();
+    let marked_rows = (0..fb.height()).filter(|&y| yellow(0, y)).count();
     assert_eq!(marked_rows, b.window_violations[0]);
-    for y in (0..fb.height).filter(|&y| map[(y * fb.width) as usize].is_some_and(|p| p < 0.0)) {
+    for y in (0..fb.height()).filter(|&y| map[(y * fb.width()) as usize].is_some_and(|p| p < 0.0)) {
         assert!((0..band).all(|x| yellow(x, y)), "row {y}");
     }
     // Nothing else is yellow: the far wall's rows at the left edge are not.
-    let yellow_px = (0..fb.height)
-        .flat_map(|y| (0..fb.width).map(move |x| (x, y)))
+    let yellow_px = (0..fb.height())
+        .flat_map(|y| (0..fb.width()).map(move |x| (x, y)))
         .filter(|&(x, y)| yellow(x, y))
         .count();
     let sides: usize = b.window_violations.iter().sum();
@@ -348,7 +348,12 @@ fn window_violations_are_marked_on_the_parallax_image() {
     let cfb = cf.view(View::Left).unwrap();
     let crig = clean.parallax_rig().unwrap();
     assert_eq!(
-        budget(&parallax_map(cfb, &crig).unwrap(), cfb.width, cfb.height).window_violations,
+        budget(
+            &parallax_map(cfb, &crig).unwrap(),
+            cfb.width(),
+            cfb.height()
+        )
+        .window_violations,
         [0; 4]
     );
     let cimg = parallax_image(cfb, &crig).unwrap();

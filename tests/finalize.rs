@@ -102,9 +102,9 @@ pub fn eyes(frame: &Frame) -> (&Framebuffer, &Framebuffer) {
 /// Centroid (window coordinates, pixel centers at +0.5) of the pixels with depth < 1.
 pub fn drawn_centroid(fb: &Framebuffer) -> [f64; 2] {
     let (mut sx, mut sy, mut n) = (0.0, 0.0, 0usize);
-    for y in 0..fb.height {
-        for x in 0..fb.width {
-            if fb.depth[fb.index(x, y)] < 1.0 {
+    for y in 0..fb.height() {
+        for x in 0..fb.width() {
+            if fb.depth()[fb.index(x, y)] < 1.0 {
                 sx += x as f64 + 0.5;
                 sy += y as f64 + 0.5;
                 n += 1;

@@ -26,10 +26,10 @@ pub(crate) fn check_golden(name: &str, actual: &Framebuffer) {
         })
         .to_rgba8();
     let mut exp_fb = Framebuffer::new(expected.width(), expected.height(), [0; 4]).unwrap();
-    for (dst, src) in exp_fb.color.iter_mut().zip(expected.pixels()) {
+    for (dst, src) in exp_fb.color_mut().iter_mut().zip(expected.pixels()) {
         *dst = src.0;
     }
-    if exp_fb.color != actual.color {
+    if exp_fb.color() != actual.color() {
         let m = stereolab::compare::compare(&exp_fb, actual);
         let strip = stereolab::compare::write_diff_strip(
             &exp_fb,

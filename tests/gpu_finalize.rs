@@ -42,7 +42,7 @@ fn noise_eyes() -> [Framebuffer; 2] {
     };
     [0, 1].map(|_| {
         let mut fb = Framebuffer::new(256, 64, [0, 0, 0, 255]).expect("size");
-        for (i, c) in fb.color.iter_mut().enumerate() {
+        for (i, c) in fb.color_mut().iter_mut().enumerate() {
             let v = next().to_le_bytes();
             // Row 0 walks every value in all channels; the rest is noise.
             *c = if i < 256 {
@@ -141,7 +141,8 @@ fn wgsl_parallax_matches_the_cpu_map_and_colors_on_identical_depth() {
     assert!(worst <= bound, "parallax differs by {worst} px > {bound}");
 
     let cpu_full = parallax_image(&left, &rig).expect("cpu image");
-    let cpu_image = image::imageops::crop_imm(&cpu_full, 0, 0, left.width, left.height).to_image();
+    let cpu_image =
+        image::imageops::crop_imm(&cpu_full, 0, 0, left.width(), left.height()).to_image();
     let (max, n) = diff(&cpu_image, &gpu_image);
     eprintln!("parallax color (image area): max {max}, {n} pixels differ");
     assert!(
@@ -160,7 +161,7 @@ fn wgsl_remap_and_occlusion_match_the_cpu_on_identical_eyes() {
     let Some(r) = gpu() else { return };
     let fin = GpuFinalize::new(r).expect("finalize shaders compile");
     let (_, [left, right], eyes) = wuson_eyes();
-    let pixels = (left.width * left.height) as f64;
+    let pixels = (left.width() * left.height()) as f64;
     for (name, this, other, k) in [("left", &left, &right, 0), ("right", &right, &left, 1)] {
         let (tm, om) = (&eyes[k].mvp, &eyes[1 - k].mvp);
         let cpu = remap_color(this, other, tm, om, Precision::F32Composed).expect("cpu");
@@ -234,16 +235,16 @@ fn chromadepth_pass_matches_the_cpu_in_every_mode() {
                     };
                     let (max, n) = diff(&cpu.to_rgba_image(), &gpu.to_rgba_image());
                     let beyond = cpu
-                        .color
+                        .color()
                         .iter()
-                        .zip(&gpu.color)
+                        .zip(gpu.color())
                         .filter(|(c, g)| c.iter().zip(*g).any(|(a, b)| a.abs_diff(*b) > bound))
                         .count();
                     eprintln!(
                         "chromadepth {name} {sampling:?} {texgen:?} lit {lit}: max {max}, {n} pixels differ, {beyond} beyond {bound}"
                     );
                     assert!(
-                        100.0 * beyond as f64 / cpu.color.len() as f64 <= CREASE_PERCENT,
+                        100.0 * beyond as f64 / cpu.color().len() as f64 <= CREASE_PERCENT,
                         "{name} {sampling:?} {texgen:?} lit {lit}: {beyond} pixels differ by more than {bound}"
                     );
                     assert!(lit || max <= bound, "{name} unlit: max {max} > {bound}");

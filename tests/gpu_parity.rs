@@ -180,7 +180,7 @@ fn assert_same_coverage(name: &str, cpu: &Framebuffer, gpu: &Framebuffer) {
             "{name}: {} pixels differ in coverage (expected 0; # both, ! GPU only, ? CPU only):\n{}\
              strip: {}",
             m.coverage_mismatch,
-            ascii_map(&coverage(cpu), &coverage(gpu), cpu.width as usize, 64),
+            ascii_map(&coverage(cpu), &coverage(gpu), cpu.width() as usize, 64),
             strip.display()
         );
     }
@@ -287,7 +287,7 @@ fn depth_only_passes_match_coverage_and_depth_on_grid_scenes() {
             d.max_depth_diff
         );
         // No fragment stage on either path: the color stays the background, byte for byte.
-        assert_eq!(cpu.color, gpu.color, "seed {seed}: depth-only color");
+        assert_eq!(cpu.color(), gpu.color(), "seed {seed}: depth-only color");
     }
 }
 
@@ -542,8 +542,8 @@ fn coincident_coplanar_triangles_have_the_same_winner_on_both_paths() {
     // Who won each pixel, from its colour: the quad is red, the decal blue.
     let winner = |p: [u8; 4]| p[0] > p[2];
     let (mut quad_wins, mut decal_wins, mut differ) = (0, 0, Vec::new());
-    for (i, (a, b)) in c.color.iter().zip(&g.color).enumerate() {
-        if c.depth[i] >= 1.0 {
+    for (i, (a, b)) in c.color().iter().zip(g.color()).enumerate() {
+        if c.depth()[i] >= 1.0 {
             continue;
         }
         if winner(*a) {
@@ -552,7 +552,7 @@ fn coincident_coplanar_triangles_have_the_same_winner_on_both_paths() {
             decal_wins += 1;
         }
         if winner(*a) != winner(*b) {
-            differ.push((i as u32 % c.width, i as u32 / c.width));
+            differ.push((i as u32 % c.width(), i as u32 / c.width()));
         }
     }
     let (same, both) = stereolab::compare::depth_bits_identical(c, g).expect("same size");
@@ -583,8 +583,12 @@ fn fullscreen_copy_reproduces_its_input_exactly() {
     let (fb, _) = render_view(&scene, &eyes[0], Shading::Color).expect("render");
     let copy = FullscreenPass::copy(r).expect("copy pass compiles");
     let out = copy.run(r, &[&fb], &[]).expect("copy runs");
-    assert_eq!(out.color, fb.color, "color through the full-screen pass");
-    let bits = |f: &Framebuffer| f.depth.iter().map(|d| d.to_bits()).collect::<Vec<_>>();
+    assert_eq!(
+        out.color(),
+        fb.color(),
+        "color through the full-screen pass"
+    );
+    let bits = |f: &Framebuffer| f.depth().iter().map(|d| d.to_bits()).collect::<Vec<_>>();
     assert_eq!(
         bits(&out),
         bits(&fb),

@@ -676,7 +676,7 @@ fn catalogue_remap_at_near_far_1e_minus_6_stays_within_half_a_pixel() {
     let worst_of = |p: Precision| {
         let got = remap_coordinates(left, &ml, &mr, p).expect("remap");
         let (mut drawn, mut worst) = (0, 0.0f64);
-        for ((a, b), d) in exact.iter().zip(&got).zip(&left.depth) {
+        for ((a, b), d) in exact.iter().zip(&got).zip(left.depth()) {
             if *d >= 1.0 {
                 continue;
             }

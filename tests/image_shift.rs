@@ -74,8 +74,8 @@ fn eye(f: &Frame, v: View) -> &Framebuffer {
 
 /// Per column: does the eye draw anything there (any pixel with depth < 1)?
 fn drawn_columns(fb: &Framebuffer) -> Vec<bool> {
-    (0..fb.width)
-        .map(|x| (0..fb.height).any(|y| fb.depth[fb.index(x, y)] < 1.0))
+    (0..fb.width())
+        .map(|x| (0..fb.height()).any(|y| fb.depth()[fb.index(x, y)] < 1.0))
         .collect()
 }
 
@@ -92,8 +92,8 @@ fn one_eye_columns(left: &Framebuffer, right: &Framebuffer) -> (usize, usize, Ve
 /// x centroid of the red square's pixels in one eye.
 fn red_centroid(fb: &Framebuffer) -> f64 {
     let (mut sum, mut n) = (0.0, 0usize);
-    for y in 0..fb.height {
-        for x in 0..fb.width {
+    for y in 0..fb.height() {
+        for x in 0..fb.width() {
             let c = fb.pixel(x, y);
             if c[0] > 100 && c[1] < 60 && c[2] < 60 {
                 sum += x as f64 + 0.5;
@@ -145,7 +145,7 @@ fn the_edge_columns_hold_one_eye_only_as_many_as_each_eye_moved() {
     assert_eq!(odd.len(), sh.total() as usize, "{odd:?}");
     // The blank columns are the clear colour.
     let right = eye(&f, View::Right);
-    assert!((0..5).all(|x| (0..right.height).all(|y| right.pixel(x, y) == s.background)));
+    assert!((0..5).all(|x| (0..right.height()).all(|y| right.pixel(x, y) == s.background)));
     // Off-axis lines the edges up: no column holds one eye only.
     let o = eyes(&test_scene("off-axis"));
     assert_eq!(
@@ -194,10 +194,10 @@ fn each_eye_is_the_parallel_eye_moved_by_its_shift() {
     ] {
         let (a, b) = (eye(&fs, view), eye(&fp, view));
         let (mut same, mut compared) = (0usize, 0usize);
-        for y in 0..a.height {
-            for x in 0..a.width {
+        for y in 0..a.height() {
+            for x in 0..a.width() {
                 let src = x as i64 - k;
-                if src < 0 || src >= a.width as i64 {
+                if src < 0 || src >= a.width() as i64 {
                     continue;
                 }
                 compared += 1;

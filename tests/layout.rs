@@ -33,7 +33,7 @@ fn above_below_squash_averages_row_pairs() {
     for y in 0..8 {
         for x in 0..4 {
             let i = l.index(x, y);
-            l.color[i] = if y % 2 == 0 {
+            l.color_mut()[i] = if y % 2 == 0 {
                 [0, 0, 0, 255]
             } else {
                 [255, 255, 255, 255]

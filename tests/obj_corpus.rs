@@ -200,10 +200,10 @@ fn every_loadable_assimp_model_renders_the_same_bytes_twice() {
         let b = render(&scene, &plan).unwrap();
         let (fa, fb) = (a.view(View::Left).unwrap(), b.view(View::Left).unwrap());
         assert!(
-            fa.color == fb.color && fa.depth == fb.depth,
+            fa.color() == fb.color() && fa.depth() == fb.depth(),
             "{name}: two renders differ"
         );
-        let drawn = fa.depth.iter().filter(|&&d| d < 1.0).count();
+        let drawn = fa.depth().iter().filter(|&&d| d < 1.0).count();
         // number_formats.obj's one face, (0,0,0) (1,2,3) (-1,-2,-3), is a line: nothing shows.
         if all_degenerate(&mesh) {
             assert_eq!(drawn, 0, "{name}: a zero-area face drew pixels");
@@ -396,7 +396,7 @@ fn concave_64_gon_scene(name: &str) -> (Scene, Vec<(f32, f32)>) {
 
 /// Every pixel at least a pixel away from the outline is drawn exactly when it lies inside.
 fn assert_is_the_outline(what: &str, fb: &Framebuffer, outline: &[(f32, f32)]) {
-    let (w, h) = (fb.width, fb.height);
+    let (w, h) = (fb.width(), fb.height());
     let (mut covered, mut wrong) = (0, Vec::new());
     for row in 0..h {
         for col in 0..w {
@@ -408,14 +408,14 @@ fn assert_is_the_outline(what: &str, fb: &Framebuffer, outline: &[(f32, f32)]) {
                 continue; // rasterization rules decide these; not this test's business
             }
             let k = (row * w + col) as usize;
-            let drawn = fb.depth[k] < 1.0;
+            let drawn = fb.depth()[k] < 1.0;
             if drawn != inside(p, outline) {
                 wrong.push((col, row, drawn));
             }
             covered += usize::from(drawn);
         }
     }
-    let img = image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(fb.color[(y * w + x) as usize]));
+    let img = image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(fb.color()[(y * w + x) as usize]));
     let file = what.replace([' ', '(', ')'], "_");
     img.save(out_dir(&format!("obj_corpus_outline_{file}")).join("left.png"))
         .unwrap(); // to look at when this fails

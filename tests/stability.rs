@@ -51,7 +51,7 @@ proptest! {
         let clip: Vec<Vec4> = c.iter().map(|(x, y, z, w)| Vec4::new(*x, *y, *z, *w)).collect();
         let mut fb = Framebuffer::new(32, 24, [0, 0, 0, 255]).unwrap();
         rasterize(&[[0, 1, 2]], 3, &Clip(clip), &mut fb, &RasterOptions::default());
-        prop_assert!(fb.depth.iter().all(|d| (0.0..=1.0).contains(d)));
+        prop_assert!(fb.depth().iter().all(|d| (0.0..=1.0).contains(d)));
     }
 }
 
@@ -80,13 +80,13 @@ fn far_near_ratios_up_to_1e6_keep_a_plane_in_front_of_a_plane_behind() {
         .unwrap();
         let frame = render(&scene, &Plan::new(&[Output::Left])).unwrap();
         let fb = frame.view(View::Left).unwrap();
-        let red = fb.color.iter().filter(|c| c[0] > c[2]).count();
+        let red = fb.color().iter().filter(|c| c[0] > c[2]).count();
         assert_eq!(
             red, 0,
             "far/near = {ratio}: the farther plane shows through on {red} pixels"
         );
         assert!(
-            fb.depth.iter().all(|d| *d < 1.0 && d.is_finite()),
+            fb.depth().iter().all(|d| *d < 1.0 && d.is_finite()),
             "far/near = {ratio}: plane must cover the view"
         );
     }

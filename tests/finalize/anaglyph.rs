@@ -284,7 +284,12 @@ fn linear_light_mixes_decoded_values() {
 fn image_loop_matches_the_per_pixel_function() {
     let mut a = solid(5, 4, [0; 4]);
     let mut b = solid(5, 4, [0; 4]);
-    for (i, (p, q)) in a.color.iter_mut().zip(b.color.iter_mut()).enumerate() {
+    for (i, (p, q)) in a
+        .color_mut()
+        .iter_mut()
+        .zip(b.color_mut().iter_mut())
+        .enumerate()
+    {
         *p = [
             (i * 37 % 256) as u8,
             (i * 91 % 256) as u8,
@@ -311,7 +316,8 @@ fn image_loop_matches_the_per_pixel_function() {
             )
             .expect("anaglyph");
             for (i, px) in img.pixels().enumerate() {
-                let want = anaglyph_pixel(&kind.matrices(), a.color[i], b.color[i], linear_light);
+                let want =
+                    anaglyph_pixel(&kind.matrices(), a.color()[i], b.color()[i], linear_light);
                 assert_eq!(px.0, want, "{kind:?} linear {linear_light} pixel {i}");
             }
         }

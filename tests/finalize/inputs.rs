@@ -4,8 +4,8 @@ use glam::Mat4;
 use stereolab_core::Framebuffer;
 use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
 use stereolab_core::effects::occlusion::occlusion_image;
-use stereolab_core::effects::parallax::{ParallaxRig, parallax_image, parallax_image_with};
-use stereolab_core::effects::remap::{Precision, remap_color, remap_color_with, visibility_map};
+use stereolab_core::effects::parallax::{ParallaxRig, parallax_image};
+use stereolab_core::effects::remap::{Precision, remap_color, visibility_map};
 use stereolab_core::math::{Camera, StereoRig};
 
 fn fb(w: u32, h: u32) -> Framebuffer {
@@ -54,90 +54,65 @@ fn framebuffers_of_different_sizes_are_refused() {
     }
 }
 
+/// A framebuffer holds `width × height` colors and depths by construction: buffers from
+/// elsewhere of another length are refused where they come in, naming the buffer.
 #[test]
-fn missing_depth_is_refused() {
-    let mut a = fb(8, 6);
-    a.depth.clear();
-    let b = fb(8, 6);
-    let m = mvps();
-    for e in [
-        remap_color(&a, &b, &m[0], &m[1], Precision::F64).map(drop),
-        visibility_map(&b, &a, &m[0], &m[1], Precision::F64).map(drop),
-        occlusion_image(&a, &b, [&m[0], &m[1]], Precision::F64).map(drop),
-        parallax_image(&a, &parallax_rig(8, 6)).map(drop),
-    ] {
-        let msg = e.expect_err("no depth").to_string();
-        assert!(msg.contains("missing depth"), "{msg}");
-    }
-    let mut short = fb(8, 6);
-    short.color.pop();
-    let msg = anaglyph(&short, &b, AnaglyphKind::Color, AnaglyphOptions::default())
+fn buffers_of_the_wrong_length_are_refused() {
+    let n = 8 * 6;
+    let msg = Framebuffer::from_buffers(8, 6, vec![[0; 4]; n], Vec::new())
+        .expect_err("no depth")
+        .to_string();
+    assert!(
+        msg.contains("framebuffer depth") && msg.contains("48"),
+        "{msg}"
+    );
+    let msg = Framebuffer::from_buffers(8, 6, vec![[0; 4]; n - 1], vec![1.0; n])
         .expect_err("short color")
         .to_string();
-    assert!(msg.contains("left eye color"), "{msg}");
-}
-
-#[test]
-fn nan_depth_is_refused_naming_the_pixel() {
-    let mut a = fb(8, 6);
-    let i = a.index(3, 2);
-    a.depth[i] = f32::NAN;
-    let b = fb(8, 6);
-    let m = mvps();
-    for e in [
-        remap_color(&a, &b, &m[0], &m[1], Precision::F64).map(drop),
-        occlusion_image(&b, &a, [&m[0], &m[1]], Precision::F64).map(drop),
-        parallax_image(&a, &parallax_rig(8, 6)).map(drop),
-    ] {
-        let msg = e.expect_err("NaN depth").to_string();
-        assert!(msg.contains("pixel (3, 2)") && msg.contains("NaN"), "{msg}");
-    }
-    a.depth[i] = 1.5;
-    let msg = parallax_image(&a, &parallax_rig(8, 6))
-        .expect_err("depth > 1")
+    assert!(
+        msg.contains("framebuffer color") && msg.contains("47"),
+        "{msg}"
+    );
+    let msg = Framebuffer::from_buffers(0, 6, Vec::new(), Vec::new())
+        .expect_err("zero width")
         .to_string();
-    assert!(msg.contains("1.5"), "{msg}");
+    assert!(msg.contains("image.width"), "{msg}");
 }
 
-/// The remap and the parallax image test the depth values inside a pass they make anyway (a
-/// row at a time, or the extremes' scan in blocks): on an image of several rows and blocks, on
-/// the AVX2 and the scalar loops, the first bad pixel is the one named, wherever it lies, and
-/// every kind of bad value is found.
+/// Every depth of a framebuffer is a window depth in [0, 1] by construction: a NaN, an
+/// infinity or a value outside is refused where the buffers come in, the first bad pixel
+/// named wherever it lies, so no effect ever reads one.
 #[test]
 fn a_bad_depth_anywhere_is_refused_naming_the_first() {
     let (w, h) = (1030u32, 40u32);
-    let mut a = fb(w, h);
-    // Something drawn, so the modes do real work around the bad value.
-    for (k, d) in a.depth.iter_mut().enumerate() {
-        if k % 3 == 0 {
-            *d = 0.25 + (k % 1000) as f32 / 4000.0;
-        }
-    }
-    let b = fb(w, h);
-    let m = mvps();
-    let rig = parallax_rig(w, h);
+    let n = (w * h) as usize;
+    // Something drawn, so the bad value sits among real depths.
+    let drawn: Vec<f32> = (0..n)
+        .map(|k| {
+            if k % 3 == 0 {
+                0.25 + (k % 1000) as f32 / 4000.0
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    assert!(Framebuffer::from_buffers(w, h, vec![[0; 4]; n], drawn.clone()).is_ok());
     for (x, y) in [(0, 0), (1029, 0), (517, 16), (7, 39), (1029, 39)] {
-        for bad in [f32::NAN, -0.25, 1.0f32.next_up(), f32::NEG_INFINITY] {
-            let mut a = a.clone();
-            let i = a.index(x, y);
-            a.depth[i] = bad;
+        for bad in [f32::NAN, -0.25, 1.0f32.next_up(), 1.5, f32::NEG_INFINITY] {
+            let mut depth = drawn.clone();
+            let i = (y * w + x) as usize;
+            depth[i] = bad;
             // A later bad value must not be named instead.
-            let last = a.depth.len() - 1;
-            if i != last {
-                a.depth[last] = 2.0;
+            if i != n - 1 {
+                depth[n - 1] = 2.0;
             }
-            for simd in [true, false] {
-                for e in [
-                    remap_color_with(&a, &b, &m[0], &m[1], Precision::F64, simd).map(drop),
-                    parallax_image_with(&a, &rig, simd).map(drop),
-                ] {
-                    let msg = e.expect_err("bad depth").to_string();
-                    assert!(
-                        msg.contains(&format!("pixel ({x}, {y})")),
-                        "{bad} at ({x}, {y}), simd {simd}: {msg}"
-                    );
-                }
-            }
+            let msg = Framebuffer::from_buffers(w, h, vec![[0; 4]; n], depth)
+                .expect_err("bad depth")
+                .to_string();
+            assert!(
+                msg.contains(&format!("pixel ({x}, {y})")) && msg.contains(&bad.to_string()),
+                "{bad} at ({x}, {y}): {msg}"
+            );
         }
     }
 }

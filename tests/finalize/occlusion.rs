@@ -120,7 +120,7 @@ fn check_scene(rig: &Rig, occ: Option<Occluder>, precision: Precision) -> Vec<us
     let s = scene(rig, &meshes, &["occlusion"]);
     let frame = render_outputs(&s, &[Output::Occlusion]);
     let (left, right) = eyes(&frame);
-    let (w, h) = (left.width, left.height);
+    let (w, h) = (left.width(), left.height());
     let mut strip_rows = Vec::new();
     for (k, (this, other)) in [(left, right), (right, left)].into_iter().enumerate() {
         let (e_this, e_other) = (&frame.eyes[k], &frame.eyes[1 - k]);
@@ -234,7 +234,7 @@ fn flat_planes_are_never_flagged_for_near_far_10_to_1e5() {
         let frame = render_outputs(&s, &[Output::Occlusion]);
         let (left, right) = eyes(&frame);
         assert!(
-            left.depth.iter().all(|d| *d < 1.0),
+            left.depth().iter().all(|d| *d < 1.0),
             "plane must fill the view"
         );
         for precision in [Precision::F64, Precision::F32] {
@@ -312,15 +312,15 @@ fn map_with_tolerance(
     mvp: [&glam::Mat4; 2],
     tol: &dyn Fn(&Framebuffer, u32, u32) -> f64,
 ) -> Vec<Visibility> {
-    let (w, h) = (this.width, this.height);
+    let (w, h) = (this.width(), this.height());
     let r = Remapper::new(mvp[0], mvp[1], w, h, Precision::F64).expect("remapper");
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .map(|(x, y)| {
-            let d = this.depth[this.index(x, y)];
+            let d = this.depth()[this.index(x, y)];
             let target = r.remap(x, y, d).and_then(|m| {
                 m.texel(w, h)
-                    .map(|(tx, ty)| (m, other.depth[other.index(tx, ty)]))
+                    .map(|(tx, ty)| (m, other.depth()[other.index(tx, ty)]))
             });
             classify(d, target, tol(this, x, y))
         })

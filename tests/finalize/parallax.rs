@@ -164,7 +164,7 @@ fn budget_reports_share_beyond_three_percent_and_window_violations() {
     assert_eq!(b.beyond_budget, b.drawn);
     // The quad touches the left border only: rows it covers at x = 0.
     let quad_rows = (0..rig.height)
-        .filter(|&y| left.depth[left.index(0, y)] < left.depth[left.index(rig.width - 1, y)])
+        .filter(|&y| left.depth()[left.index(0, y)] < left.depth()[left.index(rig.width - 1, y)])
         .count();
     assert!(quad_rows > 0);
     assert_eq!(b.window_violations, [quad_rows, 0, 0, 0]);

@@ -15,18 +15,18 @@ fn max_deviation(z: f32, precision: Precision, shift_x: f64) -> (f64, f64) {
         remap_coordinates(left, &frame.eyes[0].mvp, &frame.eyes[1].mvp, precision).expect("remap");
     let (mut dx, mut dy) = (0.0f64, 0.0f64);
     let mut n = 0;
-    for y in 0..left.height {
-        for x in 0..left.width {
+    for y in 0..left.height() {
+        for x in 0..left.width() {
             let i = left.index(x, y);
-            assert!(left.depth[i] < 1.0, "the plane must fill the view");
+            assert!(left.depth()[i] < 1.0, "the plane must fill the view");
             let r = coords[i].expect("in front of the other eye");
-            let [wx, wy] = r.window(left.width, left.height);
+            let [wx, wy] = r.window(left.width(), left.height());
             dx = dx.max((wx - (x as f64 + 0.5) - shift_x).abs());
             dy = dy.max((wy - (y as f64 + 0.5)).abs());
             n += 1;
         }
     }
-    assert_eq!(n, (left.width * left.height) as usize);
+    assert_eq!(n, (left.width() * left.height()) as usize);
     (dx, dy)
 }
 
@@ -76,16 +76,16 @@ fn remapped_view_takes_the_other_eyes_colors() {
     .expect("remap");
     let shift = rig.parallax_px(9.0);
     let mut checked = 0;
-    for y in 0..left.height {
-        for x in 0..left.width {
+    for y in 0..left.height() {
+        for x in 0..left.width() {
             let xr = ((x as f64 + 0.5 + shift).floor()) as u32;
-            if xr < right.width {
+            if xr < right.width() {
                 assert_eq!(img.get_pixel(x, y).0, right.pixel(xr, y), "({x}, {y})");
                 checked += 1;
             }
         }
     }
-    assert!(checked > (left.width * left.height) as usize * 9 / 10);
+    assert!(checked > (left.width() * left.height()) as usize * 9 / 10);
 }
 
 /// Largest |τ − τ_f64| in pixels over the drawn pixels of the real model's left eye at
@@ -102,7 +102,7 @@ fn unprojection_error_px(near_over_far: f32, precision: Precision) -> f64 {
     let exact = remap_coordinates(&left, &eyes[0].mvp, &eyes[1].mvp, Precision::F64).expect("f64");
     let other = remap_coordinates(&left, &eyes[0].mvp, &eyes[1].mvp, precision).expect("remap");
     let mut worst = 0.0f64;
-    for ((a, b), d) in exact.iter().zip(&other).zip(&left.depth) {
+    for ((a, b), d) in exact.iter().zip(&other).zip(left.depth()) {
         if *d < 1.0 {
             let (a, b) = (a.expect("f64 in view"), b.expect("in view"));
             worst = worst.max((a.tex[0] - b.tex[0]).abs().max((a.tex[1] - b.tex[1]).abs()));

@@ -208,7 +208,7 @@ fn subpixel_bits(scene: &Scene, scale: Scale) -> Result<Vec<Knob>> {
         let mut s = scene.clone();
         s.raster.subpixel_bits = b;
         let (fb, _) = render_view(&s, &eyes[0], Shading::DepthOnly)?;
-        let cov: Vec<bool> = fb.depth.iter().map(|d| *d < 1.0).collect();
+        let cov: Vec<bool> = fb.depth().iter().map(|d| *d < 1.0).collect();
         let ms = median_ms(scale.iters, || {
             render_view(&s, &eyes[0], Shading::DepthOnly).is_ok()
         });
@@ -480,7 +480,7 @@ fn anaglyph_light(scene: &Scene, iters: usize) -> Result<Knob> {
                 .zip(linear.as_raw())
                 .map(|(a, b)| u64::from(a.abs_diff(*b)))
                 .sum();
-            let mean = sum as f64 / (left.color.len() * 3) as f64;
+            let mean = sum as f64 / (left.color().len() * 3) as f64;
             let ms = median_ms(iters, || run(linear_light).is_ok());
             let how = if linear_light { "linear" } else { "stored" };
             points.push(point(format!("{} {how}", kind.output_name()), mean, ms));
@@ -709,8 +709,8 @@ fn threads(scene: &Scene, iters: usize) -> Result<Knob> {
             let mut b = Vec::new();
             for v in [View::Left, View::Right] {
                 if let Some(fb) = f.view(v) {
-                    b.extend(fb.color.iter().flatten());
-                    b.extend(fb.depth.iter().flat_map(|d| d.to_le_bytes()));
+                    b.extend(fb.color().iter().flatten());
+                    b.extend(fb.depth().iter().flat_map(|d| d.to_le_bytes()));
                 }
             }
             Ok(b)

@@ -253,7 +253,7 @@ fn pass_vs_pair(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
 fn glasses_and_terrain(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let center = StereoRig::center(&scene.camera, scene.aspect())?;
     let (fb, _) = render_view(scene, &center, Shading::ChromaDepth)?;
-    let shift = scene.chromadepth.max_shift_px(fb.width);
+    let shift = scene.chromadepth.max_shift_px(fb.width());
     let glasses_ms = median_ms(iters, || glasses_pair(&fb, shift));
     let csv = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes/terrain/island.csv");
     let text = std::fs::read_to_string(&csv).map_err(|e| Error::io(&csv, e))?;
@@ -271,7 +271,7 @@ fn glasses_and_terrain(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             None,
             "",
             glasses_ms,
-            format!("{}x{}, max shift {shift:.1} px", fb.width, fb.height),
+            format!("{}x{}, max shift {shift:.1} px", fb.width(), fb.height()),
         ),
         row(
             "terrain",

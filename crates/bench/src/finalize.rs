@@ -118,7 +118,7 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         return Ok(Vec::new());
     };
     let mvp = [frame.eyes[0].mvp, frame.eyes[1].mvp];
-    let px = left.color.len();
+    let px = left.color().len();
     let mut rows = anaglyph_rows(left, right, iters)?;
     // Each mode on the AVX2 rows (where the CPU has AVX2) and on the scalar loops, what a CPU
     // without AVX2 runs; the bytes are the same (unit tests). Each against a copy of the bytes
@@ -132,7 +132,7 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         move || remap_color_with(this, other, &mvp[k], &mvp[1 - k], Precision::F64, simd).map(drop)
     };
     let drawn_share = |fb: &Framebuffer| {
-        let drawn = fb.depth.iter().filter(|d| **d < 1.0).count();
+        let drawn = fb.depth().iter().filter(|d| **d < 1.0).count();
         format!("{:.0}% of pixels drawn", 100.0 * drawn as f64 / px as f64)
     };
     for (name, eye, mut f) in [
@@ -217,7 +217,7 @@ pub(super) fn remap_precision(scene: &Scene, iters: usize) -> Result<(Vec<Row>, 
 /// Each anaglyph kind on stored values and in linear light: time, and the largest and mean
 /// channel difference (8-bit levels) of linear light against stored values.
 fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Result<Vec<Row>> {
-    let px = left.color.len();
+    let px = left.color().len();
     let mut rows = Vec::new();
     for kind in AnaglyphKind::ALL {
         let run = |linear_light| {
@@ -268,9 +268,9 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
     // neighbours equal) shows the rate of the arithmetic itself.
     let kind = AnaglyphKind::DuboisRedCyan;
     let noise = |seed: u64| -> Result<Framebuffer> {
-        let mut fb = Framebuffer::new(left.width, left.height, [0, 0, 0, 255])?;
+        let mut fb = Framebuffer::new(left.width(), left.height(), [0, 0, 0, 255])?;
         let mut state = seed;
-        for c in &mut fb.color {
+        for c in fb.color_mut() {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
@@ -329,7 +329,7 @@ fn remap_precision_rows(
     ] {
         let coords = remap_coordinates(left, &mvp[0], &mvp[1], p)?;
         let (mut drawn, mut all) = (0.0f64, 0.0f64);
-        for ((a, b), d) in exact.iter().zip(&coords).zip(&left.depth) {
+        for ((a, b), d) in exact.iter().zip(&coords).zip(left.depth()) {
             let e = match (a, b) {
                 (Some(a), Some(b)) => (a.tex[0] - b.tex[0]).abs().max((a.tex[1] - b.tex[1]).abs()),
                 (None, None) => 0.0,
@@ -341,12 +341,12 @@ fn remap_precision_rows(
             }
         }
         // Time the per-pixel program alone (no coordinate buffer to allocate).
-        let remapper = Remapper::new(&mvp[0], &mvp[1], left.width, left.height, p)?;
+        let remapper = Remapper::new(&mvp[0], &mvp[1], left.width(), left.height(), p)?;
         let ms = median_ms(iters, || {
             let mut sum = 0.0;
-            for y in 0..left.height {
-                for x in 0..left.width {
-                    if let Some(m) = remapper.remap(x, y, left.depth[left.index(x, y)]) {
+            for y in 0..left.height() {
+                for x in 0..left.width() {
+                    if let Some(m) = remapper.remap(x, y, left.depth()[left.index(x, y)]) {
                         sum += m.tex[0] + m.tex[1] + m.depth;
                     }
                 }
@@ -362,8 +362,8 @@ fn remap_precision_rows(
         );
         r.note = format!(
             "= {:.4} px at width {}; all pixels incl. far plane {:.2e}",
-            drawn * left.width as f64,
-            left.width,
+            drawn * left.width() as f64,
+            left.width(),
             all
         );
         rows.push(r);

@@ -45,7 +45,7 @@ fn finalize_rows(r: &GpuRenderer, frame: &Frame, scene: &Scene, iters: usize) ->
     let kind = AnaglyphKind::DuboisRedCyan;
     let opts = AnaglyphOptions::default();
     let crop = |img: image::RgbaImage| {
-        image::imageops::crop_imm(&img, 0, 0, left.width, left.height).to_image()
+        image::imageops::crop_imm(&img, 0, 0, left.width(), left.height()).to_image()
     };
     let effects: Vec<Effect> = vec![
         (
@@ -69,14 +69,14 @@ fn finalize_rows(r: &GpuRenderer, frame: &Frame, scene: &Scene, iters: usize) ->
             Box::new(|| fin.occlusion_image(r, left, right, mvps)),
         ),
     ];
-    let size = format!("{}x{}", left.width, left.height);
+    let size = format!("{}x{}", left.width(), left.height());
     let mut rows = Vec::new();
     for (name, cpu, gpu) in effects {
         let (c, g) = (cpu()?, gpu()?);
         let c = if name == "parallax" { crop(c) } else { c };
         let metrics = compare(
-            &framebuffer_from_image(&c, scene.background),
-            &framebuffer_from_image(&g, scene.background),
+            &framebuffer_from_image(&c, scene.background)?,
+            &framebuffer_from_image(&g, scene.background)?,
         )?;
         let mut failed = None;
         let cpu_ms = median_ms(iters, || cpu().map_err(|e| failed = Some(e)));
@@ -212,7 +212,7 @@ fn pair_and_anaglyph(
     let eyes = scene.rig.eyes(&scene.camera, scene.aspect())?;
     let oneshot = super::gpu_oneshot::OneShot::new(scene, &eyes)?;
     let cpu = match cpu_frame()? {
-        Image::Rgba(img) => framebuffer_from_image(&img, scene.background),
+        Image::Rgba(img) => framebuffer_from_image(&img, scene.background)?,
         _ => {
             return Err(stereolab_core::Error::internal(
                 "anaglyph",
@@ -224,8 +224,8 @@ fn pair_and_anaglyph(
     let resident = resident_frame()?;
     let identical = host == resident;
     let fb = |img: &image::RgbaImage| framebuffer_from_image(img, scene.background);
-    let host_diff = compare(&cpu, &fb(&host))?.max_channel_diff;
-    let resident_diff = compare(&cpu, &fb(&resident))?.max_channel_diff;
+    let host_diff = compare(&cpu, &fb(&host)?)?.max_channel_diff;
+    let resident_diff = compare(&cpu, &fb(&resident)?)?.max_channel_diff;
     let ms = interleaved_medians(
         iters,
         1,

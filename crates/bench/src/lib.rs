@@ -242,7 +242,7 @@ fn subpixel_bits(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         let mut s = scene.clone();
         s.raster.subpixel_bits = bits;
         let (fb, _) = render_view(&s, &eyes[0], stereolab::plan::Shading::DepthOnly)?;
-        Ok(fb.depth.iter().map(|d| *d < 1.0).collect())
+        Ok(fb.depth().iter().map(|d| *d < 1.0).collect())
     };
     let reference = coverage(16)?;
     let mut rows = Vec::new();

@@ -13,16 +13,21 @@ pub const MAX_IMAGE_SIDE: u32 = 16384;
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 
 /// An RGBA8 color buffer and an f32 depth buffer in [0, 1] (1 = far plane), row 0 at the top.
+///
+/// Valid by construction: its size is one [`check_size`] accepts, both buffers hold
+/// `width × height` values, and every depth is a window depth in [0, 1]. [`Framebuffer::new`]
+/// clears one, the rasterizer draws into it, [`Framebuffer::from_buffers`] checks buffers from
+/// elsewhere (files, the GPU's readback); nothing downstream checks them again.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Framebuffer {
     /// Width in pixels.
-    pub width: u32,
+    pub(crate) width: u32,
     /// Height in pixels.
-    pub height: u32,
+    pub(crate) height: u32,
     /// Row-major RGBA8 pixels, row 0 at the top.
-    pub color: Vec<[u8; 4]>,
+    pub(crate) color: Vec<[u8; 4]>,
     /// Row-major window depth, `glDepthRange(0, 1)`.
-    pub depth: Vec<f32>,
+    pub(crate) depth: Vec<f32>,
 }
 
 /// The stereo draw buffers of a quad-buffered OpenGL context, by the names the SGI course notes
@@ -85,6 +90,108 @@ impl Framebuffer {
             color,
             depth,
         })
+    }
+
+    /// A framebuffer of buffers made elsewhere (an image file, the GPU's readback), checked.
+    ///
+    /// # Errors
+    /// `Invalid` for a size [`check_size`] refuses, a buffer whose length is not
+    /// `width × height`, or a depth that is not a number in [0, 1] (naming its pixel).
+    pub fn from_buffers(
+        width: u32,
+        height: u32,
+        color: Vec<[u8; 4]>,
+        depth: Vec<f32>,
+    ) -> Result<Self> {
+        check_size(width, height)?;
+        let n = width as usize * height as usize;
+        for (name, len) in [("color", color.len()), ("depth", depth.len())] {
+            if len != n {
+                return Err(Error::invalid(
+                    format!("framebuffer {name}"),
+                    format!("{len} values"),
+                    format!("a {width}x{height} framebuffer holds {n}"),
+                ));
+            }
+        }
+        if let Some(i) = depth.iter().position(|d| !(0.0..=1.0).contains(d)) {
+            return Err(Error::invalid(
+                format!(
+                    "depth at pixel ({}, {})",
+                    i % width as usize,
+                    i / width as usize
+                ),
+                depth[i],
+                "window depth must be a number in [0, 1] (NaN or out of range found)",
+            ));
+        }
+        Ok(Framebuffer {
+            width,
+            height,
+            color,
+            depth,
+        })
+    }
+
+    /// Width in pixels.
+    #[inline]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    #[inline]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Row-major RGBA8 pixels, row 0 at the top.
+    #[inline]
+    pub fn color(&self) -> &[[u8; 4]] {
+        &self.color
+    }
+
+    /// The color buffer to draw into (its length is fixed; depth is not touched).
+    #[inline]
+    pub fn color_mut(&mut self) -> &mut [[u8; 4]] {
+        &mut self.color
+    }
+
+    /// Row-major window depth in [0, 1], `glDepthRange(0, 1)`.
+    #[inline]
+    pub fn depth(&self) -> &[f32] {
+        &self.depth
+    }
+
+    /// Depth 0 everywhere: every pixel counts as drawn (a picture compared by coverage, not a
+    /// pass).
+    pub fn cover_all(&mut self) {
+        self.depth.fill(0.0);
+    }
+
+    /// Takes `other`'s depth buffer (the same size), keeping this framebuffer's colors: a
+    /// picture drawn over another pass's depth.
+    ///
+    /// # Errors
+    /// `Invalid` when the sizes differ.
+    pub fn copy_depth_from(&mut self, other: &Framebuffer) -> Result<()> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return Err(Error::invalid(
+                "depth source",
+                format!("{}x{}", other.width, other.height),
+                format!(
+                    "must be {}x{}, the framebuffer's size",
+                    self.width, self.height
+                ),
+            ));
+        }
+        self.depth.copy_from_slice(&other.depth);
+        Ok(())
+    }
+
+    /// The buffers, for a caller that takes them over (an image, a texture upload).
+    pub fn into_buffers(self) -> (Vec<[u8; 4]>, Vec<f32>) {
+        (self.color, self.depth)
     }
 
     /// Index of pixel (x, y) in the row-major buffers.

@@ -231,7 +231,7 @@ pub fn remap_one_pixel(ctx: &Context) -> Result<Canvas> {
     // The covered pixel nearest the image center.
     let (x, y) = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .filter(|&(x, y)| left.depth[left.index(x, y)] < 1.0)
+        .filter(|&(x, y)| left.depth()[left.index(x, y)] < 1.0)
         .min_by_key(|&(x, y)| {
             let (dx, dy) = (
                 i64::from(x) - i64::from(w / 2 - 30),
@@ -240,7 +240,7 @@ pub fn remap_one_pixel(ctx: &Context) -> Result<Canvas> {
             dx * dx + dy * dy
         })
         .ok_or_else(|| Error::internal("figures", "the left eye sees nothing"))?;
-    let depth = left.depth[left.index(x, y)];
+    let depth = left.depth()[left.index(x, y)];
     let (ml, mr) = (frame.eyes[0].mvp, frame.eyes[1].mvp);
     let r = Remapper::new(&ml, &mr, w, h, Precision::F64)?;
     let remapped = r

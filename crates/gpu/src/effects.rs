@@ -54,7 +54,7 @@ fn image_of(fb: &Framebuffer) -> RgbaImage {
 /// The nearest and farthest window depth of the drawn pixels (as `occlusion::depth_extremes`):
 /// a reduction over the input, done on the host.
 fn depth_extremes(fb: &Framebuffer) -> (f32, f32) {
-    fb.depth
+    fb.depth()
         .iter()
         .filter(|d| **d < 1.0)
         .fold((1.0f32, 0.0f32), |(lo, hi), d| (lo.min(*d), hi.max(*d)))
@@ -113,10 +113,10 @@ impl GpuFinalize {
         fb: &Framebuffer,
         rig: &ParallaxRig,
     ) -> Result<(Vec<f32>, RgbaImage)> {
-        if (fb.width, fb.height) != (rig.width, rig.height) {
+        if (fb.width(), fb.height()) != (rig.width, rig.height) {
             return Err(Error::invalid(
                 "parallax framebuffer",
-                format!("{}x{}", fb.width, fb.height),
+                format!("{}x{}", fb.width(), fb.height()),
                 format!("the rig was resolved for {}x{}", rig.width, rig.height),
             ));
         }
@@ -130,10 +130,11 @@ impl GpuFinalize {
             p.extend(unit_color(PARALLAX_BACKGROUND));
             p
         };
-        let first = self.parallax.run(r, &[fb], &params(1.0))?;
-        let scale = parallax_scale(&first.depth);
-        let colored = self.parallax.run(r, &[fb], &params(scale))?;
-        Ok((first.depth, image_of(&colored)))
+        // The pass writes p(z) where a depth would be: read back as values, not depths.
+        let first = self.parallax.run_readback(r, &[fb], &params(1.0))?;
+        let scale = parallax_scale(&first.values);
+        let colored = self.parallax.run_readback(r, &[fb], &params(scale))?;
+        Ok((first.values, colored.to_rgba_image()))
     }
 
     /// `this` eye recolored from `other`, as [`remap_color`](stereolab_core::effects::remap::remap_color)
@@ -172,7 +173,7 @@ impl GpuFinalize {
         check_depth("left", left)?;
         check_depth("right", right)?;
         let eyes = [left, right];
-        let (w, h) = (left.width, left.height);
+        let (w, h) = (left.width(), left.height());
         let mut out = RgbaImage::new(2 * w, h);
         for k in 0..2 {
             let params = remap_params(mvps[k], mvps[1 - k], 1.0, depth_extremes(eyes[k]))?;
@@ -253,7 +254,7 @@ pub fn produce_wgsl(
             let (values, area) = fin.parallax(r, left, &scene.parallax_rig()?)?;
             // The same scale the pass used.
             let scale = f64::from(parallax_scale(&values));
-            let legend = stereolab_core::effects::legend::draw_legend(left.width, scale, &|p| {
+            let legend = stereolab_core::effects::legend::draw_legend(left.width(), scale, &|p| {
                 stereolab_core::effects::parallax::parallax_color(p, scale)
             })?;
             let mut bytes = area.into_raw();
@@ -264,15 +265,15 @@ pub fn produce_wgsl(
                 .collect();
             let marks = stereolab_core::effects::parallax::window_violation_marks(
                 &map,
-                left.width,
-                left.height,
+                left.width(),
+                left.height(),
             );
             for i in marks {
                 bytes[4 * i..4 * i + 4]
                     .copy_from_slice(&stereolab_core::effects::parallax::VIOLATION_COLOR);
             }
             bytes.extend_from_slice(legend.data());
-            RgbaImage::from_raw(left.width, left.height + legend.height(), bytes)
+            RgbaImage::from_raw(left.width(), left.height() + legend.height(), bytes)
                 .ok_or_else(|| Error::internal("parallax", "image and legend size mismatch"))?
         }
         _ => return Ok(None),

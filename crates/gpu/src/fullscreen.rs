@@ -10,7 +10,9 @@ use stereolab_core::framebuffer::Framebuffer;
 
 use super::device::GpuRenderer;
 use super::gpu_error;
-use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read, submit_and_read_colors};
+use super::readback::{
+    COLOR_FORMAT, DepthKind, Readback, Target, submit_and_read, submit_and_read_colors,
+};
 use super::resources::{fragment_texture_entry, fragment_uniform_entry, texture_2d, write_texels};
 
 /// Vertex stage and helpers every full-screen shader gets.
@@ -198,23 +200,34 @@ impl FullscreenPass {
         inputs: &[&Framebuffer],
         params: &[f32],
     ) -> Result<Framebuffer> {
+        self.run_readback(r, inputs, params)?.into_framebuffer()
+    }
+
+    /// [`FullscreenPass::run`] without reading its R32 output as depths: the values as the
+    /// pass wrote them (the parallax pass writes p(z) there).
+    pub(crate) fn run_readback(
+        &self,
+        r: &GpuRenderer,
+        inputs: &[&Framebuffer],
+        params: &[f32],
+    ) -> Result<Readback> {
         self.check_arguments(inputs.len(), params)?;
-        let (width, height) = (inputs[0].width, inputs[0].height);
+        let (width, height) = (inputs[0].width(), inputs[0].height());
         if let Some(f) = inputs
             .iter()
-            .find(|f| (f.width, f.height) != (width, height))
+            .find(|f| (f.width(), f.height()) != (width, height))
         {
             return Err(Error::invalid(
                 format!("{} inputs", self.label),
-                format!("{}x{} vs {}x{}", f.width, f.height, width, height),
+                format!("{}x{} vs {}x{}", f.width(), f.height(), width, height),
                 "all inputs must have the same size",
             ));
         }
         let target = Target::take(r, width, height, DepthKind::ColorR32)?;
         let mut views = Vec::with_capacity(inputs.len());
         for fb in inputs {
-            let color: Vec<u8> = fb.color.iter().flatten().copied().collect();
-            let depth: Vec<u8> = fb.depth.iter().flat_map(|d| d.to_ne_bytes()).collect();
+            let color: Vec<u8> = fb.color().iter().flatten().copied().collect();
+            let depth: Vec<u8> = fb.depth().iter().flat_map(|d| d.to_ne_bytes()).collect();
             views.push([
                 upload_texture(r, COLOR_FORMAT, width, height, &color),
                 upload_texture(r, DepthKind::ColorR32.format(), width, height, &depth),
@@ -232,11 +245,11 @@ impl FullscreenPass {
             target.encode_color_copy(&mut encoder);
             submit_and_read_colors(r, encoder, &[&target])?
                 .pop()
-                .map(|img| Framebuffer {
+                .map(|img| Readback {
                     width,
                     height,
                     color: img.pixels().map(|p| p.0).collect(),
-                    depth: vec![0.0; width as usize * height as usize],
+                    values: vec![0.0; width as usize * height as usize],
                 })
         };
         Target::give_back(r, [target]);

@@ -104,15 +104,15 @@ pub fn compare_finalize(
             Output::Parallax => {
                 let rig = scene.parallax_rig()?;
                 let full = parallax_image(left, &rig)?;
-                let cpu = image::imageops::crop_imm(&full, 0, 0, left.width, left.height);
+                let cpu = image::imageops::crop_imm(&full, 0, 0, left.width(), left.height());
                 (cpu.to_image(), fin.parallax(r, left, &rig)?.1)
             }
             _ => continue,
         };
         let name = format!("{} (wgsl)", o.name());
         let (e, a) = (
-            framebuffer_from_image(&cpu, scene.background),
-            framebuffer_from_image(&gpu, scene.background),
+            framebuffer_from_image(&cpu, scene.background)?,
+            framebuffer_from_image(&gpu, scene.background)?,
         );
         let metrics = compare(&e, &a)?;
         let strip = out
@@ -164,8 +164,8 @@ pub fn compare_frames(
             continue; // depth images: the pass rows already compare depth exactly
         };
         let (e, a) = (
-            framebuffer_from_image(&e, scene.background),
-            framebuffer_from_image(&a, scene.background),
+            framebuffer_from_image(&e, scene.background)?,
+            framebuffer_from_image(&a, scene.background)?,
         );
         let metrics = compare(&e, &a)?;
         let strip = out

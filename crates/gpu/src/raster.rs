@@ -19,7 +19,7 @@ use stereolab_core::raster::{RasterOptions, RasterStats};
 use stereolab_core::shade::BlinnPhong;
 
 use super::device::{FusedEye, GpuRenderer, PipelineKey};
-use super::readback::{COLOR_FORMAT, DepthKind, Target, submit_and_read};
+use super::readback::{COLOR_FORMAT, DepthKind, Readback, Target, submit_and_read};
 use super::resources::{buffer_with, clear_color};
 
 /// The mirror of [`BlinnPhong`](stereolab_core::shade::BlinnPhong).
@@ -240,10 +240,13 @@ impl GpuRenderer {
             t.encode_copies(&mut encoder);
         }
         let refs: Vec<&Target> = targets.iter().collect();
-        let framebuffers = submit_and_read(self, encoder, &refs)?;
+        let readbacks = submit_and_read(self, encoder, &refs)?;
         // Only after a clean readback: a failed one may leave a buffer mapped.
         Target::give_back(self, targets);
-        Ok(framebuffers)
+        readbacks
+            .into_iter()
+            .map(Readback::into_framebuffer)
+            .collect()
     }
 
     /// Records one scene pass per view into `encoder`, each into a target of its own (color

@@ -181,7 +181,7 @@ pub(crate) fn submit_and_read(
     r: &GpuRenderer,
     encoder: wgpu::CommandEncoder,
     targets: &[&Target],
-) -> Result<Vec<Framebuffer>> {
+) -> Result<Vec<Readback>> {
     let buffers: Vec<&wgpu::Buffer> = targets
         .iter()
         .flat_map(|t| [&t.color_buffer, &t.depth_buffer])
@@ -257,8 +257,31 @@ fn read_color(t: &Target) -> Result<RgbaImage> {
         .ok_or_else(|| stereolab_core::Error::internal("readback", "color buffer size mismatch"))
 }
 
-/// Unpads the mapped buffers of `t` into a framebuffer, then unmaps them.
-fn read_target(t: &Target) -> Result<Framebuffer> {
+/// A target's pixels as read back: its colors and the f32 values of its depth (or R32) texture,
+/// which a full-screen pass may fill with other numbers than depths (the parallax pass writes
+/// p(z) there).
+pub(crate) struct Readback {
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) color: Vec<[u8; 4]>,
+    pub(crate) values: Vec<f32>,
+}
+
+impl Readback {
+    /// The readback of a depth target as a framebuffer (its values checked as window depths).
+    pub(crate) fn into_framebuffer(self) -> Result<Framebuffer> {
+        Framebuffer::from_buffers(self.width, self.height, self.color, self.values)
+    }
+
+    /// The colors as an image.
+    pub(crate) fn to_rgba_image(&self) -> RgbaImage {
+        let bytes: Vec<u8> = self.color.iter().flatten().copied().collect();
+        RgbaImage::from_raw(self.width, self.height, bytes).expect("4 bytes per pixel")
+    }
+}
+
+/// Unpads the mapped buffers of `t`, then unmaps them.
+fn read_target(t: &Target) -> Result<Readback> {
     let (w, row) = (t.width as usize, t.padded_row as usize);
     let n = w * t.height as usize;
     let (mut color, mut depth) = (Vec::with_capacity(n), Vec::with_capacity(n));
@@ -280,10 +303,10 @@ fn read_target(t: &Target) -> Result<Framebuffer> {
     }
     t.color_buffer.unmap();
     t.depth_buffer.unmap();
-    Ok(Framebuffer {
+    Ok(Readback {
         width: t.width,
         height: t.height,
         color,
-        depth,
+        values: depth,
     })
 }

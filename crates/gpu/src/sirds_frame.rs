@@ -60,8 +60,8 @@ pub fn compare_strips(
     let cpu = sirds::from_frame(frame, scene)?.to_rgba_image();
     let gpu = from_frame(r, &GpuStrips::new(r)?, frame, scene)?.to_rgba_image();
     let (e, a) = (
-        framebuffer_from_image(&cpu, scene.background),
-        framebuffer_from_image(&gpu, scene.background),
+        framebuffer_from_image(&cpu, scene.background)?,
+        framebuffer_from_image(&gpu, scene.background)?,
     );
     let metrics = compare(&e, &a)?;
     let strip = out

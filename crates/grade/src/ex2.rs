@@ -50,11 +50,11 @@ const RAMP_STRIP_HEIGHT: u32 = 6;
 fn strip(colors: &[Option<[f32; 3]>]) -> Framebuffer {
     let mut fb = Framebuffer::new(RAMP_STRIP_WIDTH, RAMP_STRIP_HEIGHT, [0, 0, 0, 255])
         .expect("a valid constant size");
-    fb.depth.fill(0.0);
+    fb.cover_all();
     for y in 0..RAMP_STRIP_HEIGHT {
         for (x, c) in colors.iter().enumerate() {
             let i = fb.index(x as u32, y);
-            fb.color[i] = c.map_or([0, 0, 0, 255], |c| to_rgba8(Vec3::from(c)));
+            fb.color_mut()[i] = c.map_or([0, 0, 0, 255], |c| to_rgba8(Vec3::from(c)));
         }
     }
     fb

@@ -162,7 +162,7 @@ fn dot(x: usize, y: usize) -> [u8; 4] {
 fn sirds_picture(w: u32, rows: &[Option<Vec<usize>>]) -> Framebuffer {
     let h = rows.len() as u32;
     let mut fb = Framebuffer::new(w, h.max(1), [0, 0, 0, 255]).expect("the scene's size");
-    fb.depth.fill(0.0);
+    fb.cover_all();
     for (y, row) in rows.iter().enumerate() {
         let w = w as usize;
         let mut pix = vec![[0u8; 4]; w];
@@ -174,7 +174,7 @@ fn sirds_picture(w: u32, rows: &[Option<Vec<usize>>]) -> Framebuffer {
             };
         }
         let start = y * w;
-        fb.color[start..start + w].copy_from_slice(&pix);
+        fb.color_mut()[start..start + w].copy_from_slice(&pix);
     }
     fb
 }

@@ -145,7 +145,7 @@ impl Fixture {
     pub(crate) fn canvas(&self, color: [u8; 4]) -> Framebuffer {
         let (w, h) = self.size();
         let mut fb = Framebuffer::new(w, h, color).expect("the scene's size was validated");
-        fb.depth.fill(0.0);
+        fb.cover_all();
         fb
     }
 
@@ -177,11 +177,11 @@ pub(crate) fn pixel_uv(w: u32, h: u32, x: u32, y: u32) -> [f32; 2] {
 /// Eye-space position (in `m.view`'s space) of a covered pixel of `fb`, rendered with `m`;
 /// `None` for background.
 pub(crate) fn unproject(m: &EyeMatrices, fb: &Framebuffer, x: u32, y: u32) -> Option<Vec3> {
-    let d = fb.depth[fb.index(x, y)];
+    let d = fb.depth()[fb.index(x, y)];
     if d >= 1.0 {
         return None;
     }
-    let [u, v] = pixel_uv(fb.width, fb.height, x, y);
+    let [u, v] = pixel_uv(fb.width(), fb.height(), x, y);
     let ndc = glam::Vec4::new(2.0 * u - 1.0, 2.0 * v - 1.0, 2.0 * d - 1.0, 1.0);
     let p = m.projection.inverse() * ndc;
     Some(p.truncate() / p.w)

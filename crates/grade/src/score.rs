@@ -544,7 +544,7 @@ fn check_pictures(
             }
         }
         // One map per task (the first failing picture): the others are in their strips.
-        if p.expected.width <= ASCII_MAX_WIDTH && m.coverage_mismatch > 0 && !mapped {
+        if p.expected.width() <= ASCII_MAX_WIDTH && m.coverage_mismatch > 0 && !mapped {
             mapped = true;
             let _ = write!(
                 line,
@@ -552,7 +552,7 @@ fn check_pictures(
                 ascii_map(
                     &coverage(&p.expected),
                     &coverage(&p.actual),
-                    p.expected.width as usize,
+                    p.expected.width() as usize,
                     ASCII_MAX_WIDTH as usize
                 )
                 .lines()

@@ -40,7 +40,7 @@ impl Metrics {
 pub fn compare(expected: &Framebuffer, actual: &Framebuffer) -> Result<Metrics> {
     same_size(expected, actual)?;
     let mut m = Metrics {
-        pixels: expected.color.len(),
+        pixels: expected.color().len(),
         coverage_mismatch: 0,
         max_channel_diff: 0,
         mean_channel_diff: 0.0,
@@ -49,15 +49,15 @@ pub fn compare(expected: &Framebuffer, actual: &Framebuffer) -> Result<Metrics> 
     };
     let mut sum = 0u64;
     let mut sq = 0u64;
-    for i in 0..expected.color.len() {
-        let (a, b) = (expected.color[i], actual.color[i]);
+    for i in 0..expected.color().len() {
+        let (a, b) = (expected.color()[i], actual.color()[i]);
         for c in 0..3 {
             let d = a[c].abs_diff(b[c]);
             m.max_channel_diff = m.max_channel_diff.max(d);
             sum += d as u64;
             sq += (d as u64) * (d as u64);
         }
-        let (da, db) = (expected.depth[i], actual.depth[i]);
+        let (da, db) = (expected.depth()[i], actual.depth()[i]);
         let (ca, cb) = (da < 1.0, db < 1.0);
         if ca != cb {
             m.coverage_mismatch += 1;
@@ -86,7 +86,7 @@ pub fn depth_bits_identical(
 ) -> Result<(usize, usize)> {
     same_size(expected, actual)?;
     let (mut same, mut both) = (0, 0);
-    for (e, a) in expected.depth.iter().zip(&actual.depth) {
+    for (e, a) in expected.depth().iter().zip(actual.depth()) {
         if *e < 1.0 && *a < 1.0 {
             both += 1;
             same += usize::from(e.to_bits() == a.to_bits());
@@ -97,7 +97,7 @@ pub fn depth_bits_identical(
 
 /// Coverage of each pixel: depth < 1 (something was drawn).
 pub fn coverage(fb: &Framebuffer) -> Vec<bool> {
-    fb.depth.iter().map(|d| *d < 1.0).collect()
+    fb.depth().iter().map(|d| *d < 1.0).collect()
 }
 
 /// Scotty3D-style ASCII map of two coverage masks: `#` both, `!` extra (actual only),
@@ -122,10 +122,10 @@ pub fn ascii_map(expected: &[bool], actual: &[bool], width: usize, max_width: us
 /// An image of where two framebuffers differ: black where equal, the per-pixel maximum channel
 /// difference amplified ×8 in red, coverage mismatches in full yellow.
 pub fn diff_image(expected: &Framebuffer, actual: &Framebuffer) -> RgbaImage {
-    RgbaImage::from_fn(expected.width, expected.height, |x, y| {
+    RgbaImage::from_fn(expected.width(), expected.height(), |x, y| {
         let i = expected.index(x, y);
-        let (a, b) = (expected.color[i], actual.color[i]);
-        if (expected.depth[i] < 1.0) != (actual.depth[i] < 1.0) {
+        let (a, b) = (expected.color()[i], actual.color()[i]);
+        if (expected.depth()[i] < 1.0) != (actual.depth()[i] < 1.0) {
             return Rgba([255, 255, 0, 255]);
         }
         let d = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
@@ -165,7 +165,7 @@ pub fn write_diff_strip(
     name: &str,
 ) -> Result<PathBuf> {
     compare(expected, actual)?;
-    let (w, h) = (expected.width, expected.height);
+    let (w, h) = (expected.width(), expected.height());
     let k = strip_scale(w);
     let (sw, sh) = strip_size(w, h);
     let diff = diff_image(expected, actual);
@@ -352,18 +352,16 @@ impl Thresholds {
 /// A framebuffer from an image without depth: a pixel counts as covered (depth 0) when it
 /// differs from `background` in RGB, uncovered (depth 1) otherwise, so that coverage mismatch
 /// means "drawn in one image, background in the other".
-pub fn framebuffer_from_image(img: &RgbaImage, background: [u8; 4]) -> Framebuffer {
+///
+/// # Errors
+/// An image larger than a framebuffer may be.
+pub fn framebuffer_from_image(img: &RgbaImage, background: [u8; 4]) -> Result<Framebuffer> {
     let color: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
     let depth = color
         .iter()
         .map(|c| if c[..3] == background[..3] { 1.0 } else { 0.0 })
         .collect();
-    Framebuffer {
-        width: img.width(),
-        height: img.height(),
-        color,
-        depth,
-    }
+    Framebuffer::from_buffers(img.width(), img.height(), color, depth)
 }
 
 /// Loads any image the `image` crate reads (PNG, PPM, GIF) as RGBA8.
@@ -391,12 +389,12 @@ pub fn compare_images(
         stereolab_core::framebuffer::open_image(expected, "image")?,
         stereolab_core::framebuffer::open_image(actual, "image")?,
     );
-    let to_fb = |img: &image::DynamicImage| -> Framebuffer {
+    let to_fb = |img: &image::DynamicImage| -> Result<Framebuffer> {
         let img = img.to_rgba8();
         let bg = background.unwrap_or_else(|| img.get_pixel(0, 0).0);
         framebuffer_from_image(&img, bg)
     };
-    let (e, a) = (to_fb(&de), to_fb(&da));
+    let (e, a) = (to_fb(&de)?, to_fb(&da)?);
     let deep = is_16_bit(&de) || is_16_bit(&da);
     let metrics = compare(&e, &a).map_err(|err| match err {
         Error::Invalid { value, .. } => Error::invalid(
@@ -455,7 +453,7 @@ pub fn compare_stereo_photos(
                 let bg = background.unwrap_or_else(|| img.get_pixel(0, 0).0);
                 framebuffer_from_image(img, bg)
             };
-            let (ef, af) = (to_fb(ei), to_fb(ai));
+            let (ef, af) = (to_fb(ei)?, to_fb(ai)?);
             let metrics = compare(&ef, &af).map_err(|err| match err {
                 Error::Invalid { value, .. } => Error::invalid(
                     format!("{} vs {} ({eye} eye)", expected.display(), actual.display()),
@@ -528,12 +526,15 @@ fn compare_16(
 
 /// Refuses two framebuffers of different sizes, naming both.
 fn same_size(expected: &Framebuffer, actual: &Framebuffer) -> Result<()> {
-    if (expected.width, expected.height) != (actual.width, actual.height) {
+    if (expected.width(), expected.height()) != (actual.width(), actual.height()) {
         return Err(Error::invalid(
             "compare",
             format!(
                 "{}x{} vs {}x{}",
-                expected.width, expected.height, actual.width, actual.height
+                expected.width(),
+                expected.height(),
+                actual.width(),
+                actual.height()
             ),
             "images must have the same size",
         ));
@@ -616,7 +617,7 @@ mod tests {
             1 => Rgba([10, 20, 31, 255]),
             _ => Rgba([10, 20, 30, 0]), // alpha is ignored
         });
-        let fb = framebuffer_from_image(&img, bg);
+        let fb = framebuffer_from_image(&img, bg).expect("a 3x1 image");
         assert_eq!(coverage(&fb), vec![false, true, false]);
     }
 

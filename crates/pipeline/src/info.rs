@@ -279,7 +279,7 @@ pub fn depth_step_parallax(
     fb: &stereolab_core::Framebuffer,
     rig: &stereolab_core::effects::parallax::ParallaxRig,
 ) -> f64 {
-    let drawn = fb.depth.iter().copied().filter(|d| *d < 1.0);
+    let drawn = fb.depth().iter().copied().filter(|d| *d < 1.0);
     let (lo, hi) = drawn.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| {
         (lo.min(d), hi.max(d))
     });

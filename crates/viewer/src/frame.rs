@@ -116,9 +116,9 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
 /// every pixel's parallax; this looks at the border pixels only, as only they can violate
 /// (a unit test holds the two equal).
 pub fn window_violations(fb: &Framebuffer, rig: &ParallaxRig) -> [usize; 4] {
-    let (w, h) = (fb.width as usize, fb.height as usize);
+    let (w, h) = (fb.width() as usize, fb.height() as usize);
     let negative = |x: usize, y: usize| {
-        fb.depth
+        fb.depth()
             .get(y * w + x)
             .and_then(|&d| rig.parallax_pixels(d))
             .is_some_and(|p| p < 0.0)
@@ -192,18 +192,18 @@ impl Shown {
             }
         };
         let fb = self.frame.view(view)?;
-        if px >= fb.width || py >= fb.height {
+        if px >= fb.width() || py >= fb.height() {
             return None;
         }
-        let d = *fb.depth.get((py * fb.width + px) as usize)?;
+        let d = *fb.depth().get((py * fb.width() + px) as usize)?;
         (d < 1.0).then(|| {
             unproject(
                 &self.frame.matrices(view).mvp,
                 px,
                 py,
                 d,
-                fb.width,
-                fb.height,
+                fb.width(),
+                fb.height(),
             )
         })
     }
@@ -260,12 +260,8 @@ mod tests {
                 })
                 .map(|d: f32| d.min(1.0))
                 .collect();
-            let fb = Framebuffer {
-                width: w,
-                height: h,
-                color: vec![[0; 4]; (w * h) as usize],
-                depth,
-            };
+            let fb = Framebuffer::from_buffers(w, h, vec![[0; 4]; (w * h) as usize], depth)
+                .expect("depths in [0, 1]");
             let rig = StereoRig {
                 zero_parallax: ZeroParallax::Distance(z0),
                 ..StereoRig::default()

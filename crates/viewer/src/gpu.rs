@@ -105,8 +105,8 @@ impl GpuPath {
         }
         let bg = scene.background;
         let output = compare(
-            &framebuffer_from_image(&cpu.image.to_display_rgba(), bg),
-            &framebuffer_from_image(&image.to_display_rgba(), bg),
+            &framebuffer_from_image(&cpu.image.to_display_rgba(), bg)?,
+            &framebuffer_from_image(&image.to_display_rgba(), bg)?,
         )?;
         Ok(GpuShown {
             adapter: r.short_name(),

@@ -54,8 +54,8 @@ fn matrices_from(a: &[f64]) -> Option<AnaglyphMatrices> {
 
 fn anaglyph_picture(fx: &Fixture, m: &AnaglyphMatrices) -> Framebuffer {
     let mut fb = fx.canvas([0, 0, 0, 255]);
-    for (i, px) in fb.color.iter_mut().enumerate() {
-        *px = mix(m, fx.views[0].color[i], fx.views[1].color[i]);
+    for (i, px) in fb.color_mut().iter_mut().enumerate() {
+        *px = mix(m, fx.views[0].color()[i], fx.views[1].color()[i]);
     }
     fb
 }
@@ -90,8 +90,8 @@ pub(super) fn anaglyph_task(fx: &Fixture) -> TaskSpec {
             .map(|((k, expected), a)| {
                 let mut actual = blank_fb.clone();
                 if let Some(m) = a.as_deref().and_then(matrices_from) {
-                    for (i, px) in actual.color.iter_mut().enumerate() {
-                        *px = mix(&m, views[0].color[i], views[1].color[i]);
+                    for (i, px) in actual.color_mut().iter_mut().enumerate() {
+                        *px = mix(&m, views[0].color()[i], views[1].color()[i]);
                     }
                 }
                 Picture {

@@ -145,7 +145,7 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
         .flat_map(|y| (0..pw).map(move |x| (x * STEP, y * STEP)))
         .map(|(x, y)| {
             let i = fx.views[0].index(x, y);
-            (fx.views[0].color[i], fx.views[1].color[i])
+            (fx.views[0].color()[i], fx.views[1].color()[i])
         })
         .collect();
     let sets = [
@@ -154,7 +154,7 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
     ];
     let canvas = {
         let mut fb = Framebuffer::new(pw, ph, [0, 0, 0, 255]).expect("half the fixture's size");
-        fb.depth.fill(0.0);
+        fb.cover_all();
         fb
     };
     let image_inputs = sets
@@ -169,7 +169,7 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
         .iter()
         .map(|(_, m)| {
             let mut fb = canvas.clone();
-            for (px, (l, r)) in fb.color.iter_mut().zip(&pixels) {
+            for (px, (l, r)) in fb.color_mut().iter_mut().zip(&pixels) {
                 *px = anaglyph_pixel(&reference_matrices(*m), *l, *r, false);
             }
             fb
@@ -185,7 +185,7 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
             .map(|(k, (name, expected))| {
                 let mut actual = canvas.clone();
                 for (px, a) in actual
-                    .color
+                    .color_mut()
                     .iter_mut()
                     .zip(&answers[k * count..(k + 1) * count])
                 {

@@ -150,7 +150,7 @@ fn eyes(
 
 /// An empty framebuffer of `like`'s size: the picture of a missing answer.
 pub(crate) fn blank(like: &Framebuffer, background: [u8; 4]) -> Framebuffer {
-    Framebuffer::new(like.width, like.height, background).expect("same size as a valid one")
+    Framebuffer::new(like.width(), like.height(), background).expect("same size as a valid one")
 }
 
 /// Covered pixels of the left view, with their texture coordinate and stored depth.
@@ -165,7 +165,7 @@ fn view_samples(fx: &Fixture, eye: usize) -> Vec<(u32, u32, [f32; 2], f32)> {
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .filter_map(|(x, y)| {
-            let d = left.depth[left.index(x, y)];
+            let d = left.depth()[left.index(x, y)];
             (d < 1.0).then(|| (x, y, fx.uv(x, y), d))
         })
         .collect()

@@ -108,14 +108,16 @@ pub(super) fn parallax_color_task(fx: &Fixture) -> TaskSpec {
         .map(|s| s.2.abs())
         .fold(f32::MIN_POSITIVE, f32::max);
     let mut canvas = fx.canvas(fx.scene.background);
-    canvas.depth = fx.views[0].depth.clone();
+    canvas
+        .copy_depth_from(&fx.views[0])
+        .expect("the fixture's canvas and views share one size");
     let picture = {
         let samples = samples.clone();
         move |answers: &[Option<Vec<f64>>]| {
             let mut fb = canvas.clone();
             for ((x, y, _), a) in samples.iter().zip(answers) {
                 let i = fb.index(*x, *y);
-                fb.color[i] = match a.as_deref() {
+                fb.color_mut()[i] = match a.as_deref() {
                     Some([r, g, b]) => to_rgba8(Vec3::new(*r as f32, *g as f32, *b as f32)),
                     _ => [0, 0, 0, 255],
                 };

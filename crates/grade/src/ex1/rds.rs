@@ -76,15 +76,15 @@ impl RdsCase {
         seed: u64,
         tolerance: f32,
     ) -> RdsCase {
-        let (width, height) = (views[0].width, views[0].height);
+        let (width, height) = (views[0].width(), views[0].height());
         RdsCase {
             label,
             left_mvp: eyes[0].mvp,
             right_mvp: eyes[1].mvp,
             width,
             height,
-            left_depth: views[0].depth.clone(),
-            right_depth: views[1].depth.clone(),
+            left_depth: views[0].depth().to_vec(),
+            right_depth: views[1].depth().to_vec(),
             left_dots: dots(seed, width, height),
             fresh_dots: dots(right_only_seed(seed), width, height),
             tolerance,
@@ -288,7 +288,7 @@ fn hidden_case(fx: &Fixture, rng: &mut SplitMix64) -> RdsCase {
 /// A dots answer (1 white) as a picture; `EITHER` and anything else not 0 shows as white.
 fn dots_picture(like: &Framebuffer, dots: &[f64]) -> Framebuffer {
     let mut fb = like.clone();
-    for (c, d) in fb.color.iter_mut().zip(dots) {
+    for (c, d) in fb.color_mut().iter_mut().zip(dots) {
         let v = if *d > 0.0 { 255 } else { 0 };
         *c = [v, v, v, 255];
     }
@@ -298,7 +298,7 @@ fn dots_picture(like: &Framebuffer, dots: &[f64]) -> Framebuffer {
 /// The red-cyan anaglyph of the pair: left dots in red, right dots in green and blue.
 fn anaglyph_picture(like: &Framebuffer, left: &[bool], right: &[f64]) -> Framebuffer {
     let mut fb = like.clone();
-    for ((c, l), r) in fb.color.iter_mut().zip(left).zip(right) {
+    for ((c, l), r) in fb.color_mut().iter_mut().zip(left).zip(right) {
         let (l, r) = (if *l { 255 } else { 0 }, if *r > 0.0 { 255 } else { 0 });
         *c = [l, r, r, 255];
     }

@@ -191,7 +191,9 @@ fn remap_direction_task(fx: &Fixture, from: usize) -> TaskSpec {
         let samples = samples.clone();
         let other = fx.views[to].clone();
         let mut canvas = fx.canvas(fx.scene.background);
-        canvas.depth = fx.views[from].depth.clone();
+        canvas
+            .copy_depth_from(&fx.views[from])
+            .expect("the fixture's canvas and views share one size");
         let (w, h) = fx.size();
         move |answers: &[Option<Vec<f64>>]| {
             let mut fb = canvas.clone();
@@ -201,8 +203,8 @@ fn remap_direction_task(fx: &Fixture, from: usize) -> TaskSpec {
                     .filter(|a| a.len() == 3)
                     .and_then(|a| texel_of(a[0], a[1], w, h));
                 let i = fb.index(*x, *y);
-                fb.color[i] = match texel {
-                    Some((tx, ty)) => other.color[other.index(tx, ty)],
+                fb.color_mut()[i] = match texel {
+                    Some((tx, ty)) => other.color()[other.index(tx, ty)],
                     None => [0, 0, 0, 255],
                 };
             }

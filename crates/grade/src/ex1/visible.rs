@@ -28,7 +28,7 @@ fn fixture_visible_inputs(fx: &Fixture) -> Vec<(u32, u32, VisibleInput)> {
             let input = match a.as_slice() {
                 [u, v, z] => {
                     let stored = texel_of(*u, *v, w, h)
-                        .map_or(1.0, |(tx, ty)| right.depth[right.index(tx, ty)]);
+                        .map_or(1.0, |(tx, ty)| right.depth()[right.index(tx, ty)]);
                     (
                         Some([*u as f32, *v as f32]),
                         *z as f32,
@@ -147,7 +147,7 @@ pub(super) fn visible_task(fx: &Fixture) -> TaskSpec {
             for ((x, y), a) in pixels.iter().zip(answers) {
                 let i = fb.index(*x, *y);
                 if *a != Some(true) {
-                    fb.color[i] = HIDDEN_COLOR;
+                    fb.color_mut()[i] = HIDDEN_COLOR;
                 }
             }
             fb

@@ -99,7 +99,7 @@ pub fn shear_vs_rotate(frame: &Frame) -> Result<(RgbaImage, ShearVsRotate)> {
         pass(frame, View::RotateLeft)?,
         pass(frame, View::RotateRight)?,
     ];
-    let (w, h) = (shear[0].width, shear[0].height);
+    let (w, h) = (shear[0].width(), shear[0].height());
     let rotate_map = vertical_parallax_map(
         rotate[0],
         &mvp(frame, View::RotateLeft)?,

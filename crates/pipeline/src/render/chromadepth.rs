@@ -202,7 +202,7 @@ pub fn texgen_map(
     // 0xFFFFFFFF is a NaN bit pattern: uncovered pixels read back as NaN.
     let mut fb = Framebuffer::new(scene.width, scene.height, [0xFF; 4])?;
     draw_objects(scene, m, texgen, &ramp, settings, &mut fb, RecordS);
-    Ok(fb.color.iter().map(|c| f32::from_le_bytes(*c)).collect())
+    Ok(fb.color().iter().map(|c| f32::from_le_bytes(*c)).collect())
 }
 
 /// Rasterizes every object with the ChromaDepth program, wrapped by `wrap`.

@@ -161,7 +161,7 @@ fn render(
     height: u32,
 ) -> Result<Vec<[u8; 4]>> {
     let mut fb = Framebuffer::new(width, height, [0, 0, 0, 255])?;
-    fb.color.copy_from_slice(start);
+    fb.color_mut().copy_from_slice(start);
     rasterize(
         &geometry.triangles,
         geometry.clip.len(),
@@ -169,7 +169,7 @@ fn render(
         &mut fb,
         &RasterOptions::default(),
     );
-    Ok(fb.color)
+    Ok(fb.into_buffers().0)
 }
 
 /// Copies the columns of `strip` from `from` to `to`, every row (`width` pixels a row).
