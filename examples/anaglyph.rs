@@ -6,24 +6,29 @@ use glam::{Mat4, Vec3};
 use stereolab::scene::Mesh;
 use stereolab_core::Framebuffer;
 use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
-use stereolab_core::math::{Camera, StereoRig};
+use stereolab_core::math::{Camera, StereoRig, ZeroParallax};
 use stereolab_core::raster::{RasterOptions, rasterize_blinn_phong};
 use stereolab_core::shade::{BlinnPhong, Light};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or("anaglyph.png".into());
     let (width, height) = (640, 480);
+    let (eye, target, up) = ([0.0, 0.6, 4.0], [0.0; 3], [0.0, 1.0, 0.0]);
     let camera = Camera {
-        eye: [0.0, 0.6, 4.0],
-        target: [0.0, 0.0, 0.0],
-        up: [0.0, 1.0, 0.0],
+        eye,
+        target,
+        up,
         fov_y: 50.0,
         near: 0.5,
         far: 20.0,
     };
-    // The default rig: off-axis, the StereoGraphics guide's automatic separation, zero
-    // parallax halfway between near and far.
-    let eyes = StereoRig::default().eyes(&camera, width as f32 / height as f32)?;
+    // Off-axis, the StereoGraphics guide's automatic separation, the screen (zero parallax)
+    // through the torus's centre: its near half comes out of the screen, the far half behind.
+    let rig = StereoRig {
+        zero_parallax: ZeroParallax::Distance(4.0),
+        ..StereoRig::default()
+    };
+    let eyes = rig.eyes(&camera, width as f32 / height as f32)?;
     let torus = Mesh::torus(1.0, 0.35, 64, 32);
     let model = Mat4::from_rotation_x(0.9);
     let mut views = Vec::new();
@@ -38,23 +43,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             Vec3::new(0.9, 0.7, 0.3),
             Light::default(),
         );
-        let opts = RasterOptions::default();
-        rasterize_blinn_phong(
-            &torus.triangles,
-            torus.positions.len(),
-            &shader,
-            &mut fb,
-            &opts,
-        );
+        let (opts, count) = (RasterOptions::default(), torus.positions.len());
+        rasterize_blinn_phong(&torus.triangles, count, &shader, &mut fb, &opts);
         views.push(fb);
     }
-    let image = anaglyph(
-        &views[0],
-        &views[1],
-        AnaglyphKind::DuboisRedCyan,
-        AnaglyphOptions::default(),
-    )?;
-    image.save(&out)?;
+    let kind = AnaglyphKind::DuboisRedCyan;
+    anaglyph(&views[0], &views[1], kind, AnaglyphOptions::default())?.save(&out)?;
     println!("wrote {out}");
     Ok(())
 }

@@ -39,31 +39,21 @@ impl Shader for ChromaDepth<'_> {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or("chromadepth.png".into());
     let (width, height, near, far) = (640, 480, 0.5, 30.0);
+    // A ring in the XZ plane seen from above and in front: its near side is nearer the eye.
     let mesh = Mesh::torus(1.5, 0.5, 96, 48);
-    let model = Mat4::from_rotation_x(1.2);
-    let view = look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y);
-    let world: Vec<Vec3> = mesh
-        .positions
-        .iter()
-        .map(|p| model.transform_point3(*p))
-        .collect();
+    let view = look_at(Vec3::new(0.0, 4.0, 3.0), Vec3::ZERO, Vec3::Y);
     // D1 and D2 from the bounding sphere: the ramp spans exactly the object.
-    let (d1, d2) = auto_range(&world, view, near, far)?;
+    let (d1, d2) = auto_range(&mesh.positions, view, near, far)?;
     let shader = ChromaDepth {
         positions: &mesh.positions,
-        modelview: view * model,
+        modelview: view,
         projection: perspective(50.0, width as f32 / height as f32, near, far),
         texgen: Texgen::from_range(d1, d2)?,
         ramp: Ramp::new(RampKind::Hsv, 256)?,
     };
     let mut fb = Framebuffer::new(width, height, [0, 0, 0, 255])?;
-    rasterize(
-        &mesh.triangles,
-        mesh.positions.len(),
-        &shader,
-        &mut fb,
-        &RasterOptions::default(),
-    );
+    let (opts, count) = (RasterOptions::default(), mesh.positions.len());
+    rasterize(&mesh.triangles, count, &shader, &mut fb, &opts);
     fb.to_rgba_image().save(&out)?;
     println!("wrote {out}: D1 = {d1:.2}, D2 = {d2:.2}");
     Ok(())

@@ -86,3 +86,17 @@ fn the_link_reader_skips_urls_and_anchors() {
     let text = "[a](docs/x.md#part) [b](https://example.org) ![c](assets/p.png)";
     assert_eq!(relative_links(text), ["docs/x.md", "assets/p.png"]);
 }
+
+/// `examples/` holds short complete programs (CI builds and runs them): each fits a screen.
+#[test]
+fn the_examples_are_short_programs() {
+    let mut count = 0;
+    for entry in std::fs::read_dir(root().join("examples")).unwrap().flatten() {
+        let text = std::fs::read_to_string(entry.path()).unwrap();
+        let lines = text.lines().count();
+        assert!(lines <= 60, "{}: {lines} lines, more than 60", entry.path().display());
+        assert!(text.contains("fn main()"), "{}: no main", entry.path().display());
+        count += 1;
+    }
+    assert!(count >= 4, "only {count} examples");
+}
