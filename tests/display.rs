@@ -369,9 +369,12 @@ fn chromadepth_report_names_the_d1_d2_it_used() {
         .iter()
         .find(|l| l.starts_with("chromadepth: D1 = "))
         .unwrap_or_else(|| panic!("{lines:?}"));
-    let t =
-        stereolab::render::chromadepth::resolve_texgen(&scene, &frame.center, &scene.chromadepth)
-            .unwrap();
+    let t = stereolab::render::chromadepth::resolve_texgen(
+        &scene,
+        &frame.views.center,
+        &scene.chromadepth,
+    )
+    .unwrap();
     assert!(
         line.contains(&format!("D1 = {:.4} (bounding sphere)", t.d1)),
         "{line}"

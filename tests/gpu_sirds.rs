@@ -44,7 +44,7 @@ fn gpu_strips_match_cpu_strips_and_decode() {
         let f = frame(&s);
         let (depth, range) = scene_depth(&f, &s).expect("depth");
         let d = s.sirds.geometry.to_pixels().expect("valid");
-        let g = StripGeometry::new(&s, &f.center, &range, &d, false);
+        let g = StripGeometry::new(&s, &f.views.center, &range, &d, false);
         let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
         for start in [Start::Left, Start::Center] {
             for filter in [Filter::Nearest, Filter::Bilinear] {
@@ -126,7 +126,7 @@ fn gpu_strips_reject_too_few_iterations_like_the_cpu() {
     let f = frame(&s);
     let (_, range) = scene_depth(&f, &s).expect("depth");
     let d = s.sirds.geometry.to_pixels().expect("valid");
-    let g = StripGeometry::new(&s, &f.center, &range, &d, false);
+    let g = StripGeometry::new(&s, &f.views.center, &range, &d, false);
     let opts = PerVertexOptions {
         iterations: Some(2),
         ..PerVertexOptions::default()

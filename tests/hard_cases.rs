@@ -609,7 +609,7 @@ fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
             }
         }
         points.push(target);
-        for (side, eye) in [(-1.0, &eyes[0]), (1.0, &eyes[1])] {
+        for (side, eye) in stereolab_core::Eye::BOTH.into_iter().zip(&eyes) {
             let m64 = stereolab_core::reference::eye(
                 &scene.rig,
                 &scene.camera,
@@ -635,7 +635,7 @@ fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
                 let err = (a.0 - b.0).hypot(a.1 - b.1);
                 assert!(
                     err <= 0.01,
-                    "separation {sep:e}, side {side}: {p:?} lands {err:e} px from the f64 rig"
+                    "separation {sep:e}, {side:?} eye: {p:?} lands {err:e} px from the f64 rig"
                 );
                 worst = worst.max(err);
                 checked += 1;
@@ -671,7 +671,7 @@ fn catalogue_remap_at_near_far_1e_minus_6_stays_within_half_a_pixel() {
     );
     let frame = stereolab::render::render(&scene, &Plan::new(&[Out::RemapLeft])).expect("render");
     let left = frame.view(View::Left).expect("left pass");
-    let (ml, mr) = (frame.eyes[0].mvp, frame.eyes[1].mvp);
+    let (ml, mr) = (frame.views.eyes[0].mvp, frame.views.eyes[1].mvp);
     let exact = remap_coordinates(left, &ml, &mr, Precision::F64).expect("f64");
     let worst_of = |p: Precision| {
         let got = remap_coordinates(left, &ml, &mr, p).expect("remap");

@@ -91,11 +91,22 @@ fn the_link_reader_skips_urls_and_anchors() {
 #[test]
 fn the_examples_are_short_programs() {
     let mut count = 0;
-    for entry in std::fs::read_dir(root().join("examples")).unwrap().flatten() {
+    for entry in std::fs::read_dir(root().join("examples"))
+        .unwrap()
+        .flatten()
+    {
         let text = std::fs::read_to_string(entry.path()).unwrap();
         let lines = text.lines().count();
-        assert!(lines <= 60, "{}: {lines} lines, more than 60", entry.path().display());
-        assert!(text.contains("fn main()"), "{}: no main", entry.path().display());
+        assert!(
+            lines <= 60,
+            "{}: {lines} lines, more than 60",
+            entry.path().display()
+        );
+        assert!(
+            text.contains("fn main()"),
+            "{}: no main",
+            entry.path().display()
+        );
         count += 1;
     }
     assert!(count >= 4, "only {count} examples");

@@ -230,7 +230,7 @@ fn per_vertex_nearest_copies_are_exact() {
     let f = frame(&s);
     let (_, range) = scene_depth(&f, &s).expect("depth");
     let d = Geometry::default().to_pixels().expect("valid");
-    let g = StripGeometry::new(&s, &f.center, &range, &d, false);
+    let g = StripGeometry::new(&s, &f.views.center, &range, &d, false);
     for start in [Start::Left, Start::Center] {
         let opts = PerVertexOptions {
             start,

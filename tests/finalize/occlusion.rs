@@ -123,7 +123,7 @@ fn check_scene(rig: &Rig, occ: Option<Occluder>, precision: Precision) -> Vec<us
     let (w, h) = (left.width(), left.height());
     let mut strip_rows = Vec::new();
     for (k, (this, other)) in [(left, right), (right, left)].into_iter().enumerate() {
-        let (e_this, e_other) = (&frame.eyes[k], &frame.eyes[1 - k]);
+        let (e_this, e_other) = (&frame.views.eyes[k], &frame.views.eyes[1 - k]);
         let map =
             visibility_map(this, other, &e_this.mvp, &e_other.mvp, precision).expect("visibility");
         for py in 0..h {
@@ -241,8 +241,8 @@ fn flat_planes_are_never_flagged_for_near_far_10_to_1e5() {
             let map = visibility_map(
                 left,
                 right,
-                &frame.eyes[0].mvp,
-                &frame.eyes[1].mvp,
+                &frame.views.eyes[0].mvp,
+                &frame.views.eyes[1].mvp,
                 precision,
             )
             .expect("visibility");
@@ -270,7 +270,7 @@ fn occlusion_image_shows_both_eyes_maps_side_by_side() {
     let img = occlusion_image(
         left,
         right,
-        [&frame.eyes[0].mvp, &frame.eyes[1].mvp],
+        [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp],
         Precision::F64,
     )
     .expect("occlusion");
@@ -280,8 +280,8 @@ fn occlusion_image_shows_both_eyes_maps_side_by_side() {
         let map = visibility_map(
             this,
             other,
-            &frame.eyes[k as usize].mvp,
-            &frame.eyes[1 - k as usize].mvp,
+            &frame.views.eyes[k as usize].mvp,
+            &frame.views.eyes[1 - k as usize].mvp,
             Precision::F64,
         )
         .expect("visibility");
@@ -339,7 +339,7 @@ fn tolerance_is_neither_too_tight_nor_too_loose() {
     );
     let frame = render_outputs(&s, &[Output::Occlusion]);
     let (left, right) = eyes(&frame);
-    let mvp = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
+    let mvp = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     let tight = map_with_tolerance(left, right, mvp, &|_, _, _| DEPTH_PRECISION);
     let ours = map_with_tolerance(left, right, mvp, &|fb, x, y| {
         tolerance(depth_slope(fb, x, y))
@@ -361,7 +361,7 @@ fn tolerance_is_neither_too_tight_nor_too_loose() {
     let s = scene(&rig, &meshes, &["occlusion"]);
     let frame = render_outputs(&s, &[Output::Occlusion]);
     let (left, right) = eyes(&frame);
-    let mvp = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
+    let mvp = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     let loose = map_with_tolerance(left, right, mvp, &|_, _, _| 1e-5);
     let ours = map_with_tolerance(left, right, mvp, &|fb, x, y| {
         tolerance(depth_slope(fb, x, y))

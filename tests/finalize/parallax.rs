@@ -101,7 +101,7 @@ fn toe_in_reports_vertical_parallax() {
                     (y as f64 + px * sn + py * cs) as f32,
                     -z,
                 );
-                let n = project_ndc(&frame.eyes[k].mvp, world).expect("in front");
+                let n = project_ndc(&frame.views.eyes[k].mvp, world).expect("in front");
                 [
                     (n.x as f64 + 1.0) * 0.5 * rig.width as f64,
                     (1.0 - n.y as f64) * 0.5 * rig.height as f64,

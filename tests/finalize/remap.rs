@@ -11,8 +11,13 @@ fn max_deviation(z: f32, precision: Precision, shift_x: f64) -> (f64, f64) {
     let s = scene(&rig, &plane(40.0, [0.0, 0.0, -z], [0.0; 3]), &["occlusion"]);
     let frame = render_outputs(&s, &[Output::Occlusion]);
     let (left, _) = eyes(&frame);
-    let coords =
-        remap_coordinates(left, &frame.eyes[0].mvp, &frame.eyes[1].mvp, precision).expect("remap");
+    let coords = remap_coordinates(
+        left,
+        &frame.views.eyes[0].mvp,
+        &frame.views.eyes[1].mvp,
+        precision,
+    )
+    .expect("remap");
     let (mut dx, mut dy) = (0.0f64, 0.0f64);
     let mut n = 0;
     for y in 0..left.height() {
@@ -69,8 +74,8 @@ fn remapped_view_takes_the_other_eyes_colors() {
     let img = remap_color(
         left,
         right,
-        &frame.eyes[0].mvp,
-        &frame.eyes[1].mvp,
+        &frame.views.eyes[0].mvp,
+        &frame.views.eyes[1].mvp,
         Precision::F64,
     )
     .expect("remap");

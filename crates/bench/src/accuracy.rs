@@ -15,6 +15,7 @@ use super::{Row, median_ms};
 use stereolab::plan::{Output, Plan, Shading, View};
 use stereolab::render::{render, render_view};
 use stereolab::scene::{Mesh, Scene};
+use stereolab_core::Eye;
 use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
 use stereolab_core::effects::sirds::decode::{DecodeOptions, decode, round_trip};
 use stereolab_core::effects::sirds::{
@@ -260,11 +261,11 @@ fn subpixel_bits(scene: &Scene, scale: Scale) -> Result<Vec<Knob>> {
 
 /// The off-axis eye's MVP in f64 from the same scene fields the f32 rig reads (the
 /// StereoGraphics guide's `FrustumAsymmetry = −offset · balance · n / z0`, the exercise
-/// slides' frustum), for `side` −1 (left) or +1 (right).
+/// slides' frustum), for one `eye`.
 ///
 /// # Errors
 /// A rig that is not off-axis (the reference covers the mode the renderer defaults to).
-pub fn off_axis_mvp_f64(scene: &Scene, side: f64) -> Result<DMat4> {
+pub fn off_axis_mvp_f64(scene: &Scene, eye: Eye) -> Result<DMat4> {
     if scene.rig.mode != CameraMode::OffAxis {
         return Err(Error::invalid(
             "stereo.mode",
@@ -287,7 +288,7 @@ pub fn off_axis_mvp_f64(scene: &Scene, side: f64) -> Result<DMat4> {
         aspect,
         base * f64::from(scene.rig.user_offset),
         z0,
-        side,
+        eye,
     ))
 }
 
@@ -299,8 +300,8 @@ fn window_positions(scene: &Scene, way: u8) -> Result<Vec<Option<(f64, f64)>>> {
     let win =
         |c: DVec4| (c.w > 0.0).then(|| ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h));
     let mut out = Vec::new();
-    for (e, side) in eyes.iter().zip([-1.0, 1.0]) {
-        let mvp64 = off_axis_mvp_f64(scene, side)?;
+    for (e, eye) in eyes.iter().zip(Eye::BOTH) {
+        let mvp64 = off_axis_mvp_f64(scene, eye)?;
         for o in &scene.objects {
             let m32 = e.mvp * o.model;
             let m64 = mvp64 * o.model.as_dmat4();

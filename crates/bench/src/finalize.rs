@@ -117,7 +117,7 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let (Some(left), Some(right)) = (frame.view(View::Left), frame.view(View::Right)) else {
         return Ok(Vec::new());
     };
-    let mvp = [frame.eyes[0].mvp, frame.eyes[1].mvp];
+    let mvp = [frame.views.eyes[0].mvp, frame.views.eyes[1].mvp];
     let px = left.color().len();
     let mut rows = anaglyph_rows(left, right, iters)?;
     // Each mode on the AVX2 rows (where the CPU has AVX2) and on the scalar loops, what a CPU

@@ -40,7 +40,7 @@ fn finalize_rows(r: &GpuRenderer, frame: &Frame, scene: &Scene, iters: usize) ->
         return Ok(Vec::new());
     };
     let fin = GpuFinalize::new(r)?;
-    let mvps = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
+    let mvps = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     let rig = scene.parallax_rig()?;
     let kind = AnaglyphKind::DuboisRedCyan;
     let opts = AnaglyphOptions::default();

@@ -241,7 +241,7 @@ pub fn remap_one_pixel(ctx: &Context) -> Result<Canvas> {
         })
         .ok_or_else(|| Error::internal("figures", "the left eye sees nothing"))?;
     let depth = left.depth()[left.index(x, y)];
-    let (ml, mr) = (frame.eyes[0].mvp, frame.eyes[1].mvp);
+    let (ml, mr) = (frame.views.eyes[0].mvp, frame.views.eyes[1].mvp);
     let r = Remapper::new(&ml, &mr, w, h, Precision::F64)?;
     let remapped = r
         .remap(x, y, depth)

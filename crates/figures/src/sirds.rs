@@ -209,7 +209,7 @@ pub fn passes(ctx: &Context) -> Result<Canvas> {
     })?;
     let (depth, range) = scene_depth(&frame, &s)?;
     let d = s.sirds.geometry.to_pixels()?;
-    let g = StripGeometry::new(&s, &frame.center, &range, &d, s.sirds.cross_eyed);
+    let g = StripGeometry::new(&s, &frame.views.center, &range, &d, s.sirds.cross_eyed);
     let r = per_vertex(
         &g,
         s.width,

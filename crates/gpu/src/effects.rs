@@ -237,7 +237,7 @@ pub fn produce_wgsl(
             )
         })
     };
-    let mvps = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
+    let mvps = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     Ok(Some(match output {
         Output::Anaglyph(kind) => {
             fin.anaglyph(r, eye(View::Left)?, eye(View::Right)?, kind, scene.finalize)?

@@ -81,7 +81,7 @@ pub fn compare_finalize(
         return Ok(Vec::new());
     };
     let fin = GpuFinalize::new(r)?;
-    let mvps = [&frame.eyes[0].mvp, &frame.eyes[1].mvp];
+    let mvps = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     let mut rows = Vec::new();
     for &o in &frame.plan.outputs {
         let (cpu, gpu) = match o {

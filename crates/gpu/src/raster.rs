@@ -7,14 +7,14 @@ use glam::Mat3;
 
 use stereolab::plan::{Pass, Plan, Shading};
 use stereolab::render::chromadepth::resolve_texgen;
-use stereolab::render::{Frame, PassResult, planned_shear_rotate_eyes};
+use stereolab::render::{Frame, PassResult, ViewMatrices};
 use stereolab::scene::{Object, Scene};
 use stereolab_core::effects::chromadepth::TexgenMode;
 use stereolab_core::effects::chromadepth::ramp::{Ramp, Sampling};
 use stereolab_core::effects::chromadepth::texgen::Texgen;
 use stereolab_core::error::Result;
 use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::{EyeMatrices, StereoRig};
+use stereolab_core::math::EyeMatrices;
 use stereolab_core::raster::{RasterOptions, RasterStats};
 use stereolab_core::shade::BlinnPhong;
 
@@ -128,12 +128,8 @@ impl<'a> GpuScene<'a> {
 /// The matrices and shading of every pass of a plan, with the matrices they were looked up
 /// in (as [`stereolab::render::render`] looks them up).
 pub(crate) struct PlannedViews {
-    /// The rig's eyes.
-    pub eyes: [EyeMatrices; 2],
-    /// The cyclopean eye.
-    pub center: EyeMatrices,
-    /// The shear and rotate rigs' eyes, when the plan has such passes.
-    pub shear_rotate: Option<[[EyeMatrices; 2]; 2]>,
+    /// Every view's matrices.
+    pub views: ViewMatrices,
     /// Per pass of the plan, in order.
     pub passes: Vec<(EyeMatrices, Shading)>,
 }
@@ -143,25 +139,13 @@ pub(crate) struct PlannedViews {
 /// # Errors
 /// Invalid camera or rig.
 pub(crate) fn plan_views(s: &Scene, plan: &Plan) -> Result<PlannedViews> {
-    let eyes = s.rig.eyes_for_image(&s.camera, s.width, s.height)?;
-    let center = StereoRig::center(&s.camera, s.aspect())?;
-    let shear_rotate = planned_shear_rotate_eyes(s, plan)?;
+    let views = ViewMatrices::new(s, plan)?;
     let passes = plan
         .passes
         .iter()
-        .map(|p| {
-            Ok((
-                Frame::lookup(&eyes, &center, &shear_rotate, p.view)?,
-                p.shading,
-            ))
-        })
+        .map(|p| Ok((views.of_pass(p.view)?, p.shading)))
         .collect::<Result<_>>()?;
-    Ok(PlannedViews {
-        eyes,
-        center,
-        shear_rotate,
-        passes,
-    })
+    Ok(PlannedViews { views, passes })
 }
 
 impl GpuRenderer {
@@ -175,12 +159,7 @@ impl GpuRenderer {
     pub fn render(&self, scene: &GpuScene, plan: &Plan) -> Result<Frame> {
         let s = scene.scene;
         let start = Instant::now();
-        let PlannedViews {
-            eyes,
-            center,
-            shear_rotate,
-            passes,
-        } = plan_views(s, plan)?;
+        let PlannedViews { views, passes } = plan_views(s, plan)?;
         let framebuffers = self.render_views(scene, &passes)?;
         let time = start.elapsed();
         let triangles: usize = s.objects.iter().map(|o| o.mesh.triangles.len()).sum();
@@ -201,9 +180,7 @@ impl GpuRenderer {
         Ok(Frame {
             plan: plan.clone(),
             passes,
-            eyes,
-            center,
-            shear_rotate,
+            views,
         })
     }
 

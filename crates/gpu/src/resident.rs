@@ -132,7 +132,7 @@ impl GpuRenderer {
                 .ok_or_else(|| Error::internal("plan", format!("the {v:?} pass was not run")))?;
             Ok([&eyes[i].color_view, &eyes[i].depth_view])
         };
-        let mvps = [&planned.eyes[0].mvp, &planned.eyes[1].mvp];
+        let mvps = [&planned.views.eyes[0].mvp, &planned.views.eyes[1].mvp];
         let mut images = Vec::with_capacity(outputs.len());
         for o in outputs {
             let target = Target::take(self, s.width, s.height, DepthKind::ColorR32)?;

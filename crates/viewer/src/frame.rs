@@ -83,14 +83,15 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
     // other outputs, so the sliders start where the ramp would be; `None` where no range fits.
     let chromadepth = match frame.plan.pass(View::Center) {
         Some(p) if p.shading == Shading::ChromaDepth => {
-            let t = resolve_texgen(scene, &frame.center, &scene.chromadepth)?;
+            let t = resolve_texgen(scene, &frame.views.center, &scene.chromadepth)?;
             Some([t.d1, t.d2])
         }
-        _ => resolve_texgen(scene, &frame.center, &scene.chromadepth)
+        _ => resolve_texgen(scene, &frame.views.center, &scene.chromadepth)
             .ok()
             .map(|t| [t.d1, t.d2]),
     };
-    let picked_parallax = picked.and_then(|p| point_parallax_pixels(&frame.eyes, p, scene.width));
+    let picked_parallax =
+        picked.and_then(|p| point_parallax_pixels(&frame.views.eyes, p, scene.width));
     let readouts = readouts_start.elapsed();
     Ok(Shown {
         params: params.clone(),

@@ -18,6 +18,7 @@
 
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3, Vec4};
 
+use crate::eye::Eye;
 use crate::framebuffer::Framebuffer;
 use crate::math::{Camera, CameraMode, StereoRig, ZeroParallax};
 use crate::shade::{Fragment, Shader, Varyings};
@@ -57,17 +58,18 @@ pub fn look_at(eye: DVec3, target: DVec3, up: DVec3) -> DMat4 {
     )
 }
 
-/// One eye's world → clip matrix in f64: `side` −1 left, +1 right, 0 the cyclopean camera.
-/// `separation` is the resolved eye separation and `z0` the zero-parallax distance (the rig's
-/// `resolve`, which only reads the scene's numbers); the rest is the rig's `eye` in f64.
+/// One eye's world → clip matrix in f64. `separation` is the resolved eye separation and `z0`
+/// the zero-parallax distance (the rig's `resolve`, which only reads the scene's numbers); the
+/// rest is the rig's `eye` in f64.
 pub fn eye(
     rig: &StereoRig,
     camera: &Camera,
     aspect: f64,
     separation: f64,
     z0: f64,
-    side: f64,
+    eye: Eye,
 ) -> DMat4 {
+    let side = f64::from(eye.sign());
     let v = |a: [f32; 3]| DVec3::from(a.map(f64::from));
     let mv = look_at(v(camera.eye), v(camera.target), v(camera.up));
     let (n, f) = (f64::from(camera.near), f64::from(camera.far));

@@ -151,21 +151,21 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
         Output::RemapLeft => Image::Rgba(remap_color(
             eye(View::Left)?,
             eye(View::Right)?,
-            &frame.eyes[0].mvp,
-            &frame.eyes[1].mvp,
+            &frame.views.eyes[0].mvp,
+            &frame.views.eyes[1].mvp,
             Precision::default(),
         )?),
         Output::RemapRight => Image::Rgba(remap_color(
             eye(View::Right)?,
             eye(View::Left)?,
-            &frame.eyes[1].mvp,
-            &frame.eyes[0].mvp,
+            &frame.views.eyes[1].mvp,
+            &frame.views.eyes[0].mvp,
             Precision::default(),
         )?),
         Output::Occlusion => Image::Rgba(occlusion::occlusion_image(
             eye(View::Left)?,
             eye(View::Right)?,
-            [&frame.eyes[0].mvp, &frame.eyes[1].mvp],
+            [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp],
             Precision::default(),
         )?),
         Output::Parallax => Image::Rgba(parallax_image(eye(View::Left)?, &scene.parallax_rig()?)?),
@@ -225,8 +225,8 @@ fn rds_right(frame: &Frame, scene: &Scene, output: Output) -> Result<image::Rgba
     rds::rds_right(
         need(frame, View::Left, output)?,
         need(frame, View::Right, output)?,
-        &frame.eyes[0].mvp,
-        &frame.eyes[1].mvp,
+        &frame.views.eyes[0].mvp,
+        &frame.views.eyes[1].mvp,
         &scene.rds,
     )
 }

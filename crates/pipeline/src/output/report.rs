@@ -30,7 +30,7 @@ pub fn effect_lines(frame: &Frame, scene: &Scene) -> Result<Vec<String>> {
     ];
     if frame.plan.outputs.iter().any(|o| chroma.contains(o)) {
         let s = &scene.chromadepth;
-        let t = resolve_texgen(scene, &frame.center, s)?;
+        let t = resolve_texgen(scene, &frame.views.center, s)?;
         let from = |given: Option<f32>| {
             if given.is_some() {
                 "scene"

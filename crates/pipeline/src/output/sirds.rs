@@ -121,7 +121,7 @@ pub fn from_frame_with(
             )
         }
         Algorithm::PerVertex => {
-            let g = StripGeometry::new(scene, &frame.center, &range, &d, s.cross_eyed);
+            let g = StripGeometry::new(scene, &frame.views.center, &range, &d, s.cross_eyed);
             let r = strips(&g, &d)?;
             (r.pixels, Some(r.iterations))
         }

@@ -13,6 +13,7 @@ use rayon::prelude::*;
 
 use crate::plan::{Pass, Plan, Shading, View};
 use crate::scene::Scene;
+use stereolab_core::Eye;
 use stereolab_core::error::Result;
 use stereolab_core::framebuffer::Framebuffer;
 use stereolab_core::math::{CameraMode, EyeMatrices, StereoRig};
@@ -39,14 +40,81 @@ pub struct Frame {
     pub plan: Plan,
     /// One entry per pass, in plan order.
     pub passes: Vec<PassResult>,
-    /// Left and right eye matrices (index 0 left).
+    /// The matrices of every view the plan renders.
+    pub views: ViewMatrices,
+}
+
+/// The matrices of every view a frame renders, made once per frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewMatrices {
+    /// The scene's rig: left and right eye, indexed by [`Eye::index`].
     pub eyes: [EyeMatrices; 2],
-    /// The cyclopean eye.
+    /// The cyclopean eye: the camera itself.
     pub center: EyeMatrices,
-    /// The scene's rig as off-axis (`[0]`, shear) and as toe-in (`[1]`, rotate), each left and
-    /// right: the matrices of the [`View::ShearLeft`] … [`View::RotateRight`] passes, present
-    /// when the plan runs them ([`shear_rotate_eyes`]).
-    pub shear_rotate: Option<[[EyeMatrices; 2]; 2]>,
+    /// The [`View::ShearLeft`] … [`View::RotateRight`] passes' eyes, present when the plan runs
+    /// them ([`shear_rotate_eyes`]).
+    pub shear_rotate: Option<ShearRotate>,
+}
+
+/// The scene's rig as off-axis (the SGI course notes' shear) and as toe-in (rotate), each eye
+/// pair indexed by [`Eye::index`]; everything else (separation, zero parallax, balance,
+/// lighting, viewer) as the scene sets it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShearRotate {
+    /// The off-axis eyes.
+    pub shear: [EyeMatrices; 2],
+    /// The toe-in eyes.
+    pub rotate: [EyeMatrices; 2],
+}
+
+impl ViewMatrices {
+    /// The matrices of `plan`'s views of `scene`: the rig's eyes, the center, and the
+    /// shear/rotate comparison's eyes only when the plan runs it (so a rig that only toe-in
+    /// cannot represent never fails a plan that does not ask for it).
+    ///
+    /// # Errors
+    /// As [`StereoRig::eyes_for_image`] and [`StereoRig::center`].
+    pub fn new(scene: &Scene, plan: &Plan) -> Result<ViewMatrices> {
+        let needed = plan.passes.iter().any(|p| {
+            matches!(
+                p.view,
+                View::ShearLeft | View::ShearRight | View::RotateLeft | View::RotateRight
+            )
+        });
+        Ok(ViewMatrices {
+            eyes: scene
+                .rig
+                .eyes_for_image(&scene.camera, scene.width, scene.height)?,
+            center: StereoRig::center(&scene.camera, scene.aspect())?,
+            shear_rotate: needed.then(|| shear_rotate_eyes(scene)).transpose()?,
+        })
+    }
+
+    /// The matrices of `view`; `None` for a shear/rotate view the plan does not run. The one
+    /// place a view is mapped to its matrices.
+    pub fn get(&self, view: View) -> Option<&EyeMatrices> {
+        let (l, r) = (Eye::Left.index(), Eye::Right.index());
+        let compare = self.shear_rotate.as_ref();
+        match view {
+            View::Left => Some(&self.eyes[l]),
+            View::Right => Some(&self.eyes[r]),
+            View::Center => Some(&self.center),
+            View::ShearLeft => compare.map(|c| &c.shear[l]),
+            View::ShearRight => compare.map(|c| &c.shear[r]),
+            View::RotateLeft => compare.map(|c| &c.rotate[l]),
+            View::RotateRight => compare.map(|c| &c.rotate[r]),
+        }
+    }
+
+    /// [`ViewMatrices::get`] for a pass of the plan these were made for.
+    ///
+    /// # Errors
+    /// `Internal` when the plan's pass has no matrices (a plan bug).
+    pub fn of_pass(&self, view: View) -> Result<EyeMatrices> {
+        self.get(view).copied().ok_or_else(|| {
+            stereolab_core::Error::internal("plan", format!("no matrices for the {view:?} pass"))
+        })
+    }
 }
 
 impl Frame {
@@ -69,16 +137,7 @@ impl Frame {
 
     /// The matrices of `view`; `None` for a shear/rotate view the plan did not run.
     pub fn try_matrices(&self, view: View) -> Option<&EyeMatrices> {
-        let compare = |rig: usize, eye: usize| self.shear_rotate.as_ref().map(|m| &m[rig][eye]);
-        match view {
-            View::Left => Some(&self.eyes[0]),
-            View::Right => Some(&self.eyes[1]),
-            View::Center => Some(&self.center),
-            View::ShearLeft => compare(0, 0),
-            View::ShearRight => compare(0, 1),
-            View::RotateLeft => compare(1, 0),
-            View::RotateRight => compare(1, 1),
-        }
+        self.views.get(view)
     }
 
     /// The matrices of `view`.
@@ -92,60 +151,17 @@ impl Frame {
     }
 }
 
-/// The scene's rig as off-axis (`[0]`, the SGI course notes' shear) and as toe-in (`[1]`,
-/// rotate), index 0 left and 1 right within each: everything else (separation, zero parallax,
-/// balance, lighting, viewer) as the scene sets it.
+/// The scene's rig as off-axis and as toe-in ([`ShearRotate`]).
 ///
 /// # Errors
 /// As [`StereoRig::eyes_for_image`].
-pub fn shear_rotate_eyes(scene: &Scene) -> Result<[[EyeMatrices; 2]; 2]> {
+pub fn shear_rotate_eyes(scene: &Scene) -> Result<ShearRotate> {
     let rig = |mode| StereoRig { mode, ..scene.rig };
     let (w, h) = (scene.width, scene.height);
-    Ok([
-        rig(CameraMode::OffAxis).eyes_for_image(&scene.camera, w, h)?,
-        rig(CameraMode::ToeIn).eyes_for_image(&scene.camera, w, h)?,
-    ])
-}
-
-/// [`shear_rotate_eyes`] when `plan` runs a shear or rotate pass, `None` otherwise (so a rig
-/// that only toe-in cannot represent never fails a plan that does not ask for it).
-///
-/// # Errors
-/// As [`shear_rotate_eyes`].
-pub fn planned_shear_rotate_eyes(
-    scene: &Scene,
-    plan: &Plan,
-) -> Result<Option<[[EyeMatrices; 2]; 2]>> {
-    let needed = plan.passes.iter().any(|p| {
-        matches!(
-            p.view,
-            View::ShearLeft | View::ShearRight | View::RotateLeft | View::RotateRight
-        )
-    });
-    needed.then(|| shear_rotate_eyes(scene)).transpose()
-}
-
-impl Frame {
-    /// The matrices of every view, for a frame that is still being rendered.
-    pub fn lookup(
-        eyes: &[EyeMatrices; 2],
-        center: &EyeMatrices,
-        compare: &Option<[[EyeMatrices; 2]; 2]>,
-        view: View,
-    ) -> Result<EyeMatrices> {
-        let m = match view {
-            View::Left => Some(eyes[0]),
-            View::Right => Some(eyes[1]),
-            View::Center => Some(*center),
-            View::ShearLeft => compare.map(|m| m[0][0]),
-            View::ShearRight => compare.map(|m| m[0][1]),
-            View::RotateLeft => compare.map(|m| m[1][0]),
-            View::RotateRight => compare.map(|m| m[1][1]),
-        };
-        m.ok_or_else(|| {
-            stereolab_core::Error::internal("plan", format!("no matrices for the {view:?} pass"))
-        })
-    }
+    Ok(ShearRotate {
+        shear: rig(CameraMode::OffAxis).eyes_for_image(&scene.camera, w, h)?,
+        rotate: rig(CameraMode::ToeIn).eyes_for_image(&scene.camera, w, h)?,
+    })
 }
 
 /// Renders every pass of `plan`. Passes run in parallel (one per thread); each pass is itself
@@ -154,17 +170,13 @@ impl Frame {
 /// # Errors
 /// Invalid camera or rig, or an image size refused by [`Framebuffer::new`].
 pub fn render(scene: &Scene, plan: &Plan) -> Result<Frame> {
-    let eyes = scene
-        .rig
-        .eyes_for_image(&scene.camera, scene.width, scene.height)?;
-    let center = StereoRig::center(&scene.camera, scene.aspect())?;
-    let shear_rotate = planned_shear_rotate_eyes(scene, plan)?;
+    let views = ViewMatrices::new(scene, plan)?;
     let passes = plan
         .passes
         .par_iter()
         .map(|p| {
             let start = Instant::now();
-            let m = Frame::lookup(&eyes, &center, &shear_rotate, p.view)?;
+            let m = views.of_pass(p.view)?;
             let (framebuffer, stats) = render_view(scene, &m, p.shading)?;
             Ok(PassResult {
                 pass: *p,
@@ -177,9 +189,7 @@ pub fn render(scene: &Scene, plan: &Plan) -> Result<Frame> {
     Ok(Frame {
         plan: plan.clone(),
         passes,
-        eyes,
-        center,
-        shear_rotate,
+        views,
     })
 }
 
