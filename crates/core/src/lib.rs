@@ -8,8 +8,7 @@
 //! [`effects::anaglyph::anaglyph`]. Scene files, the plan and the outputs are the `stereolab`
 //! crate's; `examples/` in the repository has small complete programs.
 //!
-//! Modules import lower ones only: [`error`] → [`files`], [`eye`], [`simd`] → [`math`], [`framebuffer`],
-//! [`shade`], [`text`] → [`raster`], [`reference`](mod@reference) → [`effects`] (`tests/architecture.rs`).
+//! Its modules import lower ones only, in the order `tests/architecture.rs` holds.
 //!
 #![doc = include_str!("../../../docs/formulas.md")]
 #![warn(missing_docs)]
