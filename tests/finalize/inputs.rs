@@ -4,8 +4,10 @@ use glam::Mat4;
 use stereolab_core::Framebuffer;
 use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
 use stereolab_core::effects::occlusion::occlusion_image;
-use stereolab_core::effects::parallax::{ParallaxRig, parallax_image, parallax_image_with};
-use stereolab_core::effects::remap::{Precision, remap_color, remap_color_with, visibility_map};
+use stereolab_core::effects::parallax::{ParallaxRig, parallax_image, parallax_image_reference};
+use stereolab_core::effects::remap::{
+    Precision, remap_color, remap_color_reference, visibility_map,
+};
 use stereolab_core::math::{Camera, StereoRig};
 
 fn fb(w: u32, h: u32) -> Framebuffer {
@@ -101,7 +103,7 @@ fn nan_depth_is_refused_naming_the_pixel() {
 
 /// The remap and the parallax image test the depth values inside a pass they make anyway (a
 /// row at a time, or the extremes' scan in blocks): on an image of several rows and blocks, on
-/// the AVX2 and the scalar loops, the first bad pixel is the one named, wherever it lies, and
+/// the AVX2 loops and the scalar references, the first bad pixel is the one named, wherever it lies, and
 /// every kind of bad value is found.
 #[test]
 fn a_bad_depth_anywhere_is_refused_naming_the_first() {
@@ -126,17 +128,26 @@ fn a_bad_depth_anywhere_is_refused_naming_the_first() {
             if i != last {
                 a.depth[last] = 2.0;
             }
-            for simd in [true, false] {
-                for e in [
-                    remap_color_with(&a, &b, &m[0], &m[1], Precision::F64, simd).map(drop),
-                    parallax_image_with(&a, &rig, simd).map(drop),
-                ] {
-                    let msg = e.expect_err("bad depth").to_string();
-                    assert!(
-                        msg.contains(&format!("pixel ({x}, {y})")),
-                        "{bad} at ({x}, {y}), simd {simd}: {msg}"
-                    );
-                }
+            for (what, e) in [
+                (
+                    "remap_color",
+                    remap_color(&a, &b, &m[0], &m[1], Precision::F64).map(drop),
+                ),
+                (
+                    "remap_color_reference",
+                    remap_color_reference(&a, &b, &m[0], &m[1], Precision::F64).map(drop),
+                ),
+                ("parallax_image", parallax_image(&a, &rig).map(drop)),
+                (
+                    "parallax_image_reference",
+                    parallax_image_reference(&a, &rig).map(drop),
+                ),
+            ] {
+                let msg = e.expect_err("bad depth").to_string();
+                assert!(
+                    msg.contains(&format!("pixel ({x}, {y})")),
+                    "{bad} at ({x}, {y}), {what}: {msg}"
+                );
             }
         }
     }
