@@ -165,7 +165,6 @@ fn knobs(iters: usize) -> Result<Vec<Row>> {
             start,
             filter,
             iterations: None,
-            ..PerVertexOptions::default()
         };
         variants.push(("strip start/filter", format!("{start:?} {filter:?}"), s));
     }

@@ -299,7 +299,6 @@ mod tests {
                         start,
                         filter,
                         iterations,
-                        ..PerVertexOptions::default()
                     };
                     let want = k_passes(&g, w, h, &d, &pattern, &opts, true).expect("k passes");
                     // Not vacuous: most pixels copy another one.

@@ -126,7 +126,6 @@ fn avx2_strips_match_scalar_strips() {
                     start,
                     filter,
                     iterations: None,
-                    ..PerVertexOptions::default()
                 };
                 let run = |kernels| {
                     per_vertex_on(&g, (w, h), &d, pattern, &opts, true, kernels).expect("strips")
