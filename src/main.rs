@@ -1,6 +1,7 @@
 //! The `stereolab` command line: one module per subcommand. The library (`stereolab::…`)
 //! does the work; this binary parses arguments, prints, and sets process-wide things (the
-//! allocator, the thread pool, `STEREOLAB_SCALAR`).
+//! allocator, the thread pool). `STEREOLAB_SCALAR=1` (the scalar loops for every pass) is read
+//! where the kernels are chosen, `stereolab_core::simd::kernels`.
 
 /// `print!` to standard output, but a closed pipe or a full disk comes back as an error (which
 /// `main` reports, or ends on quietly for a closed pipe) instead of a panic.
@@ -123,12 +124,6 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
     Ok((w, h))
 }
 
-/// `STEREOLAB_SCALAR=1` (any value but empty or `0`): every pass on the scalar loops, what a
-/// CPU without AVX2 runs. The bytes are the same; only the speed differs.
-fn scalar_requested() -> bool {
-    std::env::var_os("STEREOLAB_SCALAR").is_some_and(|v| !v.is_empty() && v != "0")
-}
-
 /// Runs `work`, showing a spinner with `what` on a terminal's stderr once it has taken more
 /// than a second (never for quick work, never into a pipe or a file).
 fn with_spinner<T>(what: &str, work: impl FnOnce() -> T) -> T {
@@ -163,15 +158,12 @@ fn with_spinner<T>(what: &str, work: impl FnOnce() -> T) -> T {
     result
 }
 
-/// Loads a scene with `--set` overrides, `--size`, and `STEREOLAB_SCALAR` applied.
+/// Loads a scene with `--set` overrides and `--size` applied.
 fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Result<Scene> {
     let opts = LOAD_OPTIONS.get().copied().unwrap_or_default();
     let mut s = with_spinner(&format!("loading {}", path.display()), || {
         Scene::load_with(path, sets, &opts)
     })?;
-    if scalar_requested() {
-        s.set_simd(false);
-    }
     if let Some(size) = size {
         let (w, h) = parse_size(size)?;
         s.set_size(w, h).map_err(|e| match e {

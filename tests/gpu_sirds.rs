@@ -52,7 +52,6 @@ fn gpu_strips_match_cpu_strips_and_decode() {
                     start,
                     filter,
                     iterations: None,
-                    ..PerVertexOptions::default()
                 };
                 let pattern = Pattern::Gray { seed: 11 };
                 let cpu = per_vertex(&g, s.width, s.height, &d, &pattern, &opts, false)

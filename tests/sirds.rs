@@ -236,7 +236,6 @@ fn per_vertex_nearest_copies_are_exact() {
             start,
             filter: Filter::Nearest,
             iterations: None,
-            ..PerVertexOptions::default()
         };
         let pattern = Pattern::Gray { seed: 3 };
         let r = per_vertex(&g, s.width, s.height, &d, &pattern, &opts, true).expect("sirds");
@@ -286,7 +285,6 @@ fn decode_round_trip_every_algorithm_and_option() {
                     start,
                     filter,
                     iterations: None,
-                    ..PerVertexOptions::default()
                 };
                 variants.push((format!("per-vertex {start:?} {filter:?}"), s));
             }

@@ -500,9 +500,10 @@ fn u32_bytes(v: &[u32]) -> Vec<u8> {
     v.iter().flat_map(|f| f.to_le_bytes()).collect()
 }
 
-/// The goal-1 rows: the CPU stereo pair + Dubois anaglyph (AVX2 fragment stage where the CPU
-/// has it, and the scalar stage), beside [`OneShot`] on the same scene, timed in the same run.
-/// The CPU rows' note carries the ratio `cpu / wgpu`; the wgpu row's error is the largest
+/// The goal-1 rows: the CPU stereo pair + Dubois anaglyph (on the loops
+/// [`kernels`](stereolab_core::simd::kernels) chose: the AVX2 fragment stage where the CPU has
+/// it, the scalar stage with `STEREOLAB_SCALAR=1`), beside [`OneShot`] on the same scene, timed
+/// in the same run. The CPU row's note carries the ratio `cpu / wgpu`; the wgpu row's error is the largest
 /// channel difference to the CPU's anaglyph (its arithmetic is not the parity path's).
 /// Without a Vulkan adapter one row says so instead.
 ///
@@ -543,8 +544,6 @@ pub(super) fn rows(scene: &Scene, iters: usize) -> Result<Vec<super::Row>> {
             _ => Err(Error::internal("bench anaglyph", "not an RGBA image")),
         }
     };
-    let mut scalar = scene.clone();
-    scalar.set_simd(false);
     let cpu = cpu_frame(scene)?;
     let wgpu = oneshot.frame()?;
     let max_diff = cpu
@@ -561,12 +560,13 @@ pub(super) fn rows(scene: &Scene, iters: usize) -> Result<Vec<super::Row>> {
     let mut failed = None;
     let wgpu_ms = median_ms(iters, || oneshot.frame().map_err(|e| failed = Some(e)));
     let cpu_ms = median_ms(iters, || cpu_frame(scene).map_err(|e| failed = Some(e)));
-    let scalar_ms = median_ms(iters, || cpu_frame(&scalar).map_err(|e| failed = Some(e)));
     if let Some(e) = failed {
         return Err(e);
     }
-    let simd = if stereolab_core::raster::avx2_available() {
+    let simd = if stereolab_core::simd::kernels().avx2() {
         "AVX2 fragment stage"
+    } else if stereolab_core::simd::avx2_available() {
+        "STEREOLAB_SCALAR: scalar"
     } else {
         "no AVX2 on this CPU: scalar"
     };
@@ -578,15 +578,6 @@ pub(super) fn rows(scene: &Scene, iters: usize) -> Result<Vec<super::Row>> {
             format!(
                 "{size}, {simd}; cpu/wgpu time = {:.2} (goal <= 0.5)",
                 cpu_ms / wgpu_ms
-            ),
-        ),
-        row(
-            "cpu scalar",
-            Some(0.0),
-            scalar_ms,
-            format!(
-                "{size}, STEREOLAB_SCALAR; cpu/wgpu time = {:.2}",
-                scalar_ms / wgpu_ms
             ),
         ),
         row(

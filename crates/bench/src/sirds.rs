@@ -7,7 +7,7 @@ use super::{Row, interleaved_medians, median_ms};
 use stereolab::fixtures::{TABLE_1, scene_from_text, sphere_over_ramp, table_scene};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::{Output, Plan, Shading};
-use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
+use stereolab::render::sirds_strips::{StripGeometry, per_vertex, per_vertex_reference};
 use stereolab::render::{render, render_view};
 use stereolab::scene::Scene;
 use stereolab_core::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
@@ -22,57 +22,56 @@ use stereolab_core::math::{EyeMatrices, StereoRig};
 /// the paper's:
 /// - **depth pass + strips**: stereolab's frame with the scene's automatic depth range (a depth
 ///   pass finds the nearest and farthest drawn depth, then the strip geometry and the strips;
-///   left start, bilinear, k as in the paper). Row 1 once more with the scalar loops.
+///   left start, bilinear, k as in the paper).
 /// - **strips, range fixed**: the work the paper's frame does. Its vertex program maps each
 ///   vertex's eye-space z to a disparity with constants (§4, Fig. 4: `c[2] = (0.5a, f, 0, 0)`),
 ///   so the paper renders no depth pass: its frame is the random initialization and the k
 ///   textured passes. Here the depth range is found once before timing and the frame is the
 ///   strip geometry (the vertex program) and the strips: the second half of the full frame,
-///   so the same image.
+///   so the same image. Row 1 once more on the strips' scalar loops
+///   ([`per_vertex_reference`]): what the AVX2 loops bring (same bytes).
 ///
 /// The rows are timed in turns ([`interleaved_medians`]), blocks of 20 frames, every row once
 /// per round, until each has at least 300 frames: a slow spell of this shared VM (they last
 /// seconds and move a frame's time by up to 40%) then falls on every row alike instead of on
 /// whichever was being timed.
 fn table_1(iters: usize) -> Result<Vec<Row>> {
-    // Row 1 once more with the scalar loops: what the AVX2 loops bring (same bytes).
-    let scalar_row = TABLE_1[0];
-    let runs: Vec<_> = TABLE_1
-        .into_iter()
-        .map(|r| (r, true))
-        .chain(std::iter::once((scalar_row, false)))
-        .collect();
     let mut scenes = Vec::new();
-    for &((w, h, tris, k, _), simd) in &runs {
-        let mut s = table_scene(w, h, tris, k)?;
-        s.set_simd(simd);
+    for (w, h, tris, k, _) in TABLE_1 {
+        let s = table_scene(w, h, tris, k)?;
         let center = StereoRig::center(&s.camera, s.aspect())?;
         let d = s.sirds.geometry.to_pixels()?;
         scenes.push((s, center, d));
     }
-    let strips = |(s, center, d): &(Scene, EyeMatrices, Disparity), range: &DepthRange| {
-        let g = StripGeometry::new(s, center, range, d, false);
-        let (p, opts) = (&s.sirds.pattern, &s.sirds.per_vertex);
-        per_vertex(&g, s.width, s.height, d, p, opts, false).map(drop)
-    };
+    let strips =
+        |(s, center, d): &(Scene, EyeMatrices, Disparity), range: &DepthRange, simd: bool| {
+            let g = StripGeometry::new(s, center, range, d, false);
+            let (p, opts) = (&s.sirds.pattern, &s.sirds.per_vertex);
+            if simd {
+                per_vertex(&g, s.width, s.height, d, p, opts, false).map(drop)
+            } else {
+                per_vertex_reference(&g, s.width, s.height, d, p, opts, false).map(drop)
+            }
+        };
     let range_of = |(s, center, _): &(Scene, EyeMatrices, Disparity)| {
         let (fb, _) = render_view(s, center, Shading::DepthOnly)?;
         depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)
     };
-    // What is timed: each run's full frame, then each AVX2 run's strips with the range fixed.
-    let mut timed: Vec<(usize, Option<DepthRange>)> = (0..runs.len()).map(|i| (i, None)).collect();
-    for (i, &(_, simd)) in runs.iter().enumerate() {
-        if simd {
-            timed.push((i, Some(range_of(&scenes[i])?)));
-        }
+    // What is timed: each line's full frame, then each line's strips with the range fixed,
+    // then row 1's strips with the range fixed on the scalar loops: (line, range, AVX2 loops).
+    let mut timed: Vec<(usize, Option<DepthRange>, bool)> =
+        (0..scenes.len()).map(|i| (i, None, true)).collect();
+    for (i, scene) in scenes.iter().enumerate() {
+        timed.push((i, Some(range_of(scene)?), true));
     }
+    timed.push((0, Some(range_of(&scenes[0])?), false));
     let mut frames: Vec<Box<dyn FnMut() -> Result<()> + '_>> = timed
         .iter()
-        .map(|&(i, range)| -> Box<dyn FnMut() -> Result<()> + '_> {
+        .map(|&(i, range, simd)| -> Box<dyn FnMut() -> Result<()> + '_> {
             let scene = &scenes[i];
             match range {
-                Some(r) => Box::new(move || strips(scene, &r)),
-                None => Box::new(move || strips(scene, &range_of(scene)?)),
+                Some(r) => Box::new(move || strips(scene, &r, simd)),
+                None => Box::new(move || strips(scene, &range_of(scene)?, simd)),
             }
         })
         .collect();
@@ -83,17 +82,17 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     let loops = |simd: bool| {
         if !simd {
             ", scalar loops"
-        } else if stereolab_core::raster::avx2_available() {
+        } else if stereolab_core::simd::kernels().avx2() {
             ", AVX2 loops"
         } else {
-            ", scalar loops (no AVX2 here)"
+            ", scalar loops (no AVX2 here, or STEREOLAB_SCALAR set)"
         }
     };
     Ok(timed
         .iter()
         .zip(ms)
-        .map(|(&(i, range), ms)| {
-            let ((w, h, tris, k, paper_hz), simd) = runs[i];
+        .map(|(&(i, range, simd), ms)| {
+            let (w, h, tris, k, paper_hz) = TABLE_1[i];
             let (setting, what) = if range.is_some() {
                 (
                     format!("{w}x{h} {tris} tris k={k}, range fixed"),
@@ -166,7 +165,6 @@ fn knobs(iters: usize) -> Result<Vec<Row>> {
             start,
             filter,
             iterations: None,
-            ..PerVertexOptions::default()
         };
         variants.push(("strip start/filter", format!("{start:?} {filter:?}"), s));
     }

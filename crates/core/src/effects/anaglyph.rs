@@ -17,6 +17,7 @@ use super::eye_input::check_same_size;
 use super::par_fill_rows;
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
+use crate::simd::{Kernels, kernels};
 
 /// A 3×3 color matrix, row-major: `out[i] = Σ_j m[i][j] · in[j]`.
 pub type ColorMatrix = [[f32; 3]; 3];
@@ -278,30 +279,41 @@ pub fn anaglyph_pixel(
 /// A left and a right eye's pixel.
 type PixelPair = ([u8; 4], [u8; 4]);
 
-/// The anaglyph of two eye images (color only; depth is not read).
+/// The anaglyph of two eye images (color only; depth is not read), on the scalar loop: the
+/// definition [`anaglyph`] runs faster with the same bytes (the benchmark times both).
 ///
 /// # Errors
 /// The eyes differ in size, or a color buffer does not match its size.
+pub fn anaglyph_reference(
+    left: &Framebuffer,
+    right: &Framebuffer,
+    kind: AnaglyphKind,
+    options: AnaglyphOptions,
+) -> Result<RgbaImage> {
+    anaglyph_on(left, right, kind, options, Kernels::Scalar)
+}
+
+/// The anaglyph of two eye images (color only; depth is not read): [`anaglyph_reference`]'s
+/// bytes, stored values on the AVX2 rows where [`kernels`] chose them.
+///
+/// # Errors
+/// As [`anaglyph_reference`].
 pub fn anaglyph(
     left: &Framebuffer,
     right: &Framebuffer,
     kind: AnaglyphKind,
     options: AnaglyphOptions,
 ) -> Result<RgbaImage> {
-    anaglyph_with(left, right, kind, options, true)
+    anaglyph_on(left, right, kind, options, kernels())
 }
 
-/// [`anaglyph`], on the AVX2 rows where `simd` and the CPU allow, else on the scalar loop (the
-/// bytes are the same; the benchmark times both).
-///
-/// # Errors
-/// As [`anaglyph`].
-pub fn anaglyph_with(
+/// The anaglyph on the loops `kernels` names (the linear-light loop is scalar on both).
+fn anaglyph_on(
     left: &Framebuffer,
     right: &Framebuffer,
     kind: AnaglyphKind,
     options: AnaglyphOptions,
-    simd: bool,
+    kernels: Kernels,
 ) -> Result<RgbaImage> {
     check_same_size(left, right)?;
     let (left, right) = options.eyes(left, right);
@@ -341,16 +353,15 @@ pub fn anaglyph_with(
         // output row (`check_same_size`: both color buffers hold width × height pixels).
         unsafe { par_fill_rows(left.color.len(), w, fill) }
     } else {
-        #[cfg(target_arch = "x86_64")]
-        let simd = simd && crate::simd::avx2_available();
+        let avx2 = kernels.avx2();
         #[cfg(not(target_arch = "x86_64"))]
-        let _ = simd;
+        let _ = avx2;
         let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
             let (l, r) = eyes(y, out.len());
             #[cfg(target_arch = "x86_64")]
-            if simd {
+            if avx2 {
                 // SAFETY: `avx2::row` requires AVX2 (its only safety condition), which
-                // `avx2::available` found on this CPU. The same bytes as the loop below
+                // `Kernels::avx2` found on this CPU. The same bytes as the loop below
                 // (`avx2_rows_match_anaglyph_pixel`).
                 unsafe { avx2::row(&m, l, r, out) };
                 return;
@@ -387,12 +398,12 @@ mod tests {
         }
         for kind in AnaglyphKind::ALL {
             for linear_light in [false, true] {
-                for simd in [true, false] {
+                for kernels in [Kernels::Avx2, Kernels::Scalar] {
                     let options = AnaglyphOptions {
                         linear_light,
                         swap_eyes: false,
                     };
-                    let img = anaglyph_with(&left, &right, kind, options, simd).unwrap();
+                    let img = anaglyph_on(&left, &right, kind, options, kernels).unwrap();
                     for (i, px) in img.pixels().enumerate() {
                         let want = anaglyph_pixel(
                             &kind.matrices(),
@@ -402,7 +413,7 @@ mod tests {
                         );
                         assert_eq!(
                             px.0, want,
-                            "{kind:?} linear {linear_light} simd {simd}: pixel {i}"
+                            "{kind:?} linear {linear_light} {kernels:?}: pixel {i}"
                         );
                     }
                 }

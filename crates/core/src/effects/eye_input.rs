@@ -104,12 +104,12 @@ pub(crate) fn all_in_unit(c: &[f32]) -> bool {
             == 0
     }
     #[cfg(target_arch = "x86_64")]
-    if crate::simd::avx2_available() {
+    if crate::simd::kernels().avx2() {
         #[target_feature(enable = "avx2")]
         fn avx2(c: &[f32]) -> bool {
             body(c)
         }
-        // SAFETY: the CPU has AVX2 (`avx2_available`), `avx2`'s only requirement.
+        // SAFETY: the CPU has AVX2 (`Kernels::avx2`), `avx2`'s only requirement.
         return unsafe { avx2(c) };
     }
     body(c)

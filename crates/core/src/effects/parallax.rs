@@ -16,6 +16,7 @@ use super::legend::{LEGEND_HEIGHT, draw_legend_into, draw_legend_reference};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::math::{Camera, CameraMode, StereoRig};
+use crate::simd::{Kernels, kernels};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -176,7 +177,7 @@ impl ParallaxRig {
 /// the values. Eight at a time on AVX2 (`avx2::drawn_extremes`), else [`drawn_extremes_scalar`].
 fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
     #[cfg(target_arch = "x86_64")]
-    if crate::simd::avx2_available() {
+    if kernels().avx2() {
         // SAFETY: the CPU has AVX2 (checked above), the function's only requirement. The same
         // result as the scalar fold (`avx2_drawn_extremes_match_scalar`).
         return unsafe { avx2::drawn_extremes(c) };
@@ -383,6 +384,37 @@ fn violation_marks_where(
     marks
 }
 
+/// One pixel of the parallax image before the window marks: the background color, or
+/// [`parallax_color`] of the pixel's parallax.
+#[inline]
+pub fn parallax_pixel_color(rig: &ParallaxRig, window_depth: f32, scale: f64) -> [u8; 4] {
+    rig.parallax_pixels(window_depth)
+        .map_or(PARALLAX_BACKGROUND, |p| parallax_color(p, scale))
+}
+
+/// [`parallax_image`] as the readable program it is held to (`parallax_image_matches_reference`):
+/// the parallax map, its budget, the color scale, the colors, the marks, the legend (drawn by
+/// tiny-skia, [`draw_legend_reference`]).
+///
+/// # Errors
+/// As [`parallax_map`].
+pub fn parallax_image_reference(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> {
+    let map = parallax_map(fb, rig)?;
+    let b = budget(&map, fb.width, fb.height);
+    let scale = color_scale(&b);
+    let legend = draw_legend_reference(fb.width, scale, &|p| parallax_color(p, scale))?;
+    let mut bytes: Vec<u8> = map
+        .iter()
+        .flat_map(|p| p.map_or(PARALLAX_BACKGROUND, |p| parallax_color(p, scale)))
+        .collect();
+    for i in window_violation_marks(&map, fb.width, fb.height) {
+        bytes[4 * i..4 * i + 4].copy_from_slice(&VIOLATION_COLOR);
+    }
+    bytes.extend_from_slice(legend.data());
+    let h = fb.height + legend.height();
+    Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))
+}
+
 /// The parallax of one eye's depth buffer as color, with a legend bar (drawn with tiny-skia)
 /// appended below the image: the color scale from −S to +S pixels, ticks at 0 and at seed
 /// 003's ±3% budget, labels in pixels and percent of the width. Window violations are marked
@@ -391,21 +423,18 @@ fn violation_marks_where(
 /// The same bytes as [`parallax_image_reference`] (the readable program: the parallax map, its
 /// budget, the colors), computed without the map: S from the depth extremes
 /// (`ParallaxRig::color_scale_checked`), each row's colors in parallel, four pixels at a time on
-/// AVX2 (`parallax/avx2.rs`, the scalar [`parallax_color`] elsewhere), the window violations
-/// from the border pixels alone.
+/// AVX2 where [`kernels`] chose it (`parallax/avx2.rs`, the scalar [`parallax_color`]
+/// elsewhere), the window violations from the border pixels alone.
 ///
 /// # Errors
 /// As [`parallax_map`].
 pub fn parallax_image(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> {
-    parallax_image_with(fb, rig, true)
+    parallax_image_on(fb, rig, kernels())
 }
 
-/// [`parallax_image`], on the AVX2 rows where `simd` and the CPU allow, else on the scalar rows
-/// (the bytes are the same; the benchmark times both).
-///
-/// # Errors
-/// As [`parallax_map`].
-pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> Result<RgbaImage> {
+/// [`parallax_image`] on the rows `kernels` names: the AVX2 rows, or the scalar loop over
+/// [`parallax_pixel_color`] (the same bytes).
+fn parallax_image_on(fb: &Framebuffer, rig: &ParallaxRig, kernels: Kernels) -> Result<RgbaImage> {
     rig.check_size(fb)?;
     // The depth check in the extremes' pass; the error names the first bad pixel, as before.
     let (scale, in_unit) = rig.color_scale_checked(&fb.depth);
@@ -413,10 +442,7 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
         check_depth("parallax", fb)?;
     }
     let (w, n) = (fb.width as usize, fb.depth.len());
-    #[cfg(target_arch = "x86_64")]
-    let simd = simd && crate::simd::avx2_available();
-    #[cfg(not(target_arch = "x86_64"))]
-    let simd = simd && false;
+    let simd = kernels.avx2();
     // The AVX2 rows' affine form of the color scale, once per image.
     #[cfg(target_arch = "x86_64")]
     // SAFETY: only where `simd` says the CPU has AVX2, `Affine::of`'s only requirement.
@@ -428,7 +454,7 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
         let depth = &fb.depth[y * w..y * w + out.len()];
         #[cfg(target_arch = "x86_64")]
         if simd {
-            // SAFETY: `simd` holds only where `avx2::available` found AVX2, the row's only
+            // SAFETY: `simd` holds only where `Kernels::avx2` found AVX2, the row's only
             // safety condition. The same bytes as the loop below
             // (`avx2_rows_match_parallax_color`).
             unsafe { avx2::row(rig, scale, affine.as_ref(), depth, out) };
@@ -466,37 +492,6 @@ pub fn parallax_image_with(fb: &Framebuffer, rig: &ParallaxRig, simd: bool) -> R
         bytes[4 * i..4 * i + 4].copy_from_slice(&VIOLATION_COLOR);
     }
     let h = fb.height + LEGEND_HEIGHT;
-    Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))
-}
-
-/// One pixel of the parallax image before the window marks: the background color, or
-/// [`parallax_color`] of the pixel's parallax.
-#[inline]
-pub fn parallax_pixel_color(rig: &ParallaxRig, window_depth: f32, scale: f64) -> [u8; 4] {
-    rig.parallax_pixels(window_depth)
-        .map_or(PARALLAX_BACKGROUND, |p| parallax_color(p, scale))
-}
-
-/// [`parallax_image`] as the readable program it is held to (`parallax_image_matches_reference`):
-/// the parallax map, its budget, the color scale, the colors, the marks, the legend (drawn by
-/// tiny-skia, [`draw_legend_reference`]).
-///
-/// # Errors
-/// As [`parallax_map`].
-pub fn parallax_image_reference(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> {
-    let map = parallax_map(fb, rig)?;
-    let b = budget(&map, fb.width, fb.height);
-    let scale = color_scale(&b);
-    let legend = draw_legend_reference(fb.width, scale, &|p| parallax_color(p, scale))?;
-    let mut bytes: Vec<u8> = map
-        .iter()
-        .flat_map(|p| p.map_or(PARALLAX_BACKGROUND, |p| parallax_color(p, scale)))
-        .collect();
-    for i in window_violation_marks(&map, fb.width, fb.height) {
-        bytes[4 * i..4 * i + 4].copy_from_slice(&VIOLATION_COLOR);
-    }
-    bytes.extend_from_slice(legend.data());
-    let h = fb.height + legend.height();
     Ok(RgbaImage::from_raw(fb.width, h, bytes).expect("4 bytes per pixel"))
 }
 
@@ -572,8 +567,8 @@ mod tests {
                         };
                     }
                     let want = parallax_image_reference(&fb, r).unwrap();
-                    for simd in [true, false] {
-                        let got = parallax_image_with(&fb, r, simd).unwrap();
+                    for kernels in [Kernels::Avx2, Kernels::Scalar] {
+                        let got = parallax_image_on(&fb, r, kernels).unwrap();
                         assert_eq!(got.dimensions(), want.dimensions());
                         if let Some(i) = got
                             .as_raw()
@@ -582,7 +577,7 @@ mod tests {
                             .position(|(a, b)| a != b)
                         {
                             panic!(
-                                "{width}x{height}, rig {k}, pattern {pattern}, simd {simd}: byte {i} \
+                                "{width}x{height}, rig {k}, pattern {pattern}, {kernels:?}: byte {i} \
                                  (pixel {}) differs",
                                 i / 4
                             );

@@ -25,6 +25,7 @@ use rayon::prelude::*;
 use super::eye_input::{all_in_unit, check_depth, check_depth_len, check_same_size};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
+use crate::simd::{Kernels, kernels};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -209,8 +210,25 @@ pub fn remap_coordinates(
 /// point to remap and stay black; points outside the other image get
 /// [`OUT_OF_VIEW_COLOR`](super::occlusion::OUT_OF_VIEW_COLOR).
 ///
+/// The scalar loop over [`remap_color_pixel`]: the definition [`remap_color`] runs faster with
+/// the same bytes (the benchmark times both).
+///
 /// # Errors
 /// Different sizes, a missing or NaN depth buffer in `this`, or a singular MVP.
+pub fn remap_color_reference(
+    this: &Framebuffer,
+    other: &Framebuffer,
+    this_mvp: &Mat4,
+    other_mvp: &Mat4,
+    precision: Precision,
+) -> Result<RgbaImage> {
+    remap_color_on(this, other, this_mvp, other_mvp, precision, Kernels::Scalar)
+}
+
+/// [`remap_color_reference`]'s bytes, on the AVX2 rows where [`kernels`] chose them.
+///
+/// # Errors
+/// As [`remap_color_reference`].
 pub fn remap_color(
     this: &Framebuffer,
     other: &Framebuffer,
@@ -218,27 +236,23 @@ pub fn remap_color(
     other_mvp: &Mat4,
     precision: Precision,
 ) -> Result<RgbaImage> {
-    remap_color_with(this, other, this_mvp, other_mvp, precision, true)
+    remap_color_on(this, other, this_mvp, other_mvp, precision, kernels())
 }
 
-/// [`remap_color`], on the AVX2 rows where `simd` and the CPU allow, else on the scalar loop
-/// over [`remap_color_pixel`] (the bytes are the same; the benchmark times both).
-///
-/// # Errors
-/// As [`remap_color`].
-pub fn remap_color_with(
+/// The recolored view on the loops `kernels` names.
+fn remap_color_on(
     this: &Framebuffer,
     other: &Framebuffer,
     this_mvp: &Mat4,
     other_mvp: &Mat4,
     precision: Precision,
-    simd: bool,
+    kernels: Kernels,
 ) -> Result<RgbaImage> {
     check_same_size(this, other)?;
     check_depth_len("this", this)?;
     let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
     let (w, h) = (this.width, this.height);
-    let rows = RowProgram::new(&r, simd);
+    let rows = RowProgram::new(&r, kernels);
     // Rows in parallel: every pixel is independent, so the bytes do not depend on the threads.
     // Each depth row is checked as it is read (in cache), not in a pass of its own; a row
     // program is safe on any value (NaN and out-of-range depths fail its bounds test).
@@ -271,11 +285,11 @@ struct RowProgram<'a> {
 }
 
 impl<'a> RowProgram<'a> {
-    /// The program for `remapper`; `simd` asks for the AVX2 rows, which run only where the CPU
-    /// has AVX2 and every texel index fits an `i32`.
-    fn new(remapper: &'a Remapper, simd: bool) -> Self {
+    /// The program for `remapper` on the loops `kernels` names; the AVX2 rows run only where
+    /// the CPU has AVX2 and every texel index fits an `i32`.
+    fn new(remapper: &'a Remapper, kernels: Kernels) -> Self {
         let pixels = remapper.width as u64 * remapper.height as u64;
-        let simd = simd && crate::simd::avx2_available() && pixels < i32::MAX as u64;
+        let simd = kernels.avx2() && pixels < i32::MAX as u64;
         let (mut ndc_x64, mut ndc_x32) = (Vec::new(), Vec::new());
         if simd {
             let cols = 0..remapper.width;
@@ -307,7 +321,7 @@ impl<'a> RowProgram<'a> {
         #[cfg(target_arch = "x86_64")]
         if self.simd {
             let r = self.remapper;
-            // SAFETY: `simd` is set only where `avx2_available` found AVX2, the rows' only
+            // SAFETY: `simd` is set only where `Kernels::avx2` found AVX2, the rows' only
             // safety condition. The same bytes as the loop below
             // (`avx2_rows_match_remap_color_pixel`).
             return unsafe {
@@ -486,10 +500,10 @@ mod tests {
             *c = (i as u32).wrapping_mul(2_654_435_761).to_le_bytes();
         }
         for precision in [Precision::F64, Precision::F32Composed, Precision::F32] {
-            let run = |simd| {
-                remap_color_with(&this, &other, &eye(-0.3), &eye(0.3), precision, simd).unwrap()
+            let run = |kernels| {
+                remap_color_on(&this, &other, &eye(-0.3), &eye(0.3), precision, kernels).unwrap()
             };
-            assert_eq!(run(true), run(false), "{precision:?}");
+            assert_eq!(run(Kernels::Avx2), run(Kernels::Scalar), "{precision:?}");
         }
     }
 }

@@ -29,9 +29,10 @@ use shade_avx2::Uniforms as BlinnPhongUniforms;
 #[cfg(not(target_arch = "x86_64"))]
 enum BlinnPhongUniforms {}
 
-/// Whether this CPU can run the AVX2 loops; they run where this holds and the options allow
-/// them ([`RasterOptions::simd`], the strips' `PerVertexOptions::simd`).
+/// Whether this CPU can run the AVX2 loops; they run where this holds and
+/// [`kernels`](crate::simd::kernels) chose them.
 pub use crate::simd::avx2_available;
+use crate::simd::{Kernels, kernels};
 
 /// Rasterizer knobs. The defaults are what lavapipe does.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,9 +45,6 @@ pub struct RasterOptions {
     pub perspective_correct: bool,
     /// Depth test LESS with depth writes (true), or no depth test and no depth writes.
     pub depth_test: bool,
-    /// Run the AVX2 loops where the CPU has them (true), or the scalar ones only (false). The
-    /// same bytes either way; `STEREOLAB_SCALAR=1` sets false in the `stereolab` command.
-    pub simd: bool,
     /// Which depth the depth test compares: lavapipe's f32 window depth (the default), or
     /// reversed-Z or f64 for scenes whose near/far ratio the standard buffer cannot resolve
     /// (`[raster] depth`, see `depth_modes`).
@@ -60,7 +58,6 @@ impl Default for RasterOptions {
             subpixel_bits: 8,
             perspective_correct: true,
             depth_test: true,
-            simd: true,
             depth: DepthMode::Standard,
         }
     }
@@ -89,7 +86,9 @@ pub(crate) const BAND_ROWS: usize = 32;
 ///
 /// Vertex stage and setup run once; traversal runs in parallel over bands of `BAND_ROWS`
 /// rows, each band applying the triangles in order, so the bytes never depend on the thread
-/// count.
+/// count. Each triangle goes through [`traverse`], the scalar reference, or, in a depth-only
+/// pass where [`kernels`] chose the AVX2 loops, through its AVX2 twin with the same bits
+/// (see `traverse_band`).
 pub fn rasterize<S: Shader>(
     triangles: &[[u32; 3]],
     vertex_count: usize,
@@ -97,11 +96,11 @@ pub fn rasterize<S: Shader>(
     fb: &mut Framebuffer,
     opts: &RasterOptions,
 ) -> RasterStats {
-    rasterize_bands(triangles, vertex_count, shader, None, fb, opts)
+    rasterize_bands(triangles, vertex_count, shader, None, fb, opts, kernels())
 }
 
 /// [`rasterize`] with [`BlinnPhong`]: the same pixels and depths, its fragment stage eight
-/// pixels wide (AVX2) where [`RasterOptions::simd`] and the CPU allow it and the specular
+/// pixels wide (AVX2) where [`kernels`] chose the AVX2 loops and the specular
 /// exponent is a whole number (`shade_avx2`, held to [`BlinnPhong`]'s own stage by
 /// `avx2_blinn_phong_matches_traverse`).
 pub fn rasterize_blinn_phong(
@@ -115,11 +114,19 @@ pub fn rasterize_blinn_phong(
     let uniforms = shade_avx2::Uniforms::of(shader);
     #[cfg(not(target_arch = "x86_64"))]
     let uniforms: Option<BlinnPhongUniforms> = None;
-    rasterize_bands(triangles, vertex_count, shader, uniforms.as_ref(), fb, opts)
+    rasterize_bands(
+        triangles,
+        vertex_count,
+        shader,
+        uniforms.as_ref(),
+        fb,
+        opts,
+        kernels(),
+    )
 }
 
-/// Setup once, then the bands in parallel; `blinn_phong`: the AVX2 fragment stage's uniforms
-/// when the shader is [`BlinnPhong`].
+/// Setup once, then the bands in parallel, on the loops `kernels` names; `blinn_phong`: the
+/// AVX2 fragment stage's uniforms when the shader is [`BlinnPhong`].
 fn rasterize_bands<S: Shader>(
     triangles: &[[u32; 3]],
     vertex_count: usize,
@@ -127,6 +134,7 @@ fn rasterize_bands<S: Shader>(
     blinn_phong: Option<&BlinnPhongUniforms>,
     fb: &mut Framebuffer,
     opts: &RasterOptions,
+    kernels: Kernels,
 ) -> RasterStats {
     if opts.depth != DepthMode::Standard {
         return depth_modes::rasterize(triangles, vertex_count, shader, fb, opts);
@@ -149,7 +157,7 @@ fn rasterize_bands<S: Shader>(
                 color,
                 depth,
             };
-            traverse_band(bin, shader, blinn_phong, &mut band, opts)
+            traverse_band(bin, shader, blinn_phong, &mut band, opts, kernels)
         })
         .sum();
     stats
@@ -159,8 +167,8 @@ fn rasterize_bands<S: Shader>(
 /// Blinn-Phong pass ([`rasterize_blinn_phong`]) with the depth test on goes through the AVX2
 /// fragment stage `shade_avx2::shade_triangle` under the same conditions, with the same color
 /// and depth bits (`avx2_blinn_phong_matches_traverse`). In a
-/// depth-only pass (the shader writes no color, depth test on) where [`RasterOptions::simd`]
-/// allows it and [`avx2_available`], each
+/// depth-only pass (the shader writes no color, depth test on) where `kernels` names the
+/// AVX2 loops and [`avx2_available`], each
 /// triangle goes through the AVX2 kernel `avx2::depth_triangle` instead, which writes the same
 /// depth bits and counts the same fragments (`avx2_depth_bands_match_traverse`): `traverse`
 /// stays the scalar reference.
@@ -170,11 +178,12 @@ fn traverse_band<S: Shader>(
     blinn_phong: Option<&BlinnPhongUniforms>,
     band: &mut Band,
     opts: &RasterOptions,
+    kernels: Kernels,
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
-    if !shader.writes_color() && opts.depth_test && opts.simd && avx2_available() {
+    if !shader.writes_color() && opts.depth_test && kernels.avx2() {
         // SAFETY: `depth_triangle` requires AVX2 and POPCNT (its only safety condition),
-        // which `avx2_available` has just found on this CPU (`avx2::available`).
+        // which `Kernels::avx2` has just found on this CPU (`avx2_available`).
         return triangles
             .iter()
             .map(|t| unsafe { avx2::depth_triangle(t, band) })
@@ -183,11 +192,10 @@ fn traverse_band<S: Shader>(
     #[cfg(target_arch = "x86_64")]
     if let Some(u) = blinn_phong
         && opts.depth_test
-        && opts.simd
-        && avx2_available()
+        && kernels.avx2()
     {
         // SAFETY: `shade_triangle` requires AVX2, FMA and POPCNT (its only safety condition),
-        // which `avx2_available` has just found on this CPU (`avx2::available`).
+        // which `Kernels::avx2` has just found on this CPU (`avx2_available`).
         return triangles
             .iter()
             .map(|t| unsafe { shade_avx2::shade_triangle(t, u, band, opts.perspective_correct) })
@@ -362,15 +370,18 @@ fn setup_chunk(
 }
 
 /// For a test comparing the AVX2 loops with the scalar ones: whether there are AVX2 loops to
-/// compare. Without them (a CPU without AVX2) it says so on stderr
-/// and the test has nothing to hold: every path that runs is then the scalar one, which the
-/// other tests cover. (Unlike lavapipe, which `.ci/run` installs, AVX2 is the hardware's.)
+/// compare, that is whether [`kernels`] chose them (the tests reach them through the public
+/// functions). Without them (a CPU without AVX2, or `STEREOLAB_SCALAR` set) it says so on
+/// stderr and the test has nothing to hold: every path that runs is then the scalar one, which
+/// the other tests cover. (Unlike lavapipe, which `.ci/run` installs, AVX2 is the hardware's.)
 #[cfg(test)]
 pub(crate) fn avx2_to_compare(test: &str) -> bool {
-    if avx2_available() {
+    if kernels().avx2() {
         return true;
     }
-    eprintln!("{test}: NOT RUN: no AVX2 here, nothing to compare");
+    eprintln!(
+        "{test}: NOT RUN: no AVX2 loops here (no AVX2, or STEREOLAB_SCALAR set), nothing to compare"
+    );
     false
 }
 
@@ -513,11 +524,15 @@ mod tests {
             let stats =
                 rasterize_blinn_phong(&triangles, positions.len(), &shader, &mut fast, &opts);
             let mut plain = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
-            let scalar = RasterOptions {
-                simd: false,
-                ..opts
-            };
-            let plain_stats = rasterize(&triangles, positions.len(), &shader, &mut plain, &scalar);
+            let plain_stats = rasterize_bands(
+                &triangles,
+                positions.len(),
+                &shader,
+                None,
+                &mut plain,
+                &opts,
+                Kernels::Scalar,
+            );
             let what = format!("{w}x{h} {count} tilt {tilt} shininess {shininess}");
             assert!(stats.fragments > 0, "{what}: nothing drawn");
             assert_eq!(

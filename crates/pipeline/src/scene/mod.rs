@@ -324,14 +324,6 @@ impl Scene {
         Ok(scene)
     }
 
-    /// Lets the AVX2 loops run where the CPU has them (`true`, the default) or keeps every pass
-    /// on the scalar loops (`false`): the rasterizer's depth-only kernel and the SIRDS strips.
-    /// The output bytes are the same either way; only the speed differs.
-    pub fn set_simd(&mut self, on: bool) {
-        self.raster.simd = on;
-        self.sirds.per_vertex.simd = on;
-    }
-
     /// The numbers the parallax formula `p(z)` needs, for this scene's rig at its image size.
     ///
     /// # Errors

@@ -71,8 +71,8 @@ pub fn linearize(depth: f32, near: f32, far: f32) -> f32 {
 /// 0). `(i32::MAX, i32::MIN)` when nothing is covered.
 fn covered_bounds(depth: &[f32]) -> (i32, i32) {
     #[cfg(target_arch = "x86_64")]
-    if crate::raster::avx2_available() {
-        // SAFETY: AVX2 is available.
+    if crate::simd::kernels().avx2() {
+        // SAFETY: AVX2 is available (`Kernels::avx2`).
         return unsafe { covered_bounds_avx2(depth) };
     }
     covered_bounds_lanes(depth)

@@ -34,7 +34,7 @@ pub enum Filter {
 }
 
 /// Options of the strip algorithm.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct PerVertexOptions {
     /// Left or center start.
     pub start: Start,
@@ -42,20 +42,6 @@ pub struct PerVertexOptions {
     pub filter: Filter,
     /// Iterations k (the strip width is ⌈W / k⌉); `None`: the fewest the geometry allows.
     pub iterations: Option<u32>,
-    /// Run the AVX2 loops where the CPU has them (true, the default), or the scalar ones only.
-    /// The same bytes either way.
-    pub simd: bool,
-}
-
-impl Default for PerVertexOptions {
-    fn default() -> Self {
-        PerVertexOptions {
-            start: Start::default(),
-            filter: Filter::default(),
-            iterations: None,
-            simd: true,
-        }
-    }
 }
 
 /// Which algorithm turns depth into an autostereogram.
@@ -239,7 +225,6 @@ impl Settings {
                 start: spec.start,
                 filter: spec.filter,
                 iterations: spec.iterations,
-                simd: true,
             },
             per_pixel: PerPixelOptions {
                 hidden_surface: spec.hidden_surface.unwrap_or(true),

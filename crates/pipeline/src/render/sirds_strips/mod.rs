@@ -18,9 +18,9 @@
 //! 3. The strips then only read, in order (`resolve_strip`): each pixel takes the color at
 //!    its source, as the earlier strips left the image.
 //!
-//! Steps 2 and 3 run eight pixels at a time on AVX2 (`per_vertex/avx2.rs`), with the scalar
-//! loops' bytes; `PerVertexOptions::simd = false` (`STEREOLAB_SCALAR=1` for the command) runs
-//! the scalar ones.
+//! Steps 2 and 3 run eight pixels at a time on AVX2 (`per_vertex/avx2.rs`) where
+//! [`kernels`] chose the AVX2 loops, with the scalar loops' bytes; [`per_vertex_reference`]
+//! (and `STEREOLAB_SCALAR=1`, see [`kernels`]) runs the scalar ones.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -37,10 +37,9 @@ use stereolab_core::effects::sirds::per_pixel::check_inputs;
 use stereolab_core::effects::sirds::{Disparity, Pattern};
 use stereolab_core::effects::sirds::{Filter, PerVertexOptions, Start};
 use stereolab_core::error::{Error, Result};
-use stereolab_core::raster::{
-    RasterOptions, SetupTriangle, avx2_available, bin_rows, setup_triangles,
-};
+use stereolab_core::raster::{RasterOptions, SetupTriangle, bin_rows, setup_triangles};
 use stereolab_core::shade::{Fragment, Shader, Varyings};
+use stereolab_core::simd::{Kernels, kernels};
 
 /// What a strip run produced.
 #[derive(Clone, Debug, PartialEq)]
@@ -251,7 +250,8 @@ struct Region<'a> {
 /// Which fragment wins a pixel and where it samples depend on the geometry alone, never on the
 /// image it samples, so they are found once per band (deferred texturing) rather than once per
 /// strip; the strips then only read ([`resolve_row`]).
-fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, simd: bool) -> Vec<f32> {
+fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, kernels: Kernels) -> Vec<f32> {
+    let simd = kernels.avx2();
     let w = width as usize;
     let mut sources = vec![f32::NAN; w * rows as usize];
     let mut depth = vec![1.0f32; w * rows as usize];
@@ -260,7 +260,7 @@ fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, simd: bool) 
             #[cfg(target_arch = "x86_64")]
             if simd {
                 let band = (width, y0, rows);
-                // SAFETY: `simd` is only set where `avx2_available()` said so (`per_vertex`).
+                // SAFETY: `simd` is only set where `Kernels::avx2` found AVX2.
                 unsafe { avx2::triangle_sources(t, r, band, &mut depth, &mut sources) };
                 continue;
             }
@@ -354,9 +354,10 @@ fn resolve_strip(
     (width, y0): (usize, u32),
     strip: &Strip,
     bilinear: bool,
-    simd: bool,
+    kernels: Kernels,
     pattern: &Pattern,
 ) {
+    let simd = kernels.avx2();
     let rows = image
         .chunks_exact_mut(width)
         .zip(sources.chunks_exact(width));
@@ -366,7 +367,7 @@ fn resolve_strip(
         let pattern = |x: usize| pattern.color(x as u32, y);
         #[cfg(target_arch = "x86_64")]
         if simd {
-            // SAFETY: `simd` is only set where `avx2_available()` said so; `band_sources`
+            // SAFETY: `simd` is only set where `Kernels::avx2` found AVX2; `band_sources`
             // stored only NaN or in-bounds sources.
             unsafe { avx2::resolve_row(row, src, strip, (bilinear, gray), pattern) };
             continue;
@@ -377,8 +378,8 @@ fn resolve_strip(
 }
 
 /// The inputs of a strip run checked (separations that fit `width`, a pattern wide enough,
-/// an image size any framebuffer accepts) and its strips planned: what [`per_vertex`] and
-/// [`reference::k_passes`] both start with.
+/// an image size any framebuffer accepts) and its strips planned: what [`per_vertex`],
+/// [`per_vertex_reference`] and [`reference::k_passes`] start with.
 ///
 /// # Errors
 /// As [`check_inputs`], [`stereolab_core::framebuffer::check_size`] and [`plan_strips`].
@@ -394,7 +395,8 @@ fn checked_strips(
     plan_strips(width, d, opts)
 }
 
-/// Makes a SIRDS with the strip algorithm.
+/// Makes a SIRDS with the strip algorithm, on the scalar loops: the readable program
+/// [`per_vertex`] runs faster with the same bytes (the benchmark times both).
 ///
 /// Triangle setup once per direction; then, per band of `BAND_ROWS` rows (in parallel: rows
 /// never interact), the winning fragment's source per pixel (`band_sources`) and the strips
@@ -403,6 +405,32 @@ fn checked_strips(
 ///
 /// # Errors
 /// As [`check_inputs`], and k too small for the front separation.
+pub fn per_vertex_reference(
+    geometry: &StripGeometry,
+    width: u32,
+    height: u32,
+    d: &Disparity,
+    pattern: &Pattern,
+    opts: &PerVertexOptions,
+    record_links: bool,
+) -> Result<StripResult> {
+    let size = (width, height);
+    per_vertex_on(
+        geometry,
+        size,
+        d,
+        pattern,
+        opts,
+        record_links,
+        Kernels::Scalar,
+    )
+}
+
+/// Makes a SIRDS with the strip algorithm: [`per_vertex_reference`]'s bytes, steps 2 and 3
+/// eight pixels at a time on AVX2 where [`kernels`] chose the AVX2 loops.
+///
+/// # Errors
+/// As [`per_vertex_reference`].
 pub fn per_vertex(
     geometry: &StripGeometry,
     width: u32,
@@ -412,8 +440,20 @@ pub fn per_vertex(
     opts: &PerVertexOptions,
     record_links: bool,
 ) -> Result<StripResult> {
-    // The AVX2 loops where the options allow them and this CPU has them.
-    let simd = opts.simd && avx2_available();
+    let size = (width, height);
+    per_vertex_on(geometry, size, d, pattern, opts, record_links, kernels())
+}
+
+/// The strip algorithm on the loops `kernels` names.
+fn per_vertex_on(
+    geometry: &StripGeometry,
+    (width, height): (u32, u32),
+    d: &Disparity,
+    pattern: &Pattern,
+    opts: &PerVertexOptions,
+    record_links: bool,
+    kernels: Kernels,
+) -> Result<StripResult> {
     let strips = checked_strips(width, height, d, pattern, opts)?;
     let w = width as usize;
     let raster = RasterOptions::default();
@@ -476,9 +516,9 @@ pub fn per_vertex(
                     });
                 }
             }
-            let sources = band_sources(&regions, width, y0, rows, simd);
+            let sources = band_sources(&regions, width, y0, rows, kernels);
             for strip in &strips {
-                resolve_strip(image, &sources, (w, y0), strip, bilinear, simd, pattern);
+                resolve_strip(image, &sources, (w, y0), strip, bilinear, kernels, pattern);
             }
             // Which pixel each one copied depends on its source alone, not on the strip.
             let link = |p: f32| {

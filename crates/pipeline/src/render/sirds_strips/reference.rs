@@ -190,12 +190,12 @@ mod tests {
     use super::*;
     use crate::plan::Shading;
     use crate::render::render_view;
-    use crate::render::sirds_strips::per_vertex;
+    use crate::render::sirds_strips::{per_vertex_on, per_vertex_reference};
     use crate::scene::Scene;
     use stereolab_core::effects::sirds::Start;
     use stereolab_core::effects::sirds::depth_range;
     use stereolab_core::math::StereoRig;
-    use stereolab_core::raster::avx2_available;
+    use stereolab_core::simd::{Kernels, avx2_available};
 
     /// The camera of tests/sirds.rs.
     const CAMERA: &str = "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\
@@ -272,8 +272,8 @@ mod tests {
         let avx2 = avx2_available();
         if !avx2 {
             eprintln!(
-                "{test}: no AVX2 here (or STEREOLAB_SCALAR set): the SIMD-on case runs the \
-                 scalar loops, only those are compared with the k passes"
+                "{test}: no AVX2 here: the AVX2 case runs the scalar loops, only those are \
+                 compared with the k passes"
             );
         }
         let pattern = Pattern::Color { seed: 11 };
@@ -299,7 +299,6 @@ mod tests {
                         start,
                         filter,
                         iterations,
-                        ..PerVertexOptions::default()
                     };
                     let want = k_passes(&g, w, h, &d, &pattern, &opts, true).expect("k passes");
                     // Not vacuous: most pixels copy another one.
@@ -308,25 +307,15 @@ mod tests {
                         linked * 2 > want.pixels.len(),
                         "{name} {w}x{h} {start:?}: only {linked} pixels linked"
                     );
-                    for simd in [false, true] {
-                        let got = per_vertex(
-                            &g,
-                            w,
-                            h,
-                            &d,
-                            &pattern,
-                            &PerVertexOptions {
-                                simd: simd && avx2,
-                                ..opts
-                            },
-                            true,
-                        )
-                        .expect("fast strips");
+                    for kernels in [Kernels::Scalar, Kernels::Avx2] {
+                        let size = (w, h);
+                        let got = per_vertex_on(&g, size, &d, &pattern, &opts, true, kernels)
+                            .expect("fast strips");
                         compared += 1;
                         if let Some(diff) = differences(&want, &got, w) {
                             failures.push(format!(
                                 "{name} {w}x{h} {dpi} dpi k {iterations:?} cross-eyed \
-                                 {cross_eyed} {start:?} {filter:?} simd {simd}: {diff}"
+                                 {cross_eyed} {start:?} {filter:?} {kernels:?}: {diff}"
                             ));
                         }
                     }
@@ -351,18 +340,7 @@ mod tests {
                 iterations,
                 ..Default::default()
             };
-            let want = per_vertex(
-                &g,
-                w,
-                67,
-                &d,
-                &pattern,
-                &PerVertexOptions {
-                    simd: false,
-                    ..opts
-                },
-                false,
-            );
+            let want = per_vertex_reference(&g, w, 67, &d, &pattern, &opts, false);
             let got = k_passes(&g, w, 67, &d, &pattern, &opts, false);
             let message = |r: Result<StripResult>| r.err().map(|e| e.to_string());
             let (want, got) = (message(want), message(got));

@@ -126,21 +126,11 @@ fn avx2_strips_match_scalar_strips() {
                     start,
                     filter,
                     iterations: None,
-                    ..PerVertexOptions::default()
                 };
-                let run = |simd| {
-                    per_vertex(
-                        &g,
-                        w,
-                        h,
-                        &d,
-                        pattern,
-                        &PerVertexOptions { simd, ..opts },
-                        true,
-                    )
-                    .expect("strips")
+                let run = |kernels| {
+                    per_vertex_on(&g, (w, h), &d, pattern, &opts, true, kernels).expect("strips")
                 };
-                let (fast, plain) = (run(true), run(false));
+                let (fast, plain) = (run(Kernels::Avx2), run(Kernels::Scalar));
                 let differ = fast
                     .pixels
                     .iter()
