@@ -11,7 +11,7 @@ use glam::{DMat4, Mat4};
 use image::RgbaImage;
 
 use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions};
-use stereolab_core::effects::eye_input::{check_depth, check_same_size};
+use stereolab_core::effects::eye_input::check_same_size;
 use stereolab_core::effects::occlusion::{
     BACKGROUND_COLOR, FARTHER_COLOR, OCCLUDED_COLOR, OUT_OF_VIEW_COLOR,
 };
@@ -120,7 +120,6 @@ impl GpuFinalize {
                 format!("the rig was resolved for {}x{}", rig.width, rig.height),
             ));
         }
-        check_depth("parallax", fb)?;
         let (n, f, z0) = (rig.near, rig.far, rig.zero_parallax_distance);
         let k = rig.pixels_per_unit * rig.eye_separation;
         let a = k * (rig.balance - z0 / n);
@@ -151,7 +150,6 @@ impl GpuFinalize {
         other_mvp: &Mat4,
     ) -> Result<RgbaImage> {
         check_same_size(this, other)?;
-        check_depth("this", this)?;
         let params = remap_params(this_mvp, other_mvp, 0.0, (0.0, 1.0))?;
         Ok(image_of(&self.remap.run(r, &[this, other], &params)?))
     }
@@ -170,8 +168,6 @@ impl GpuFinalize {
         mvps: [&Mat4; 2],
     ) -> Result<RgbaImage> {
         check_same_size(left, right)?;
-        check_depth("left", left)?;
-        check_depth("right", right)?;
         let eyes = [left, right];
         let (w, h) = (left.width(), left.height());
         let mut out = RgbaImage::new(2 * w, h);

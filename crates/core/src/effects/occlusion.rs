@@ -50,7 +50,7 @@ fn depth_extremes(fb: &Framebuffer) -> (f32, f32) {
 /// Reads the two depth buffers only.
 ///
 /// # Errors
-/// Different sizes, a missing or NaN depth buffer, or a singular MVP.
+/// Different sizes, or a singular MVP.
 pub fn occlusion_image(
     left: &Framebuffer,
     right: &Framebuffer,

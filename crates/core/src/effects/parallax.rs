@@ -11,7 +11,6 @@ use std::mem::MaybeUninit;
 use image::RgbaImage;
 use rayon::prelude::*;
 
-use super::eye_input::{all_in_unit, check_depth, check_depth_len};
 use super::legend::{LEGEND_HEIGHT, draw_legend_into, draw_legend_reference};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
@@ -111,10 +110,7 @@ impl ParallaxRig {
     /// depth (up to the sign of a zero, which |p| drops). That needs `0 < n < f` and finite
     /// factors, which a resolved rig has; other values get the full scan, as [`budget`] does
     /// it. `parallax_image_matches_reference` holds the result to the full map.
-    ///
-    /// The second value says whether every depth lies in [0, 1]: `check_depth`'s test, made in
-    /// the same pass over the buffer as the extremes. The scale means nothing when it is false.
-    fn color_scale_checked(&self, depth: &[f32]) -> (f64, bool) {
+    fn color_scale_of(&self, depth: &[f32]) -> f64 {
         let monotone = self.near > 0.0
             && self.far > self.near
             && [
@@ -126,39 +122,30 @@ impl ParallaxRig {
             ]
             .iter()
             .all(|v| v.is_finite());
-        let (extremes, in_unit) = if monotone {
+        let extremes = if monotone {
             // The drawn depths' extremes, per block in parallel (min and max are exact, so the
             // result does not depend on the split).
-            let (lo, hi, in_unit) = depth.par_chunks(1 << 14).map(drawn_extremes).reduce(
-                || (u32::MAX, 0, true),
-                |a, b| (a.0.min(b.0), a.1.max(b.1), a.2 & b.2),
-            );
+            let (lo, hi) = depth
+                .par_chunks(1 << 14)
+                .map(drawn_extremes)
+                .reduce(|| (u32::MAX, 0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
             let p = |b: u32| self.parallax_pixels(f32::from_bits(b));
-            let extremes = (lo != u32::MAX)
+            (lo != u32::MAX)
                 .then(|| p(lo).zip(p(hi)).map(|(a, b)| (a.min(b), a.max(b))))
-                .flatten();
-            (extremes, in_unit)
+                .flatten()
         } else {
-            let extremes =
-                depth
-                    .iter()
-                    .filter_map(|d| self.parallax_pixels(*d))
-                    .fold(None, |e, p| {
-                        let (lo, hi) = e.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
-                        Some((lo.min(p), hi.max(p)))
-                    });
-            (extremes, all_in_unit(depth))
+            depth
+                .iter()
+                .filter_map(|d| self.parallax_pixels(*d))
+                .fold(None, |e, p| {
+                    let (lo, hi) = e.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
+                    Some((lo.min(p), hi.max(p)))
+                })
         };
-        let scale = extremes.map_or(0.5, |(lo, hi)| lo.abs().max(hi.abs()).max(0.5));
-        (scale, in_unit)
+        extremes.map_or(0.5, |(lo, hi)| lo.abs().max(hi.abs()).max(0.5))
     }
 
-    fn check(&self, fb: &Framebuffer) -> Result<()> {
-        self.check_size(fb)?;
-        check_depth("parallax", fb)
-    }
-
-    /// [`Self::check`] without reading the depth values (their length only).
+    /// `fb` has the size the rig was resolved for.
     fn check_size(&self, fb: &Framebuffer) -> Result<()> {
         if (fb.width, fb.height) != (self.width, self.height) {
             return Err(Error::invalid(
@@ -167,15 +154,15 @@ impl ParallaxRig {
                 format!("the rig was resolved for {}x{}", self.width, self.height),
             ));
         }
-        check_depth_len("parallax", fb)
+        Ok(())
     }
 }
 
 /// The smallest and largest bit patterns of the drawn (< 1) depths of `c`, `(u32::MAX, 0)`
-/// when none is drawn, and whether every value lies in [0, 1] (NaN does not). For depths in
-/// [0, 1] with the sign bit cleared (so −0 reads as 0) the order of the bits is the order of
-/// the values. Eight at a time on AVX2 (`avx2::drawn_extremes`), else [`drawn_extremes_scalar`].
-fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
+/// when none is drawn. For depths in [0, 1] (a framebuffer's) with the sign bit cleared (so −0
+/// reads as 0) the order of the bits is the order of the values. Eight at a time on AVX2
+/// (`avx2::drawn_extremes`), else [`drawn_extremes_scalar`].
+fn drawn_extremes(c: &[f32]) -> (u32, u32) {
     #[cfg(target_arch = "x86_64")]
     if kernels().avx2() {
         // SAFETY: the CPU has AVX2 (checked above), the function's only requirement. The same
@@ -186,15 +173,14 @@ fn drawn_extremes(c: &[f32]) -> (u32, u32, bool) {
 }
 
 /// [`drawn_extremes`] one depth at a time, the reference.
-fn drawn_extremes_scalar(c: &[f32]) -> (u32, u32, bool) {
+fn drawn_extremes_scalar(c: &[f32]) -> (u32, u32) {
     const ONE: u32 = 0x3f80_0000;
-    c.iter().fold((u32::MAX, 0, true), |(lo, hi, ok), d| {
-        let ok = ok & (*d >= 0.0) & (*d <= 1.0);
+    c.iter().fold((u32::MAX, 0), |(lo, hi), d| {
         let b = d.to_bits() & 0x7fff_ffff;
         if b < ONE {
-            (lo.min(b), hi.max(b), ok)
+            (lo.min(b), hi.max(b))
         } else {
-            (lo, hi, ok)
+            (lo, hi)
         }
     })
 }
@@ -202,9 +188,9 @@ fn drawn_extremes_scalar(c: &[f32]) -> (u32, u32, bool) {
 /// Parallax in pixels of every pixel of `fb` (row-major), `None` on the background.
 ///
 /// # Errors
-/// A size other than the rig's, or a missing or NaN depth buffer.
+/// A size other than the rig's.
 pub fn parallax_map(fb: &Framebuffer, rig: &ParallaxRig) -> Result<Vec<Option<f64>>> {
-    rig.check(fb)?;
+    rig.check_size(fb)?;
     Ok(fb.depth.iter().map(|d| rig.parallax_pixels(*d)).collect())
 }
 
@@ -422,7 +408,7 @@ pub fn parallax_image_reference(fb: &Framebuffer, rig: &ParallaxRig) -> Result<R
 ///
 /// The same bytes as [`parallax_image_reference`] (the readable program: the parallax map, its
 /// budget, the colors), computed without the map: S from the depth extremes
-/// (`ParallaxRig::color_scale_checked`), each row's colors in parallel, four pixels at a time on
+/// (`ParallaxRig::color_scale_of`), each row's colors in parallel, four pixels at a time on
 /// AVX2 where [`kernels`] chose it (`parallax/avx2.rs`, the scalar [`parallax_color`]
 /// elsewhere), the window violations from the border pixels alone.
 ///
@@ -436,11 +422,7 @@ pub fn parallax_image(fb: &Framebuffer, rig: &ParallaxRig) -> Result<RgbaImage> 
 /// [`parallax_pixel_color`] (the same bytes).
 fn parallax_image_on(fb: &Framebuffer, rig: &ParallaxRig, kernels: Kernels) -> Result<RgbaImage> {
     rig.check_size(fb)?;
-    // The depth check in the extremes' pass; the error names the first bad pixel, as before.
-    let (scale, in_unit) = rig.color_scale_checked(&fb.depth);
-    if !in_unit {
-        check_depth("parallax", fb)?;
-    }
+    let scale = rig.color_scale_of(&fb.depth);
     let (w, n) = (fb.width as usize, fb.depth.len());
     let simd = kernels.avx2();
     // The AVX2 rows' affine form of the color scale, once per image.
@@ -480,7 +462,7 @@ fn parallax_image_on(fb: &Framebuffer, rig: &ParallaxRig, kernels: Kernels) -> R
         },
     );
     drawn?;
-    // SAFETY: the rows (`check_depth_len`: width × height depth values, one pixel each) and
+    // SAFETY: the rows (a framebuffer holds width × height depths, one pixel each) and
     // the legend wrote every one of the first n + legend_px elements, within the capacity.
     unsafe { out.set_len(n + legend_px) };
     let mut bytes = out.into_flattened();

@@ -20,7 +20,7 @@ use glam::Mat4;
 use image::RgbaImage;
 use serde::Deserialize;
 
-use super::eye_input::{check_depth, check_same_size};
+use super::eye_input::check_same_size;
 use super::remap::{Precision, Remapper, Visibility, classify, depth_slope, tolerance};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
@@ -121,7 +121,7 @@ pub fn source_texel(
 /// eyes' depth buffers (their colors are not read), `left_mvp` and `right_mvp` their matrices.
 ///
 /// # Errors
-/// Different sizes, a missing or NaN depth buffer, a singular MVP, or invalid settings.
+/// Different sizes, a singular MVP, or invalid settings.
 pub fn rds_right(
     left: &Framebuffer,
     right: &Framebuffer,
@@ -131,8 +131,6 @@ pub fn rds_right(
 ) -> Result<RgbaImage> {
     s.validate()?;
     check_same_size(left, right)?;
-    check_depth("left", left)?;
-    check_depth("right", right)?;
     let r = Remapper::new(
         right_mvp,
         left_mvp,

@@ -16,13 +16,12 @@
 //! functions below it only loop.
 
 use std::mem::MaybeUninit;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::{DMat4, DVec4, Mat4, Vec4};
 use image::RgbaImage;
 use rayon::prelude::*;
 
-use super::eye_input::{all_in_unit, check_depth, check_depth_len, check_same_size};
+use super::eye_input::check_same_size;
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 use crate::simd::{Kernels, kernels};
@@ -188,14 +187,13 @@ impl Remapper {
 /// Where every pixel of `this` lands in the other eye (row-major; `None` behind the other eye).
 ///
 /// # Errors
-/// A missing or non-finite depth buffer, or a singular MVP.
+/// A singular MVP.
 pub fn remap_coordinates(
     this: &Framebuffer,
     this_mvp: &Mat4,
     other_mvp: &Mat4,
     precision: Precision,
 ) -> Result<Vec<Option<Remapped>>> {
-    check_depth("this", this)?;
     let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
     Ok((0..this.height)
         .flat_map(|y| (0..this.width).map(move |x| (x, y)))
@@ -214,7 +212,7 @@ pub fn remap_coordinates(
 /// the same bytes (the benchmark times both).
 ///
 /// # Errors
-/// Different sizes, a missing or NaN depth buffer in `this`, or a singular MVP.
+/// Different sizes, or a singular MVP.
 pub fn remap_color_reference(
     this: &Framebuffer,
     other: &Framebuffer,
@@ -249,28 +247,18 @@ fn remap_color_on(
     kernels: Kernels,
 ) -> Result<RgbaImage> {
     check_same_size(this, other)?;
-    check_depth_len("this", this)?;
     let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
     let (w, h) = (this.width, this.height);
     let rows = RowProgram::new(&r, kernels);
     // Rows in parallel: every pixel is independent, so the bytes do not depend on the threads.
-    // Each depth row is checked as it is read (in cache), not in a pass of its own; a row
-    // program is safe on any value (NaN and out-of-range depths fail its bounds test).
     let wu = w.max(1) as usize;
-    let bad = AtomicBool::new(false);
     let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
         let depth = &this.depth[y * wu..y * wu + out.len()];
-        if !rows.run(other, y as u32, depth, out) {
-            bad.store(true, Ordering::Relaxed);
-        }
+        rows.run(other, y as u32, depth, out);
     };
     // SAFETY: `RowProgram::run` writes one pixel per depth value of the row, and the depth row
-    // is as long as the output row (`check_depth_len`: width × height values).
+    // is as long as the output row (a framebuffer holds width × height depths).
     let bytes = unsafe { super::par_fill_rows(this.depth.len(), wu, fill) };
-    if bad.into_inner() {
-        // The error `check_depth` gives, naming the first bad pixel; the image is dropped.
-        check_depth("this", this)?;
-    }
     Ok(RgbaImage::from_raw(w, h, bytes).expect("4 bytes per pixel"))
 }
 
@@ -309,34 +297,27 @@ impl<'a> RowProgram<'a> {
     }
 
     /// Row `y` of [`remap_color`]: `out[x] = remap_color_pixel(r, other, x, y, depth[x])` for
-    /// every `x < min(out.len(), depth.len())`. Returns whether every depth of the row lies in
-    /// [0, 1] (`check_depth`'s test; the AVX2 rows make it on the vectors they load anyway).
-    fn run(
-        &self,
-        other: &Framebuffer,
-        y: u32,
-        depth: &[f32],
-        out: &mut [MaybeUninit<[u8; 4]>],
-    ) -> bool {
+    /// every `x < min(out.len(), depth.len())`.
+    fn run(&self, other: &Framebuffer, y: u32, depth: &[f32], out: &mut [MaybeUninit<[u8; 4]>]) {
         #[cfg(target_arch = "x86_64")]
         if self.simd {
             let r = self.remapper;
             // SAFETY: `simd` is set only where `Kernels::avx2` found AVX2, the rows' only
             // safety condition. The same bytes as the loop below
             // (`avx2_rows_match_remap_color_pixel`).
-            return unsafe {
+            unsafe {
                 match r.precision {
                     Precision::F64 => avx2::row_f64(r, &self.ndc_x64, y, depth, other, out),
                     Precision::F32 | Precision::F32Composed => {
                         avx2::row_f32(r, &self.ndc_x32, y, depth, other, out)
                     }
                 }
-            };
+            }
+            return;
         }
         for (x, (out, d)) in out.iter_mut().zip(depth).enumerate() {
             out.write(remap_color_pixel(self.remapper, other, x as u32, y, *d));
         }
-        all_in_unit(&depth[..out.len().min(depth.len())])
     }
 }
 
@@ -438,7 +419,7 @@ pub fn classify(this_depth: f32, target: Option<(Remapped, f32)>, tolerance: f64
 /// The visibility of every pixel of `this` in `other` (row-major). Reads both depth buffers only.
 ///
 /// # Errors
-/// Different sizes, a missing or NaN depth buffer, or a singular MVP.
+/// Different sizes, or a singular MVP.
 pub fn visibility_map(
     this: &Framebuffer,
     other: &Framebuffer,
@@ -447,8 +428,6 @@ pub fn visibility_map(
     precision: Precision,
 ) -> Result<Vec<Visibility>> {
     check_same_size(this, other)?;
-    check_depth("this", this)?;
-    check_depth("other", other)?;
     let r = Remapper::new(this_mvp, other_mvp, this.width, this.height, precision)?;
     let (w, h) = (this.width, this.height);
     // Rows in parallel, collected in order: the same map for any thread count.

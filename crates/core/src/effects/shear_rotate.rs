@@ -18,7 +18,7 @@
 use glam::Mat4;
 use image::{Rgba, RgbaImage};
 
-use super::eye_input::{check_depth, check_same_size};
+use super::eye_input::check_same_size;
 use super::remap::{Precision, Remapper};
 use crate::error::Result;
 use crate::framebuffer::Framebuffer;
@@ -28,13 +28,12 @@ use crate::framebuffer::Framebuffer;
 /// background (depth 1) and for points behind the other eye.
 ///
 /// # Errors
-/// A missing or non-finite depth buffer, or a singular `this_mvp`.
+/// A singular `this_mvp`.
 pub fn vertical_parallax_map(
     this: &Framebuffer,
     this_mvp: &Mat4,
     other_mvp: &Mat4,
 ) -> Result<Vec<Option<f64>>> {
-    check_depth("shear_vs_rotate", this)?;
     let (w, h) = (this.width, this.height);
     let r = Remapper::new(this_mvp, other_mvp, w, h, Precision::F64)?;
     Ok((0..h)
