@@ -30,7 +30,7 @@ use shade_avx2::Uniforms as BlinnPhongUniforms;
 enum BlinnPhongUniforms {}
 
 /// Whether this CPU can run the AVX2 loops; they run where this holds and
-/// [`kernels`](crate::simd::kernels) chose them.
+/// [`kernels`] chose them.
 pub use crate::simd::avx2_available;
 use crate::simd::{Kernels, kernels};
 
