@@ -180,6 +180,8 @@ fn traverse_band<S: Shader>(
     opts: &RasterOptions,
     kernels: Kernels,
 ) -> usize {
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (kernels, blinn_phong);
     #[cfg(target_arch = "x86_64")]
     if !shader.writes_color() && opts.depth_test && kernels.avx2() {
         // SAFETY: `depth_triangle` requires AVX2 and POPCNT (its only safety condition),
