@@ -1,6 +1,6 @@
 //! The finalize effects in WGSL: the anaglyph family, parallax color, remap and the
 //! visibility/occlusion classes, each a [`FullscreenPass`] mirroring its CPU function in
-//! `src/effects`. They take framebuffers as input, so feeding them the CPU path's eye
+//! `stereolab-core`'s `effects`. They take framebuffers as input, so feeding them the CPU path's eye
 //! framebuffers compares the effect alone, apart from rasterization.
 //!
 //! Every number comes from the CPU modules (matrices from [`AnaglyphKind::matrices`], rig values

@@ -53,7 +53,7 @@ fn copy_tree(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()>
 /// The handout workspace's build profile: no optimization and no debug info for the grader and
 /// every dependency, proc macros included. The grader's work (64×48 fixtures, a few thousand
 /// numbers per task) takes well under a second unoptimized; what a student waits for is the
-/// first build of 106 crates (docs/performance.md, "A student's first grade").
+/// first build of the grader and its dependencies (docs/performance.md, "A student's first grade").
 pub(crate) const HANDOUT_PROFILE: &str = "\
 [profile.dev]
 opt-level = 0
