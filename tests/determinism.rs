@@ -83,7 +83,7 @@ fn sirds_bytes_do_not_depend_on_the_thread_count() {
 /// Each scene is also rendered with the other filter, so nearest and bilinear both run.
 #[test]
 fn scalar_and_avx2_loops_write_the_same_files() {
-    if !stereolab_core::raster::avx2_available() {
+    if !stereolab_core::simd::avx2_available() {
         eprintln!("scalar_and_avx2_loops_write_the_same_files: NOT RUN: no AVX2 here");
         return;
     }

@@ -169,26 +169,6 @@ impl Framebuffer {
         self.depth.fill(0.0);
     }
 
-    /// Takes `other`'s depth buffer (the same size), keeping this framebuffer's colors: a
-    /// picture drawn over another pass's depth.
-    ///
-    /// # Errors
-    /// `Invalid` when the sizes differ.
-    pub fn copy_depth_from(&mut self, other: &Framebuffer) -> Result<()> {
-        if (self.width, self.height) != (other.width, other.height) {
-            return Err(Error::invalid(
-                "depth source",
-                format!("{}x{}", other.width, other.height),
-                format!(
-                    "must be {}x{}, the framebuffer's size",
-                    self.width, self.height
-                ),
-            ));
-        }
-        self.depth.copy_from_slice(&other.depth);
-        Ok(())
-    }
-
     /// The buffers, for a caller that takes them over (an image, a texture upload).
     pub fn into_buffers(self) -> (Vec<[u8; 4]>, Vec<f32>) {
         (self.color, self.depth)

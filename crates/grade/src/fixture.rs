@@ -149,6 +149,13 @@ impl Fixture {
         fb
     }
 
+    /// A picture over `view`'s depth: `view`'s size and depths, every pixel `color`.
+    pub(crate) fn canvas_over(&self, view: &Framebuffer, color: [u8; 4]) -> Framebuffer {
+        let mut fb = view.clone();
+        fb.color_mut().fill(color);
+        fb
+    }
+
     /// Texture coordinate (OpenGL: v = 0 at the bottom row) of pixel (x, y)'s center.
     pub fn uv(&self, x: u32, y: u32) -> [f32; 2] {
         pixel_uv(self.scene.width, self.scene.height, x, y)

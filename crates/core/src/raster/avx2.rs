@@ -14,7 +14,7 @@ use super::{Band, Plane, SetupTriangle};
 /// (`render/sirds_strips/avx2.rs` in the `stereolab` crate) does.
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA ([`super::avx2_available`]).
+/// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 pub fn opaque(mut v: __m256) -> __m256 {
@@ -32,7 +32,7 @@ pub(crate) fn lane_ids() -> __m256i {
 /// Lanes `< remaining` set.
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA ([`super::avx2_available`]).
+/// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).
 #[target_feature(enable = "avx2,fma")]
 pub fn tail_mask(remaining: usize) -> __m256i {
     _mm256_cmpgt_epi32(_mm256_set1_epi32(remaining.min(8) as i32), lane_ids())
@@ -41,7 +41,7 @@ pub fn tail_mask(remaining: usize) -> __m256i {
 /// `plane.at(fx, fy)` per lane: `(a0 + dadx·fx) + dady·fy`.
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA ([`super::avx2_available`]).
+/// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).
 #[target_feature(enable = "avx2,fma")]
 pub fn plane_at(p: &Plane, fx: __m256, fy: f32) -> __m256 {
     let row = _mm256_set1_ps(p.dady * fy);
@@ -58,7 +58,7 @@ pub fn plane_at(p: &Plane, fx: __m256, fy: f32) -> __m256 {
 /// [`SetupTriangle::fx`].
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA ([`super::avx2_available`]).
+/// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 pub fn columns(t: &SetupTriangle, x: u32) -> (__m256, __m256) {
@@ -72,7 +72,7 @@ pub fn columns(t: &SetupTriangle, x: u32) -> (__m256, __m256) {
 /// `fma(dzdy, y, fma(dzdx, x, a0))` with the same two fused operations, clamped to [0, 1].
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA ([`super::avx2_available`]).
+/// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).
 #[target_feature(enable = "avx2,fma")]
 pub fn depth_at(t: &SetupTriangle, xf: __m256, y: u32) -> __m256 {
     let p = t.depth_plane();
@@ -95,7 +95,7 @@ pub(crate) fn clamp01(v: __m256) -> __m256 {
 /// `⌊v⌋` per lane for `|v| < 2³¹`: truncate, then step down where that rounded up.
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA ([`super::avx2_available`]).
+/// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).
 #[target_feature(enable = "avx2,fma")]
 pub fn floor_i32(v: __m256) -> __m256i {
     let i = _mm256_cvttps_epi32(v);
@@ -116,7 +116,7 @@ pub fn floor_i32(v: __m256) -> __m256i {
 /// [`SmallBox`]: super::SmallBox
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA ([`super::avx2_available`]).
+/// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 pub fn covered_vectors(

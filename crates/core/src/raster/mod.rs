@@ -29,9 +29,6 @@ use shade_avx2::Uniforms as BlinnPhongUniforms;
 #[cfg(not(target_arch = "x86_64"))]
 enum BlinnPhongUniforms {}
 
-/// Whether this CPU can run the AVX2 loops; they run where this holds and
-/// [`kernels`] chose them.
-pub use crate::simd::avx2_available;
 use crate::simd::{Kernels, kernels};
 
 /// Rasterizer knobs. The defaults are what lavapipe does.
@@ -168,7 +165,7 @@ fn rasterize_bands<S: Shader>(
 /// fragment stage `shade_avx2::shade_triangle` under the same conditions, with the same color
 /// and depth bits (`avx2_blinn_phong_matches_traverse`). In a
 /// depth-only pass (the shader writes no color, depth test on) where `kernels` names the
-/// AVX2 loops and [`avx2_available`], each
+/// AVX2 loops and [`crate::simd::avx2_available`], each
 /// triangle goes through the AVX2 kernel `avx2::depth_triangle` instead, which writes the same
 /// depth bits and counts the same fragments (`avx2_depth_bands_match_traverse`): `traverse`
 /// stays the scalar reference.

@@ -107,10 +107,7 @@ pub(super) fn parallax_color_task(fx: &Fixture) -> TaskSpec {
         .iter()
         .map(|s| s.2.abs())
         .fold(f32::MIN_POSITIVE, f32::max);
-    let mut canvas = fx.canvas(fx.scene.background);
-    canvas
-        .copy_depth_from(&fx.views[0])
-        .expect("the fixture's canvas and views share one size");
+    let canvas = fx.canvas_over(&fx.views[0], fx.scene.background);
     let picture = {
         let samples = samples.clone();
         move |answers: &[Option<Vec<f64>>]| {

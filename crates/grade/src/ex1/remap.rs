@@ -190,10 +190,7 @@ fn remap_direction_task(fx: &Fixture, from: usize) -> TaskSpec {
     let picture = {
         let samples = samples.clone();
         let other = fx.views[to].clone();
-        let mut canvas = fx.canvas(fx.scene.background);
-        canvas
-            .copy_depth_from(&fx.views[from])
-            .expect("the fixture's canvas and views share one size");
+        let canvas = fx.canvas_over(&fx.views[from], fx.scene.background);
         let (w, h) = fx.size();
         move |answers: &[Option<Vec<f64>>]| {
             let mut fb = canvas.clone();

@@ -7,7 +7,7 @@ use crate::plan::Shading;
 use crate::render::render_view;
 use stereolab_core::effects::sirds::depth_range;
 use stereolab_core::math::StereoRig;
-use stereolab_core::raster::avx2_available;
+use stereolab_core::simd::avx2_available;
 
 /// Whether there are AVX2 loops to compare with the scalar ones; without them (a CPU without
 /// AVX2) it says so on stderr, and every path that runs is the scalar one the other tests cover.
