@@ -39,6 +39,9 @@ pub struct GradeArgs {
     /// $CARGO_TARGET_DIR/stereolab-grade, else target/stereolab-grade).
     #[arg(long)]
     pub build_dir: Option<PathBuf>,
+    /// Wall-clock limit of one sandboxed build in seconds (as root, builds run sandboxed).
+    #[arg(long, default_value_t = 120.0)]
+    pub build_timeout: f64,
 }
 
 /// `stereolab grade batch|bundle`.
@@ -76,6 +79,9 @@ pub struct BatchArgs {
     /// The grader's build folder, shared between submissions (default as for `grade`).
     #[arg(long)]
     pub build_dir: Option<PathBuf>,
+    /// Wall-clock limit of one submission's build in seconds (every build runs sandboxed).
+    #[arg(long, default_value_t = 120.0)]
+    pub build_timeout: f64,
 }
 
 /// Arguments of `stereolab grade bundle`.
@@ -111,6 +117,7 @@ pub fn run(args: GradeArgs) -> Result<()> {
         memory_mb,
         out,
         build_dir,
+        build_timeout,
     } = args;
     match command {
         Some(GradeCommand::Batch(b)) => return batch(b),
@@ -134,7 +141,12 @@ pub fn run(args: GradeArgs) -> Result<()> {
         },
         out,
         work: build_dir.unwrap_or_else(grade::default_work_dir),
+        sandbox: grade::Policy::for_this_user(grade::Policy::Auto),
+        build_timeout: parse_build_timeout(build_timeout)?,
     };
+    if let Some(note) = grade::check_sandbox(opts.sandbox)? {
+        eprintln!("{note}");
+    }
     let report = grade::grade(&opts, grade::fixture::grading_scene()?)?;
     out!("{}", report.text());
     if let Some(path) = json {
@@ -181,6 +193,18 @@ fn parse_timeout(seconds: f64) -> Result<Duration> {
     }
 }
 
+fn parse_build_timeout(seconds: f64) -> Result<Duration> {
+    if seconds.is_finite() && (1.0..=3600.0).contains(&seconds) {
+        Ok(Duration::from_secs_f64(seconds))
+    } else {
+        Err(Error::invalid(
+            "--build-timeout",
+            seconds,
+            "must be between 1 and 3600 seconds",
+        ))
+    }
+}
+
 fn batch(args: BatchArgs) -> Result<()> {
     let jobs = args.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism()
@@ -195,6 +219,7 @@ fn batch(args: BatchArgs) -> Result<()> {
             memory: parse_memory(args.memory_mb)?,
         },
         work: args.build_dir.unwrap_or_else(grade::default_work_dir),
+        build_timeout: parse_build_timeout(args.build_timeout)?,
         submissions: args.submissions,
         out: args.out,
     };

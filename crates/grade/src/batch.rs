@@ -32,6 +32,9 @@ pub struct BatchOptions {
     pub limits: Limits,
     /// The grader's build folder, shared by all submissions.
     pub work: PathBuf,
+    /// Wall-clock limit of one submission's build (every build and task of a batch runs in
+    /// the sandbox).
+    pub build_timeout: std::time::Duration,
 }
 
 /// The most submissions graded at once: twice the machine's cores (a grading thread waits on
@@ -126,6 +129,7 @@ pub fn grade_batch(
             "must lie outside the submissions folder (it would be graded as a submission)",
         ));
     }
+    super::check_sandbox(super::Policy::Required)?;
     let subs = submissions(&opts.submissions)?;
     if subs.is_empty() {
         return Err(Error::invalid(
@@ -187,6 +191,8 @@ fn grade_one(opts: &BatchOptions, name: &str, dir: &Path) -> BatchEntry {
                     limits: opts.limits,
                     out: opts.out.join(name).join("images"),
                     work: opts.work.clone(),
+                    sandbox: super::Policy::Required,
+                    build_timeout: opts.build_timeout,
                 },
                 scene,
             )

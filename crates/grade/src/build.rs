@@ -10,20 +10,31 @@
 //!   (`BINARY --source-hash`); the grader refuses a binary whose hash differs. Compiled
 //!   dependencies (glam, serde, `exercise-api`) are shared between submissions in one target
 //!   folder, so a warm build compiles only the student's crate.
-//! - **One cargo at a time.** Cargo locks its target folder anyway; the lock here also covers
-//!   copying the executable out, so parallel graders never pick up each other's binaries.
+//! - **Sandboxed on the official paths.** There a submission compiles in the
+//!   [sandbox](crate::sandbox) as a user of its own, with a wall-clock limit: it sees its crate,
+//!   the toolchain, the registry's sources and the dependencies' artifacts (read-only, built
+//!   once from the untouched stubs into `work/deps`), and writes only its own target folder,
+//!   whose dependency artifacts are hard links to those (a build cannot change them: they are
+//!   not its user's). So `include_str!` of an outside file finds nothing, and a build that does
+//!   not end stops at its limit without holding up anyone else's.
+//! - **One cargo at a time** where builds share a target folder (a student's own run): cargo
+//!   locks it anyway; the lock here also covers copying the executable out, so parallel
+//!   graders never pick up each other's binaries.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, OnceLock};
+use std::time::Duration;
 
 use serde_json::Value;
 use sha2::{Digest, Sha256};
 
 use super::Exercise;
-use super::child::{spawn_tracked, untrack};
+use super::child::{Binary, spawn_tracked, untrack};
 use super::export::strip_solution;
+use super::sandbox::{self, Jail, Sandbox, User};
 
 /// The largest stubs file the grader reads from a submission.
 pub(crate) const MAX_STUBS_BYTES: u64 = 1 << 20;
@@ -33,6 +44,8 @@ struct Template {
     manifest: &'static str,
     lib: &'static str,
     main: &'static str,
+    /// The handout's stubs: what the dependencies' artifacts are built with.
+    stubs: &'static str,
 }
 
 fn template(ex: Exercise) -> Template {
@@ -41,16 +54,19 @@ fn template(ex: Exercise) -> Template {
             manifest: include_str!("../../../exercises/ex1_stereo/Cargo.toml"),
             lib: include_str!("../../../exercises/ex1_stereo/src/lib.rs"),
             main: include_str!("../../../exercises/ex1_stereo/src/main.rs"),
+            stubs: include_str!("../../../exercises/ex1_stereo/src/stubs.rs"),
         },
         Exercise::Ex2 => Template {
             manifest: include_str!("../../../exercises/ex2_chromadepth/Cargo.toml"),
             lib: include_str!("../../../exercises/ex2_chromadepth/src/lib.rs"),
             main: include_str!("../../../exercises/ex2_chromadepth/src/main.rs"),
+            stubs: include_str!("../../../exercises/ex2_chromadepth/src/stubs.rs"),
         },
         Exercise::Ex3 => Template {
             manifest: include_str!("../../../exercises/ex3_sirds/Cargo.toml"),
             lib: include_str!("../../../exercises/ex3_sirds/src/lib.rs"),
             main: include_str!("../../../exercises/ex3_sirds/src/main.rs"),
+            stubs: include_str!("../../../exercises/ex3_sirds/src/stubs.rs"),
         },
     }
 }
@@ -70,7 +86,9 @@ fn repository_profile() -> Result<Option<toml::Value>, String> {
 
 /// Where `exercise-api` lives (the build's only dependency besides glam and serde).
 pub(crate) fn exercise_api_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../exercises/exercise-api")
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../exercises/exercise-api");
+    // Canonical: the sandbox binds it at this path, and the shared artifacts name it so.
+    std::fs::canonicalize(&dir).unwrap_or(dir)
 }
 
 /// The build's manifest: the exercise's own, without the instructor's `solution` feature, with
@@ -145,24 +163,87 @@ impl Sources {
 /// Serializes cargo and the copy of its output (see the module documentation).
 static CARGO: Mutex<()> = Mutex::new(());
 
-/// Builds `sources` for `ex` under `work` (`work/target`: the shared target folder;
-/// `work/src/<crate>-<hash>`: the sources; `work/bin/<crate>-<hash>`: the checked executable).
-/// A binary already built from the same hash is reused. `Ok(path)` is the executable; `Err` the
-/// compiler's messages or why the build could not run.
-pub(crate) fn build(ex: Exercise, sources: &Sources, work: &Path) -> Result<PathBuf, String> {
+/// How a submission is built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildMode {
+    /// In the sandbox, as a user of its own, with its own target folder (the official paths).
+    pub sandboxed: bool,
+    /// Wall-clock limit of one sandboxed build.
+    pub timeout: Duration,
+}
+
+impl BuildMode {
+    /// The default limit of a sandboxed build (`--build-timeout`): a cold build of an exercise
+    /// crate against the shared dependencies takes seconds.
+    pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(120);
+}
+
+/// Builds `sources` for `ex` under `work` (`work/bin/<crate>-<hash>`: the checked executable;
+/// see [`BuildMode`] for where it compiles). A binary already built from the same hash is
+/// reused. `Ok` is the executable with the SHA-256 of its bytes; `Err` the compiler's messages
+/// or why the build could not run.
+pub(crate) fn build(
+    ex: Exercise,
+    sources: &Sources,
+    work: &Path,
+    mode: BuildMode,
+) -> Result<Binary, String> {
     // Absolute: the binary runs in a scratch folder of its own, where a relative path is wrong.
     let work = &std::path::absolute(work).map_err(|e| format!("{}: {e}", work.display()))?;
     let name = ex.crate_name();
     let short = &sources.hash[..16];
-    let bin = work.join("bin").join(format!("{name}-{short}"));
+    let io = |what: &Path, e: std::io::Error| format!("{}: {e}", what.display());
+    let bin_dir = work.join("bin");
+    let bin = bin_dir.join(format!("{name}-{short}"));
     if bin.is_file() && reported_hash(&bin).as_deref() == Some(&sources.hash) {
-        return Ok(bin);
+        return Binary::hashed(bin.clone()).map_err(|e| io(&bin, e));
     }
-    let dir = work.join("src").join(format!("{name}-{short}"));
-    let _turn = CARGO.lock().unwrap_or_else(|e| e.into_inner());
+    std::fs::create_dir_all(&bin_dir).map_err(|e| io(&bin_dir, e))?;
+    if sandbox::is_root() {
+        // Only the grader lists or reads the binaries; each task's sandbox binds its own.
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&bin_dir, std::fs::Permissions::from_mode(0o700))
+            .map_err(|e| io(&bin_dir, e))?;
+    }
+    if mode.sandboxed {
+        let dir = build_dir(work, name, short);
+        let built = sandboxed_build(ex, sources, work, &dir, mode.timeout);
+        let placed = built.and_then(|exe| place(&exe, &bin_dir, &bin));
+        let _ = std::fs::remove_dir_all(&dir);
+        placed?;
+    } else {
+        let dir = work.join("src").join(format!("{name}-{short}"));
+        let _turn = CARGO.lock().unwrap_or_else(|e| e.into_inner());
+        write_sources(&dir, sources)?;
+        let target = handout_target().unwrap_or_else(|| work.join("target"));
+        let exe = cargo_build(&dir, name, &target, &sources.hash)?;
+        place(&exe, &bin_dir, &bin)?;
+    }
+    match reported_hash(&bin) {
+        Some(h) if h == sources.hash => Binary::hashed(bin.clone()).map_err(|e| io(&bin, e)),
+        other => Err(format!(
+            "the built binary reports source hash {other:?}, not {}: refusing to grade code \
+             that is not this submission's",
+            sources.hash
+        )),
+    }
+}
+
+/// A folder of its own for one sandboxed build.
+fn build_dir(work: &Path, name: &str, short: &str) -> PathBuf {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    work.join("builds").join(format!(
+        "{name}-{short}-{}-{}",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ))
+}
+
+/// Writes `sources` into `dir` (emptied first).
+fn write_sources(dir: &Path, sources: &Sources) -> Result<(), String> {
     let io = |what: &Path, e: std::io::Error| format!("{}: {e}", what.display());
     if dir.exists() {
-        std::fs::remove_dir_all(&dir).map_err(|e| io(&dir, e))?;
+        std::fs::remove_dir_all(dir).map_err(|e| io(dir, e))?;
     }
     for (file, text) in &sources.files {
         let path = dir.join(file);
@@ -171,21 +252,221 @@ pub(crate) fn build(ex: Exercise, sources: &Sources, work: &Path) -> Result<Path
         }
         std::fs::write(&path, text).map_err(|e| io(&path, e))?;
     }
-    let target = handout_target().unwrap_or_else(|| work.join("target"));
-    let built = cargo_build(&dir, name, &target, &sources.hash)?;
-    let bin_dir = work.join("bin");
-    std::fs::create_dir_all(&bin_dir).map_err(|e| io(&bin_dir, e))?;
-    let partial = bin_dir.join(format!(".{name}-{short}.partial"));
-    std::fs::copy(&built, &partial).map_err(|e| io(&built, e))?;
-    std::fs::rename(&partial, &bin).map_err(|e| io(&bin, e))?;
-    match reported_hash(&bin) {
-        Some(h) if h == sources.hash => Ok(bin),
-        other => Err(format!(
-            "the built binary reports source hash {other:?}, not {}: refusing to grade code \
-             that is not this submission's",
-            sources.hash
-        )),
+    Ok(())
+}
+
+/// Copies the executable `exe` to `bin` (through a partial file: whole or not at all).
+fn place(exe: &Path, bin_dir: &Path, bin: &Path) -> Result<(), String> {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let io = |what: &Path, e: std::io::Error| format!("{}: {e}", what.display());
+    let partial = bin_dir.join(format!(
+        ".partial-{}-{}",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::copy(exe, &partial).map_err(|e| io(exe, e))?;
+    std::fs::rename(&partial, bin).map_err(|e| io(bin, e))
+}
+
+/// The toolchain the grader builds with, as the sandbox binds it.
+struct Toolchain {
+    /// `rustc --print sysroot`: rustc, cargo and the standard library.
+    sysroot: PathBuf,
+    /// Cargo's home: the registry's index and sources (read-only in the sandbox).
+    home: PathBuf,
+}
+
+fn toolchain() -> Result<&'static Toolchain, String> {
+    static TOOLCHAIN: OnceLock<Result<Toolchain, String>> = OnceLock::new();
+    TOOLCHAIN
+        .get_or_init(|| {
+            let rustc = std::env::var_os("RUSTC")
+                .map(PathBuf::from)
+                .or_else(|| {
+                    let cargo = PathBuf::from(std::env::var_os("CARGO")?);
+                    let sibling = cargo.with_file_name("rustc");
+                    sibling.is_file().then_some(sibling)
+                })
+                .unwrap_or_else(|| PathBuf::from("rustc"));
+            let out = sandbox::output_within(
+                Command::new(&rustc)
+                    .args(["--print", "sysroot"])
+                    .stdin(Stdio::null())
+                    .stdout(Stdio::piped())
+                    .stderr(Stdio::null()),
+                Duration::from_secs(60),
+            )
+            .map_err(|e| format!("cannot run {}: {e}", rustc.display()))?;
+            let sysroot = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
+            let sysroot = std::fs::canonicalize(&sysroot)
+                .map_err(|e| format!("rustc's sysroot {}: {e}", sysroot.display()))?;
+            let home = std::env::var_os("CARGO_HOME")
+                .map(PathBuf::from)
+                .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")))
+                .ok_or("neither CARGO_HOME nor HOME is set: where is cargo's registry?")?;
+            let home = std::fs::canonicalize(&home).unwrap_or(home);
+            Ok(Toolchain { sysroot, home })
+        })
+        .as_ref()
+        .map_err(Clone::clone)
+}
+
+/// The dependencies' artifacts every sandboxed build of `ex` starts from: the handout's own
+/// stubs built (trusted code, outside the sandbox) into `work/deps/target`.
+fn deps_target(ex: Exercise, work: &Path) -> Result<PathBuf, String> {
+    let _turn = CARGO.lock().unwrap_or_else(|e| e.into_inner());
+    let sources = Sources::new(ex, template(ex).stubs.to_string())?;
+    let dir = work.join("deps").join("src").join(ex.crate_name());
+    let unchanged = sources
+        .files
+        .iter()
+        .all(|(f, text)| std::fs::read_to_string(dir.join(f)).is_ok_and(|t| &t == text));
+    if !unchanged {
+        write_sources(&dir, &sources)?;
     }
+    let target = work.join("deps").join("target");
+    cargo_build(&dir, ex.crate_name(), &target, &sources.hash)
+        .map_err(|e| format!("the handout's own {} does not build: {e}", ex.crate_name()))?;
+    Ok(target)
+}
+
+/// Mirrors the artifacts under `from` into `to` as hard links, leaving out the crate `own`'s
+/// (which the build makes anew) and cargo's lock and caches.
+fn mirror(from: &Path, to: &Path, own: &str) -> std::io::Result<()> {
+    std::fs::create_dir_all(to)?;
+    for entry in std::fs::read_dir(from)? {
+        let entry = entry?;
+        let name = entry.file_name();
+        let text = name.to_string_lossy();
+        if text.contains(own) || text == ".cargo-lock" || text == ".rustc_info.json" {
+            continue;
+        }
+        let (src, dst) = (entry.path(), to.join(&name));
+        let kind = entry.file_type()?;
+        if kind.is_dir() {
+            mirror(&src, &dst, own)?;
+        } else if kind.is_file() && std::fs::hard_link(&src, &dst).is_err() {
+            std::fs::copy(&src, &dst)?;
+        }
+    }
+    Ok(())
+}
+
+/// Gives `user` the folders under `dir` and the files under `dir/src` (not the hard links to
+/// the shared artifacts, which stay the grader's and so read-only to the build).
+fn give(dir: &Path, uid: u32, files_too: bool) -> std::io::Result<()> {
+    std::os::unix::fs::chown(dir, Some(uid), Some(uid))?;
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let kind = entry.file_type()?;
+        let path = entry.path();
+        if kind.is_dir() {
+            give(&path, uid, files_too || path.ends_with("src"))?;
+        } else if files_too && kind.is_file() {
+            std::os::unix::fs::chown(&path, Some(uid), Some(uid))?;
+        }
+    }
+    Ok(())
+}
+
+/// Compiles `sources` in the sandbox, in `dir`, within `timeout`; the executable's path.
+fn sandboxed_build(
+    ex: Exercise,
+    sources: &Sources,
+    work: &Path,
+    dir: &Path,
+    timeout: Duration,
+) -> Result<PathBuf, String> {
+    let name = ex.crate_name();
+    let io = |what: &Path, e: std::io::Error| format!("{}: {e}", what.display());
+    let deps = deps_target(ex, work)?;
+    let src = dir.join("src");
+    write_sources(&src, sources)?;
+    let target = dir.join("target");
+    mirror(&deps, &target, name).map_err(|e| io(&deps, e))?;
+    let sandbox = Sandbox::get();
+    let user: Option<User> = sandbox.user();
+    if let Some(u) = &user {
+        give(dir, u.id(), false).map_err(|e| io(dir, e))?;
+    }
+    let tc = toolchain()?;
+    let mut jail = Jail {
+        ro: vec![exercise_api_dir()],
+        rw: vec![dir.to_path_buf()],
+        tmpfs: vec![tc.home.clone()],
+        env: vec![
+            (
+                "PATH".into(),
+                format!("{}/bin:/usr/bin:/bin", tc.sysroot.display()).into(),
+            ),
+            ("HOME".into(), dir.into()),
+            ("CARGO_HOME".into(), tc.home.clone().into()),
+            ("RUSTC".into(), tc.sysroot.join("bin/rustc").into()),
+            ("CARGO_TARGET_DIR".into(), target.clone().into()),
+            ("CARGO_NET_OFFLINE".into(), "true".into()),
+            ("CARGO_TERM_COLOR".into(), "never".into()),
+            ("STEREOLAB_SOURCE_HASH".into(), sources.hash.clone().into()),
+        ],
+        cwd: dir.to_path_buf(),
+    };
+    if !tc.sysroot.starts_with("/usr") {
+        jail.ro.push(tc.sysroot.clone());
+    }
+    for extra in ["registry", "config.toml", "config"] {
+        let p = tc.home.join(extra);
+        if p.exists() {
+            jail.ro.push(p);
+        }
+    }
+    let args: Vec<std::ffi::OsString> = vec![
+        "build".into(),
+        "--offline".into(),
+        "--manifest-path".into(),
+        src.join("Cargo.toml").into(),
+        "--bin".into(),
+        name.into(),
+        "--message-format=json-render-diagnostics".into(),
+    ];
+    let mut cmd = sandbox.command(&jail, user.as_ref(), &tc.sysroot.join("bin/cargo"), &args);
+    cmd.stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    super::child::limit_resources(
+        &mut cmd,
+        super::child::Rlimits {
+            memory: None,
+            cpu_seconds: Some(timeout.as_secs() * 4 + 1),
+            file_bytes: 1 << 30,
+            processes: user.as_ref().map(|_| 512),
+        },
+    );
+    let out = sandbox::output_within(&mut cmd, timeout).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::TimedOut {
+            format!(
+                "the build was stopped at its time limit of {} s: does a constant, a macro or \
+                 a type take forever to compile?",
+                timeout.as_secs()
+            )
+        } else {
+            format!("cannot run cargo in the sandbox: {e}")
+        }
+    })?;
+    drop(user); // every process of the build's user ends here
+    artifact(&out, &src, name)
+}
+
+/// The executable cargo reported building, or the compiler's errors.
+fn artifact(out: &std::process::Output, dir: &Path, name: &str) -> Result<PathBuf, String> {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        return Err(compiler_errors(&stderr, dir));
+    }
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .filter(|v| v["reason"] == "compiler-artifact" && v["target"]["name"] == name)
+        .find_map(|v| v["executable"].as_str().map(PathBuf::from))
+        .ok_or_else(|| format!("cargo built no executable named {name}:\n{stderr}"))
 }
 
 /// In a student's handout (whose copy of stereolab's manifest has no profiles), the handout
@@ -204,17 +485,34 @@ fn handout_target() -> Option<PathBuf> {
     )
 }
 
-/// The hash `bin --source-hash` prints, if it runs and prints one.
+/// The hash `bin --source-hash` prints, if it runs (in the sandbox: a submission's code may
+/// run before `main`) and prints one within 10 s.
 fn reported_hash(bin: &Path) -> Option<String> {
-    let out = tracked_output(
-        Command::new(bin)
-            .arg("--source-hash")
-            .env_clear()
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null()),
-    )
-    .ok()?;
+    let scratch = super::child::Scratch::new().ok()?;
+    let sandbox = Sandbox::get();
+    let user = sandbox.user();
+    if let Some(u) = &user {
+        std::os::unix::fs::chown(&scratch.0, Some(u.id()), Some(u.id())).ok()?;
+    }
+    let mut jail = super::child::task_jail(bin, &scratch.0);
+    // Without the answer pipe the hash goes to stdout.
+    jail.env
+        .retain(|(k, _)| k != crate::exercise::protocol::ANSWER_FD_ENV);
+    let mut cmd = sandbox.command(&jail, user.as_ref(), bin, &["--source-hash".into()]);
+    cmd.stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null());
+    super::child::limit_resources(
+        &mut cmd,
+        super::child::Rlimits {
+            memory: Some(1 << 30),
+            cpu_seconds: Some(10),
+            file_bytes: 1 << 20,
+            processes: user.as_ref().map(|_| 16),
+        },
+    );
+    let out = sandbox::output_within(&mut cmd, Duration::from_secs(10)).ok()?;
+    drop(user);
     let text = String::from_utf8(out.stdout).ok()?;
     out.status.success().then(|| text.trim().to_string())
 }
@@ -228,6 +526,8 @@ fn tracked_output(cmd: &mut Command) -> std::io::Result<std::process::Output> {
     out
 }
 
+/// `cargo build` of the crate in `dir` into `target`, outside the sandbox (the handout's own
+/// stubs, or a student's run on their own machine).
 fn cargo_build(dir: &Path, name: &str, target: &Path, hash: &str) -> Result<PathBuf, String> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let out = tracked_output(
@@ -245,16 +545,7 @@ fn cargo_build(dir: &Path, name: &str, target: &Path, hash: &str) -> Result<Path
             .stderr(Stdio::piped()),
     )
     .map_err(|e| format!("cannot run cargo: {e}"))?;
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success() {
-        return Err(compiler_errors(&stderr, dir));
-    }
-    String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
-        .filter(|v| v["reason"] == "compiler-artifact" && v["target"]["name"] == name)
-        .find_map(|v| v["executable"].as_str().map(PathBuf::from))
-        .ok_or_else(|| format!("cargo built no executable named {name}:\n{stderr}"))
+    artifact(&out, dir, name)
 }
 
 /// The error lines of a failed build (warnings and progress left out), at most 40 lines, with

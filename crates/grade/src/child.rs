@@ -1,8 +1,10 @@
-//! Running one task of a student's binary, isolated: its answers on a pipe of their own (fd 3,
-//! never stdout), its stdout and stderr drained while it runs and kept up to a cap, a fresh
-//! empty working folder, its own process group killed as a whole when the task ends, and
-//! limits on memory, CPU time, file size and core dumps. Every way the child can end is told
-//! apart ([`Ending`]), so a crash is not reported as a wrong picture.
+//! Running one task of a student's binary, isolated: in the [sandbox](crate::sandbox) (its own
+//! namespaces and, as root, its own user), its answers on a pipe of their own (fd 3, never
+//! stdout), its stdout and stderr drained while it runs and kept up to a cap, a fresh empty
+//! working folder, every process it started killed when the task ends, and limits on memory,
+//! CPU time, file size, processes and core dumps. The binary's SHA-256 is checked against its
+//! build's right before each run. Every way the child can end is told apart ([`Ending`]), so a
+//! crash is not reported as a wrong picture.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -15,6 +17,49 @@ use serde_json::Value;
 
 use crate::exercise::decode_reply;
 use crate::exercise::protocol::ANSWER_FD_ENV;
+use crate::sandbox::{Jail, Sandbox, User};
+
+/// A built submission binary and the SHA-256 of its bytes when it was built.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Binary {
+    /// The executable.
+    pub path: PathBuf,
+    /// Hex SHA-256 of the file.
+    pub sha256: String,
+}
+
+impl Binary {
+    /// `path` with the hash of its bytes now.
+    pub(crate) fn hashed(path: PathBuf) -> std::io::Result<Binary> {
+        let sha256 = file_sha256(&path)?;
+        Ok(Binary { path, sha256 })
+    }
+
+    /// `Err` unless the file still has the bytes it was built with.
+    pub(crate) fn verify(&self) -> Result<(), String> {
+        match file_sha256(&self.path) {
+            Ok(h) if h == self.sha256 => Ok(()),
+            Ok(_) => Err(format!(
+                "{} changed since it was built: refusing to run it",
+                self.path.display()
+            )),
+            Err(e) => Err(format!("{}: {e}", self.path.display())),
+        }
+    }
+}
+
+/// Hex SHA-256 of a file's bytes.
+pub(crate) fn file_sha256(path: &Path) -> std::io::Result<String> {
+    use sha2::{Digest, Sha256};
+    let bytes = std::fs::read(path)?;
+    Ok(Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect())
+}
+
+/// Processes the run's own user may have at once (root only: the limit counts per user).
+const MAX_PROCESSES: u64 = 256;
 
 /// What a task's process may use.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,10 +153,10 @@ impl Drain {
 }
 
 /// A fresh, empty working folder for one task, removed when dropped.
-struct Scratch(PathBuf);
+pub(crate) struct Scratch(pub(crate) PathBuf);
 
 impl Scratch {
-    fn new() -> std::io::Result<Scratch> {
+    pub(crate) fn new() -> std::io::Result<Scratch> {
         static NEXT: AtomicU64 = AtomicU64::new(0);
         let dir = std::env::temp_dir().join(format!(
             "stereolab-task-{}-{}",
@@ -131,7 +176,7 @@ impl Drop for Scratch {
 
 /// Runs `binary TASK` with `inputs` on stdin under `limits`. Never panics: every way the child
 /// can fail is described in the returned [`Run`].
-pub fn run(binary: &Path, task: &str, inputs: &[Value], limits: Limits) -> Run {
+pub fn run(binary: &Binary, task: &str, inputs: &[Value], limits: Limits) -> Run {
     let mut run = Run {
         replies: Vec::new(),
         ending: None,
@@ -140,9 +185,13 @@ pub fn run(binary: &Path, task: &str, inputs: &[Value], limits: Limits) -> Run {
     };
     let no_start = |e: String| Ending {
         kind: "no-start",
-        message: format!("cannot start {}: {e}", binary.display()),
+        message: format!("cannot start {}: {e}", binary.path.display()),
         hint: "the grader could not start your program (see above)",
     };
+    if let Err(e) = binary.verify() {
+        run.ending = Some(no_start(e));
+        return run;
+    }
     let scratch = match Scratch::new() {
         Ok(s) => s,
         Err(e) => {
@@ -150,7 +199,9 @@ pub fn run(binary: &Path, task: &str, inputs: &[Value], limits: Limits) -> Run {
             return run;
         }
     };
-    let (answers, mut child) = match spawn(binary, task, &scratch.0, limits) {
+    let sandbox = Sandbox::get();
+    let user = sandbox.user();
+    let (answers, mut child) = match spawn(&binary.path, task, &scratch.0, limits, user.as_ref()) {
         Ok(x) => x,
         Err(e) => {
             run.ending = Some(no_start(e.to_string()));
@@ -214,6 +265,7 @@ pub fn run(binary: &Path, task: &str, inputs: &[Value], limits: Limits) -> Run {
     kill_group(pid);
     let status = status.or_else(|| child.wait().ok());
     untrack(pid);
+    drop(user); // kills whatever else ran as the task's user
     reap_orphans();
     // Everything the task printed: the pipes end now that its processes are gone.
     run.stdout = out.take(DRAIN_WAIT);
@@ -230,7 +282,16 @@ pub fn run(binary: &Path, task: &str, inputs: &[Value], limits: Limits) -> Run {
             hint: "your code ran past the time limit: an endless loop?",
         })
     } else {
-        status.and_then(|s| classify(s, &run.stderr.0, run.replies.len(), inputs.len(), limits))
+        status.and_then(|s| {
+            classify(
+                s,
+                sandbox.protected(),
+                &run.stderr.0,
+                run.replies.len(),
+                inputs.len(),
+                limits,
+            )
+        })
     };
     run
 }
@@ -246,9 +307,23 @@ fn wait_until(child: &mut Child, deadline: Instant) -> Option<ExitStatus> {
     }
 }
 
+/// The signal that ended a process: its own, or, through the sandbox (whose first process
+/// exits with 128 + the signal of the task it ran, as a shell does), that code's.
+fn signal_of(status: ExitStatus, sandboxed: bool) -> Option<i32> {
+    #[cfg(unix)]
+    if let Some(sig) = std::os::unix::process::ExitStatusExt::signal(&status) {
+        return Some(sig);
+    }
+    match status.code() {
+        Some(c) if sandboxed && (129..=128 + 64).contains(&c) => Some(c - 128),
+        _ => None,
+    }
+}
+
 /// Tells apart the ways a process ends early. `None`: it answered everything and exited with 0.
 fn classify(
     status: ExitStatus,
+    sandboxed: bool,
     stderr: &str,
     answered: usize,
     expected: usize,
@@ -256,7 +331,7 @@ fn classify(
 ) -> Option<Ending> {
     let progress = format!("after {answered} of {expected} answers");
     #[cfg(unix)]
-    if let Some(sig) = std::os::unix::process::ExitStatusExt::signal(&status) {
+    if let Some(sig) = signal_of(status, sandboxed) {
         let (kind, message, hint) = match sig {
             libc::SIGXCPU => (
                 "cpu-limit",
@@ -317,39 +392,51 @@ fn classify(
     })
 }
 
-/// Starts `binary task` in `dir`: fd 3 the write end of the answer pipe, its own process group,
-/// a clean environment and the limits.
+/// The jail of one task: its binary (read-only) and its scratch folder, nothing else.
+pub(crate) fn task_jail(binary: &Path, dir: &Path) -> Jail {
+    let mut env: Vec<(String, std::ffi::OsString)> = vec![
+        ("PATH".into(), "/usr/bin:/bin".into()),
+        ("HOME".into(), dir.into()),
+        ("RUST_BACKTRACE".into(), "0".into()),
+        (ANSWER_FD_ENV.into(), "3".into()),
+    ];
+    // The mutation tests plant mistakes in the instructor's solution through this variable.
+    if let Some(m) = std::env::var_os("STEREOLAB_MUTANT") {
+        env.push(("STEREOLAB_MUTANT".into(), m));
+    }
+    Jail {
+        ro: vec![binary.to_path_buf()],
+        rw: vec![dir.to_path_buf()],
+        tmpfs: Vec::new(),
+        env,
+        cwd: dir.to_path_buf(),
+    }
+}
+
+/// Starts `binary task` in `dir`, in the sandbox (as `user` when given): fd 3 the write end of
+/// the answer pipe, its own process group, only its jail's environment, and the limits.
 #[cfg(unix)]
 fn spawn(
     binary: &Path,
     task: &str,
     dir: &Path,
     limits: Limits,
+    user: Option<&User>,
 ) -> std::io::Result<(std::io::PipeReader, Child)> {
     use std::os::fd::AsRawFd;
     use std::os::unix::process::CommandExt;
 
     let (reader, writer) = std::io::pipe()?;
     let wfd = writer.as_raw_fd();
-    let cpu = limits.time.as_secs() + 1;
-    let memory = limits.memory;
-    let mut cmd = Command::new(binary);
-    cmd.arg(task)
-        .current_dir(dir)
-        .env_clear()
-        .env("PATH", "/usr/bin:/bin")
-        .env("HOME", dir)
-        .env("RUST_BACKTRACE", "0")
-        .env(ANSWER_FD_ENV, "3")
-        .stdin(Stdio::piped())
+    if let Some(u) = user {
+        std::os::unix::fs::chown(dir, Some(u.id()), Some(u.id()))?;
+    }
+    let mut cmd = Sandbox::get().command(&task_jail(binary, dir), user, binary, &[task.into()]);
+    cmd.stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .process_group(0);
-    // The mutation tests plant mistakes in the instructor's solution through this variable.
-    if let Some(m) = std::env::var_os("STEREOLAB_MUTANT") {
-        cmd.env("STEREOLAB_MUTANT", m);
-    }
-    // SAFETY: between fork and exec only async-signal-safe calls (dup2, fcntl, setrlimit).
+    // SAFETY: between fork and exec only async-signal-safe calls (dup2, fcntl).
     unsafe {
         cmd.pre_exec(move || {
             if wfd == 3 {
@@ -359,23 +446,18 @@ fn spawn(
             } else if libc::dup2(wfd, 3) < 0 {
                 return Err(std::io::Error::last_os_error());
             }
-            let limit = |what, soft: u64, hard: u64| {
-                let l = libc::rlimit {
-                    rlim_cur: soft as libc::rlim_t,
-                    rlim_max: hard as libc::rlim_t,
-                };
-                if libc::setrlimit(what, &l) < 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                Ok(())
-            };
-            limit(libc::RLIMIT_AS, memory, memory)?;
-            limit(libc::RLIMIT_CPU, cpu, cpu + 1)?;
-            limit(libc::RLIMIT_FSIZE, MAX_FILE_BYTES, MAX_FILE_BYTES)?;
-            limit(libc::RLIMIT_CORE, 0, 0)?;
             Ok(())
         });
     }
+    limit_resources(
+        &mut cmd,
+        Rlimits {
+            memory: Some(limits.memory),
+            cpu_seconds: Some(limits.time.as_secs() + 1),
+            file_bytes: MAX_FILE_BYTES,
+            processes: user.map(|_| MAX_PROCESSES),
+        },
+    );
     let child = spawn_tracked(&mut cmd)?;
     drop(writer); // the child holds the only write end: EOF when it (and its group) is gone
     Ok((reader, child))
@@ -387,10 +469,59 @@ fn spawn(
     _task: &str,
     _dir: &Path,
     _limits: Limits,
+    _user: Option<&User>,
 ) -> std::io::Result<(std::io::PipeReader, Child)> {
     Err(std::io::Error::other(
         "the grader isolates tasks with Unix process groups and limits: grade on Linux or macOS",
     ))
+}
+
+/// Resource limits of a sandboxed process (and of all it starts).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rlimits {
+    /// Address space, bytes.
+    pub memory: Option<u64>,
+    /// CPU time, seconds (SIGXCPU at the soft limit, SIGKILL a second later).
+    pub cpu_seconds: Option<u64>,
+    /// Largest file written, bytes.
+    pub file_bytes: u64,
+    /// Processes of the run's own user (only when it has one: the count is per user).
+    pub processes: Option<u64>,
+}
+
+/// Sets `l` (and no core dumps) in `cmd`'s process before it starts.
+pub(crate) fn limit_resources(cmd: &mut Command, l: Rlimits) {
+    #[cfg(unix)]
+    // SAFETY: between fork and exec only async-signal-safe calls (setrlimit).
+    unsafe {
+        use std::os::unix::process::CommandExt;
+        cmd.pre_exec(move || {
+            let limit = |what, soft: u64, hard: u64| {
+                let r = libc::rlimit {
+                    rlim_cur: soft as libc::rlim_t,
+                    rlim_max: hard as libc::rlim_t,
+                };
+                if libc::setrlimit(what, &r) < 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            };
+            if let Some(m) = l.memory {
+                limit(libc::RLIMIT_AS, m, m)?;
+            }
+            if let Some(c) = l.cpu_seconds {
+                limit(libc::RLIMIT_CPU, c, c + 1)?;
+            }
+            limit(libc::RLIMIT_FSIZE, l.file_bytes, l.file_bytes)?;
+            limit(libc::RLIMIT_CORE, 0, 0)?;
+            if let Some(n) = l.processes {
+                limit(libc::RLIMIT_NPROC, n, n)?;
+            }
+            Ok(())
+        });
+    }
+    #[cfg(not(unix))]
+    let _ = (cmd, l);
 }
 
 /// Kills the task's whole process group (the task and whatever it started).

@@ -66,7 +66,13 @@ pub fn compare_exercise(
         .map(|eye| ex1::eye_view_input(&setup, &modelview, eye, lighting))
         .collect();
     child::become_subreaper();
-    let binary = submission_binary(dir, ex, solution, &default_work_dir())
+    let policy = super::Policy::for_this_user(super::Policy::Auto);
+    super::check_sandbox(policy)?;
+    let mode = super::BuildMode {
+        sandboxed: policy == super::Policy::Required,
+        timeout: super::BuildMode::DEFAULT_TIMEOUT,
+    };
+    let binary = submission_binary(dir, ex, solution, &default_work_dir(), mode)
         .map_err(|log| Error::invalid(ex.crate_name(), "cannot be built", log))?;
     let run = child::run(&binary, TASK, &inputs, limits);
     let expected = r.render_views(

@@ -19,6 +19,7 @@ pub mod fixture;
 #[cfg(feature = "gpu")]
 pub mod gpu_compare;
 pub mod report;
+pub mod sandbox;
 pub mod score;
 pub mod spec;
 
@@ -26,9 +27,11 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-pub use child::Limits;
+pub use build::BuildMode;
+pub use child::{Binary, Limits};
 use fixture::Fixture;
 use report::{ExerciseResult, Report};
+pub use sandbox::Policy;
 use score::TaskResult;
 use spec::TaskSpec;
 use stereolab::compare::{compare, write_diff_strip};
@@ -109,6 +112,33 @@ pub struct GradeOptions {
     pub out: PathBuf,
     /// The grader's build folder (shared compiled dependencies, one folder per build).
     pub work: PathBuf,
+    /// Whether every build and task must run in the sandbox (see [`sandbox`]).
+    pub sandbox: Policy,
+    /// Wall-clock limit of one sandboxed build.
+    pub build_timeout: std::time::Duration,
+}
+
+impl GradeOptions {
+    /// How submissions are built under these options: sandboxed when the policy requires it.
+    pub fn build_mode(&self) -> BuildMode {
+        BuildMode {
+            sandboxed: self.sandbox == Policy::Required,
+            timeout: self.build_timeout,
+        }
+    }
+}
+
+/// Setup error unless `policy` can be met on this machine; for a student's run without a
+/// sandbox, the note that says so (print it once).
+///
+/// # Errors
+/// [`Policy::Required`] where no sandbox can be made.
+pub fn check_sandbox(policy: Policy) -> Result<Option<String>> {
+    let sandbox = sandbox::Sandbox::get();
+    sandbox
+        .check(policy)
+        .map_err(|why| Error::invalid("sandbox", "unavailable", why))?;
+    Ok(sandbox.note())
 }
 
 /// Removes the pictures an earlier run left in `out` (`ex1_….png` and the like: only the
@@ -162,7 +192,8 @@ pub(crate) fn submission_binary(
     ex: Exercise,
     solution: bool,
     work: &Path,
-) -> std::result::Result<PathBuf, String> {
+    mode: BuildMode,
+) -> std::result::Result<Binary, String> {
     let path = stubs_path(dir, ex, solution);
     let stubs = stereolab_core::files::read_text(&path, build::MAX_STUBS_BYTES).map_err(|e| {
         if solution && !path.exists() {
@@ -175,7 +206,7 @@ pub(crate) fn submission_binary(
         }
     })?;
     let sources = build::Sources::new(ex, stubs)?;
-    build::build(ex, &sources, work)
+    build::build(ex, &sources, work, mode)
 }
 
 /// The exercises folder: `given`, else `./exercises`, else `.` when it holds `ex1_stereo`.
@@ -205,12 +236,13 @@ pub fn exercises_dir(given: Option<PathBuf>) -> Result<PathBuf> {
         })
 }
 
-fn inputs_of(spec: &TaskSpec) -> Vec<Value> {
+/// The inputs of one task's public run: its cases, then its image check's inputs. The hidden
+/// cases go to a process of their own ([`score::evaluate`]).
+fn public_inputs(spec: &TaskSpec) -> Vec<Value> {
     let mut v: Vec<Value> = spec.cases.iter().map(|c| c.input.clone()).collect();
     if let Some(img) = &spec.image {
         v.extend(img.inputs.iter().cloned());
     }
-    v.extend(spec.hidden.iter().map(|c| c.input.clone()));
     v
 }
 
@@ -221,37 +253,44 @@ fn inputs_of(spec: &TaskSpec) -> Vec<Value> {
 /// Only setup problems (an exercise crate missing, the scene invalid): a student's compile
 /// error, panic, endless loop or NaN is a result in the report.
 pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
+    check_sandbox(opts.sandbox)?;
     let fx = Fixture::new(scene)?;
     child::become_subreaper();
     clear_old_pictures(&opts.out);
     let mut exercises = Vec::new();
     for &ex in &opts.exercises {
         let specs = ex.tasks(&fx);
-        let result = match submission_binary(&opts.dir, ex, opts.solution, &opts.work) {
-            Err(log) => ExerciseResult {
-                exercise: ex,
-                build_error: Some(log),
-                tasks: specs
-                    .iter()
-                    .map(|s| TaskResult::not_built(ex.id(), s))
-                    .collect(),
-            },
-            Ok(binary) => {
-                let mut tasks: Vec<TaskResult> = specs
-                    .iter()
-                    .map(|s| {
-                        let run = child::run(&binary, s.name, &inputs_of(s), opts.limits);
-                        score::evaluate(ex.id(), s, &run, &opts.out)
-                    })
-                    .collect();
-                score::blame_dependencies(&specs, &mut tasks);
-                ExerciseResult {
+        let result =
+            match submission_binary(&opts.dir, ex, opts.solution, &opts.work, opts.build_mode()) {
+                Err(log) => ExerciseResult {
                     exercise: ex,
-                    build_error: None,
-                    tasks,
+                    build_error: Some(log),
+                    tasks: specs
+                        .iter()
+                        .map(|s| TaskResult::not_built(ex.id(), s))
+                        .collect(),
+                },
+                Ok(binary) => {
+                    let mut tasks: Vec<TaskResult> = specs
+                        .iter()
+                        .map(|s| {
+                            let run = child::run(&binary, s.name, &public_inputs(s), opts.limits);
+                            let hidden = (!s.hidden.is_empty()).then(|| {
+                                let inputs: Vec<Value> =
+                                    s.hidden.iter().map(|c| c.input.clone()).collect();
+                                child::run(&binary, s.name, &inputs, opts.limits)
+                            });
+                            score::evaluate(ex.id(), s, &run, hidden.as_ref(), &opts.out)
+                        })
+                        .collect();
+                    score::blame_dependencies(&specs, &mut tasks);
+                    ExerciseResult {
+                        exercise: ex,
+                        build_error: None,
+                        tasks,
+                    }
                 }
-            }
-        };
+            };
         exercises.push(result);
     }
     Ok(Report { exercises })
@@ -273,7 +312,12 @@ pub fn render_exercise(
 ) -> Result<Vec<String>> {
     let fx = Fixture::new(scene)?;
     child::become_subreaper();
-    let binary = submission_binary(dir, ex, solution, &default_work_dir())
+    let mode = BuildMode {
+        sandboxed: Policy::for_this_user(Policy::Auto) == Policy::Required,
+        timeout: BuildMode::DEFAULT_TIMEOUT,
+    };
+    check_sandbox(Policy::for_this_user(Policy::Auto))?;
+    let binary = submission_binary(dir, ex, solution, &default_work_dir(), mode)
         .map_err(|log| Error::invalid(ex.crate_name(), "cannot be built", log))?;
     let mut lines = Vec::new();
     for spec in ex.tasks(&fx) {

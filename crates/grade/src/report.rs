@@ -120,8 +120,16 @@ impl Report {
         self.text_with(true)
     }
 
-    /// [`Report::text`], with or without the hidden cases' details (inputs and answers).
+    /// [`Report::text`] with everything (`hidden_details`), or the public part alone: each
+    /// task's points and the totals without its hidden cases, no line about them, and the
+    /// public points in place of the verdict (which would tell how the hidden cases went).
     fn text_with(&self, hidden_details: bool) -> String {
+        let part = |t: &TaskResult| -> (f64, f64) {
+            match (&t.hidden, hidden_details) {
+                (Some(h), false) => (round2(t.score - h.score), round2(t.points - h.points)),
+                _ => (t.score, t.points),
+            }
+        };
         let mut s = String::new();
         let _ = writeln!(
             s,
@@ -143,31 +151,37 @@ impl Report {
                 } else {
                     t.name.to_string()
                 };
+                let (score, points) = part(t);
                 let _ = writeln!(
                     s,
                     "{:<4} {:<30} {:>6.2} / {:<4} {:>8} {:>7}",
                     e.exercise.id(),
                     name,
-                    t.score,
-                    t.points,
+                    score,
+                    points,
                     format!("{}/{}", t.passed, t.total),
                     image
                 );
             }
+            let score: f64 = e.tasks.iter().map(|t| part(t).0).sum();
+            let max: f64 = e.tasks.iter().filter(|t| !t.bonus).map(|t| part(t).1).sum();
             let _ = writeln!(
                 s,
                 "{:<4} {:<30} {:>6.2} / {:<4}",
                 e.exercise.id(),
                 "total",
-                e.score(),
-                e.max()
+                round2(score),
+                round2(max)
             );
         }
         let failing: Vec<&TaskResult> = self
             .exercises
             .iter()
             .flat_map(|e| &e.tasks)
-            .filter(|t| t.score < t.points)
+            .filter(|t| {
+                let (score, points) = part(t);
+                score < points
+            })
             .collect();
         if !failing.is_empty() {
             let _ = writeln!(s, "\nTasks that lost points:");
@@ -181,23 +195,44 @@ impl Report {
             for d in &t.details {
                 let _ = writeln!(s, "  {d}");
             }
-            if let Some(h) = &t.hidden {
+            if let (Some(h), true) = (&t.hidden, hidden_details) {
                 let _ = writeln!(
                     s,
                     "  hidden cases: {}/{} passed, {:.2} of {:.2} points",
                     h.passed, h.total, h.score, h.points
                 );
-                if hidden_details {
-                    for d in &h.details {
-                        let _ = writeln!(s, "    {d}");
-                    }
+                for d in &h.details {
+                    let _ = writeln!(s, "    {d}");
                 }
             }
             if let Some((id, text)) = &t.hint {
                 let _ = writeln!(s, "  hint [{id}]: {text}");
             }
         }
-        let _ = writeln!(s, "\n{}", self.verdict());
+        let hidden_points: f64 = self
+            .exercises
+            .iter()
+            .flat_map(|e| &e.tasks)
+            .filter_map(|t| t.hidden.as_ref().filter(|_| !t.bonus).map(|h| h.points))
+            .sum();
+        if hidden_details || hidden_points == 0.0 {
+            let _ = writeln!(s, "\n{}", self.verdict());
+        } else {
+            let public: f64 = self
+                .exercises
+                .iter()
+                .flat_map(|e| &e.tasks)
+                .map(|t| part(t).0)
+                .sum();
+            let _ = writeln!(
+                s,
+                "\npublic cases: {:.2} of {:.2} points; the hidden cases ({:.2} points) and \
+                 the verdict are published with the grades",
+                round2(public),
+                round2(self.max() - hidden_points),
+                round2(hidden_points)
+            );
+        }
         s
     }
 

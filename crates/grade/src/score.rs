@@ -278,16 +278,18 @@ fn tally(cases: &[Case], replies: &[Result<Vec<f64>, String>], tol: &Tolerance) 
     t
 }
 
-/// Scores `spec` from `run`; failing pictures are written to `out_dir` as
-/// `expected | diff | actual` strips named `<exercise>_<picture>.png`.
+/// Scores `spec` from `run` (the public cases and the image check's inputs) and `hidden_run`
+/// (the hidden cases, answered by a process of their own, so nothing the public run prints can
+/// show them); failing pictures are written to `out_dir` as `expected | diff | actual` strips
+/// named `<exercise>_<picture>.png`.
 pub(crate) fn evaluate(
     exercise: &'static str,
     spec: &TaskSpec,
     run: &Run,
+    hidden_run: Option<&Run>,
     out_dir: &Path,
 ) -> TaskResult {
     let n = spec.cases.len();
-    let image_n = spec.image.as_ref().map_or(0, |img| img.inputs.len());
     let replies = |from: usize| {
         run.replies
             .get(from.min(run.replies.len())..)
@@ -342,9 +344,24 @@ pub(crate) fn evaluate(
         Some(ok) => (1.0 - IMAGE_SHARE) * frac + IMAGE_SHARE * f64::from(u8::from(ok)),
         None => frac,
     };
-    // Hidden cases (after the image inputs): HIDDEN_SHARE of the points when there are any.
+    // Hidden cases, from their own run: HIDDEN_SHARE of the points when there are any.
     let hidden = (!spec.hidden.is_empty()).then(|| {
-        let t = tally(&spec.hidden, replies(n + image_n), &spec.tolerance);
+        let empty = Run {
+            replies: Vec::new(),
+            ending: None,
+            stdout: (String::new(), 0),
+            stderr: (String::new(), 0),
+        };
+        let hrun = hidden_run.unwrap_or(&empty);
+        let mut t = tally(&spec.hidden, &hrun.replies, &spec.tolerance);
+        if let Some(e) = &hrun.ending {
+            t.details.push(format!("your program {}", e.message));
+        }
+        for (what, (text, total)) in [("stdout", &hrun.stdout), ("stderr", &hrun.stderr)] {
+            if *total > 0 {
+                t.details.push(printed(what, text, *total));
+            }
+        }
         let points = spec.points * HIDDEN_SHARE;
         let frac = t.passed as f64 / spec.hidden.len() as f64;
         HiddenResult {
