@@ -137,18 +137,15 @@ fn a_process_left_behind_by_a_task_cannot_change_the_results() {
     let results = dir.join("results.json");
     // Two ways to outlive the task: a plain child in its process group, and one in a new
     // session of its own (`setsid`), both rewriting results.json a second later.
-    // Each leaves a marker first, to prove it ran (a forger that never started proves nothing),
-    // and the task waits (at most 10 s) for that marker before it returns, so that on a busy
-    // machine the grader's end of task cannot come before the forger has started.
+    // Each says it started on the task's stderr and leaves a marker in the task's folder
+    // first, to prove it ran (a forger that never started proves nothing), and the task waits
+    // (at most 5 s) for that marker before it returns, so that on a busy machine the grader's
+    // end of task cannot come before the forger has started.
     let forge = |how: &str| {
-        let marker = format!(
-            "{}/started-{}",
-            dir.display(),
-            if how.is_empty() { "plain" } else { how }
-        );
+        let label = if how.is_empty() { "plain" } else { how };
         format!(
-            "std::process::Command::new(\"sh\").args([\"-c\", \"{how} sh -c 'touch {marker}; sleep 1; echo forged > {}'\"]).spawn().ok(); \
-             for _ in 0..1000 {{ if std::path::Path::new(\"{marker}\").exists() {{ break; }} std::thread::sleep(std::time::Duration::from_millis(10)); }}",
+            "std::process::Command::new(\"sh\").args([\"-c\", \"{how} sh -c 'echo started-{label} >&2; touch started-{label}; sleep 1; echo forged > {}'\"]).spawn().ok(); \
+             for _ in 0..500 {{ if std::path::Path::new(\"started-{label}\").exists() {{ break; }} std::thread::sleep(std::time::Duration::from_millis(10)); }}",
             results.display()
         )
     };
@@ -165,10 +162,14 @@ fn a_process_left_behind_by_a_task_cannot_change_the_results() {
     assert_eq!(score(&v), 5.0, "{v}");
     let written = std::fs::read_to_string(&results).unwrap();
     std::thread::sleep(Duration::from_millis(2500));
+    let texgen = test_named(&v, "ex2 texgen")["output"]
+        .as_str()
+        .unwrap()
+        .to_string();
     for how in ["plain", "setsid"] {
         assert!(
-            dir.join(format!("started-{how}")).is_file(),
-            "the {how} forger never ran: the test would prove nothing"
+            texgen.contains(&format!("started-{how}")),
+            "the {how} forger never ran: the test would prove nothing\n{texgen}"
         );
     }
     assert_eq!(

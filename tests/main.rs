@@ -23,6 +23,7 @@ mod gpu_parity;
 mod gpu_sirds;
 mod grading;
 mod grading_batch;
+mod grading_sandbox;
 mod grading_trust;
 mod hard_cases;
 mod image_shift;

@@ -185,6 +185,62 @@ pub(crate) fn stubs_path(dir: &Path, ex: Exercise, solution: bool) -> PathBuf {
     }
 }
 
+/// The stubs file at `path` inside the submission `dir`, as the bytes of a regular file: a
+/// symbolic link (the file or a folder on the way from `dir`) or a special file is refused with
+/// that reason, never followed (it could name a file of the grader's machine).
+fn read_stubs(path: &Path, dir: &Path) -> Result<String> {
+    let refuse = |p: &Path, what: &str| {
+        Error::io(
+            p,
+            std::io::Error::other(format!(
+                "refusing to read it: it is {what}; submit the file itself"
+            )),
+        )
+    };
+    let rel = path.strip_prefix(dir).unwrap_or(path);
+    let mut at = dir.to_path_buf();
+    for part in rel.components() {
+        at.push(part);
+        match std::fs::symlink_metadata(&at) {
+            Ok(m) if m.file_type().is_symlink() => return Err(refuse(&at, "a symbolic link")),
+            Ok(_) => {}
+            Err(e) => return Err(Error::io(&at, e)),
+        }
+    }
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW);
+    let file = options.open(path).map_err(|e| Error::io(path, e))?;
+    let meta = file.metadata().map_err(|e| Error::io(path, e))?;
+    if !meta.is_file() {
+        return Err(refuse(
+            path,
+            "not a regular file (a folder, device, FIFO or socket)",
+        ));
+    }
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(file, build::MAX_STUBS_BYTES + 1),
+        &mut bytes,
+    )
+    .map_err(|e| Error::io(path, e))?;
+    if bytes.len() as u64 > build::MAX_STUBS_BYTES {
+        return Err(Error::parse(
+            path,
+            None,
+            format!("more than the {} bytes accepted", build::MAX_STUBS_BYTES),
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        Error::parse(
+            path,
+            None,
+            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        )
+    })
+}
+
 /// Builds the binary of `ex` from the submission in `dir` (see [`build`]); `Err` is what to
 /// tell the student: the compiler's messages, or the file that is missing.
 pub(crate) fn submission_binary(
@@ -195,7 +251,7 @@ pub(crate) fn submission_binary(
     mode: BuildMode,
 ) -> std::result::Result<Binary, String> {
     let path = stubs_path(dir, ex, solution);
-    let stubs = stereolab_core::files::read_text(&path, build::MAX_STUBS_BYTES).map_err(|e| {
+    let stubs = read_stubs(&path, dir).map_err(|e| {
         if solution && !path.exists() {
             format!(
                 "no {} here: the instructor's solution is not part of a handout ({e})",

@@ -408,7 +408,8 @@ pub(crate) fn output_within(
 ) -> std::io::Result<std::process::Output> {
     #[cfg(unix)]
     std::os::unix::process::CommandExt::process_group(cmd, 0);
-    let child = cmd.spawn()?;
+    // Known to the grader as its own while it runs (see `child::reap_orphans`).
+    let child = crate::child::spawn_tracked(cmd)?;
     let pid = child.id();
     let deadline = Instant::now() + limit;
     let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
@@ -427,6 +428,7 @@ pub(crate) fn output_within(
         }
     });
     let out = child.wait_with_output();
+    crate::child::untrack(pid);
     let _ = done_tx.send(());
     let _ = watchdog.join();
     if Instant::now() >= deadline {
