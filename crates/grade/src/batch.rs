@@ -222,7 +222,7 @@ fn write_entry(out: &Path, entry: &BatchEntry) -> Result<()> {
 }
 
 /// A CSV field: quoted when it holds a comma, quote or line break.
-fn csv_field(s: &str) -> String {
+pub(crate) fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {

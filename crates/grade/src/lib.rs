@@ -20,6 +20,7 @@ pub mod fixture;
 pub mod gpu_compare;
 pub mod report;
 pub mod score;
+pub mod similarity;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
