@@ -46,7 +46,8 @@ pub struct GradeArgs {
 pub enum GradeCommand {
     /// Grade every submission folder in SUBMISSIONS_DIR (each holding the handout's
     /// `<crate>/src/stubs.rs`, directly or one folder down): RESULTS_DIR/<submission>/results.json
-    /// and report.txt, and RESULTS_DIR/scores.csv.
+    /// and report.txt, RESULTS_DIR/scores.csv, and RESULTS_DIR/similarity.csv (similar
+    /// functions among the submissions and the reference solution).
     Batch(BatchArgs),
     /// Write the Gradescope autograder zip (setup.sh, run_autograder, the grader's sources; no
     /// solutions) and, with --classroom, a GitHub Classroom workflow.
@@ -76,6 +77,10 @@ pub struct BatchArgs {
     /// The grader's build folder, shared between submissions (default as for `grade`).
     #[arg(long)]
     pub build_dir: Option<PathBuf>,
+    /// Flag pairs of functions at least this similar in RESULTS_DIR/similarity.csv (0 to 1; a
+    /// reason to look, never a change of score).
+    #[arg(long, default_value_t = grade::similarity::DEFAULT_THRESHOLD)]
+    pub similarity_threshold: f64,
 }
 
 /// Arguments of `stereolab grade bundle`.
@@ -197,6 +202,7 @@ fn batch(args: BatchArgs) -> Result<()> {
         work: args.build_dir.unwrap_or_else(grade::default_work_dir),
         submissions: args.submissions,
         out: args.out,
+        similarity_threshold: grade::similarity::check_threshold(args.similarity_threshold)?,
     };
     let count = grade::batch::submissions(&opts.submissions)?.len() as u64;
     let bar = indicatif::ProgressBar::new(count).with_style(
@@ -220,6 +226,19 @@ fn batch(args: BatchArgs) -> Result<()> {
         "graded {} submissions: {passed} passed, {errors} not graded; scores in {}",
         entries.len(),
         opts.out.join("scores.csv").display()
+    );
+    let similar = grade::similarity::Summary::read(&opts.out)?;
+    outln!(
+        "similarity: {} pairs of functions flagged (similarity at least {}) of {} listed in {}{}",
+        similar.flagged,
+        opts.similarity_threshold,
+        similar.pairs,
+        opts.out.join(grade::similarity::FILE_NAME).display(),
+        similar
+            .notes
+            .iter()
+            .map(|n| format!("; {n}"))
+            .collect::<String>()
     );
     Ok(())
 }
