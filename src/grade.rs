@@ -49,7 +49,8 @@ pub struct GradeArgs {
 pub enum GradeCommand {
     /// Grade every submission folder in SUBMISSIONS_DIR (each holding the handout's
     /// `<crate>/src/stubs.rs`, directly or one folder down): RESULTS_DIR/<submission>/results.json
-    /// and report.txt, and RESULTS_DIR/scores.csv.
+    /// and report.txt, RESULTS_DIR/scores.csv, and RESULTS_DIR/similarity.csv (similar
+    /// functions among the submissions and the reference solution).
     Batch(BatchArgs),
     /// Write the Gradescope autograder zip (setup.sh, run_autograder, the grader's sources; no
     /// solutions) and, with --classroom, a GitHub Classroom workflow.
@@ -82,6 +83,10 @@ pub struct BatchArgs {
     /// Wall-clock limit of one submission's build in seconds (every build runs sandboxed).
     #[arg(long, default_value_t = 120.0)]
     pub build_timeout: f64,
+    /// Flag pairs of functions at least this similar in RESULTS_DIR/similarity.csv (0 to 1; a
+    /// reason to look, never a change of score).
+    #[arg(long, default_value_t = grade::similarity::DEFAULT_THRESHOLD)]
+    pub similarity_threshold: f64,
 }
 
 /// Arguments of `stereolab grade bundle`.
@@ -222,6 +227,7 @@ fn batch(args: BatchArgs) -> Result<()> {
         build_timeout: parse_build_timeout(args.build_timeout)?,
         submissions: args.submissions,
         out: args.out,
+        similarity_threshold: grade::similarity::check_threshold(args.similarity_threshold)?,
     };
     let count = grade::batch::submissions(&opts.submissions)?.len() as u64;
     let bar = indicatif::ProgressBar::new(count).with_style(
@@ -245,6 +251,19 @@ fn batch(args: BatchArgs) -> Result<()> {
         "graded {} submissions: {passed} passed, {errors} not graded; scores in {}",
         entries.len(),
         opts.out.join("scores.csv").display()
+    );
+    let similar = grade::similarity::Summary::read(&opts.out)?;
+    outln!(
+        "similarity: {} pairs of functions flagged (similarity at least {}) of {} listed in {}{}",
+        similar.flagged,
+        opts.similarity_threshold,
+        similar.pairs,
+        opts.out.join(grade::similarity::FILE_NAME).display(),
+        similar
+            .notes
+            .iter()
+            .map(|n| format!("; {n}"))
+            .collect::<String>()
     );
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! `stereolab grade batch`: every submission in a folder, graded on a bounded number of threads,
-//! one `results.json` and `report.txt` each and a `scores.csv` of all.
+//! one `results.json` and `report.txt` each, a `scores.csv` of all and a `similarity.csv` (see
+//! [`super::similarity`]).
 //!
 //! A submission is one subfolder of the batch folder, holding the handout's layout
 //! (`<crate>/src/stubs.rs`), directly or one folder further down (`alice/ex1_stereo/src/stubs.rs`
@@ -35,6 +36,8 @@ pub struct BatchOptions {
     /// Wall-clock limit of one submission's build (every build and task of a batch runs in
     /// the sandbox).
     pub build_timeout: std::time::Duration,
+    /// Pairs of functions at least this similar are flagged in `similarity.csv`.
+    pub similarity_threshold: f64,
 }
 
 /// The most submissions graded at once: twice the machine's cores (a grading thread waits on
@@ -104,8 +107,8 @@ pub fn submissions(dir: &Path) -> Result<Vec<(String, PathBuf)>> {
 }
 
 /// Grades every submission of `opts.submissions` on `opts.jobs` threads, writing each one's
-/// `results.json` and `report.txt` as it finishes and `scores.csv` at the end; `done` is called
-/// once per submission (the progress bar). Returns the entries sorted by name.
+/// `results.json` and `report.txt` as it finishes, `scores.csv` and `similarity.csv` at the end;
+/// `done` is called once per submission (the progress bar). Returns the entries sorted by name.
 ///
 /// # Errors
 /// Bad options (no submissions, `jobs` out of range) or an unwritable results folder; a
@@ -176,6 +179,12 @@ pub fn grade_batch(
         &csv_path,
         scores_csv(&opts.exercises, &entries).as_bytes(),
     )?;
+    super::similarity::write_batch_report(
+        &subs,
+        &opts.exercises,
+        opts.similarity_threshold,
+        &opts.out,
+    )?;
     Ok(entries)
 }
 
@@ -228,7 +237,7 @@ fn write_entry(out: &Path, entry: &BatchEntry) -> Result<()> {
 }
 
 /// A CSV field: quoted when it holds a comma, quote or line break.
-fn csv_field(s: &str) -> String {
+pub(crate) fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {

@@ -21,6 +21,7 @@ pub mod gpu_compare;
 pub mod report;
 pub mod sandbox;
 pub mod score;
+pub mod similarity;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
