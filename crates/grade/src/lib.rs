@@ -18,6 +18,7 @@ pub mod export;
 pub mod fixture;
 #[cfg(feature = "gpu")]
 pub mod gpu_compare;
+pub mod points;
 pub mod report;
 pub mod score;
 pub mod spec;
@@ -51,7 +52,7 @@ impl Exercise {
     pub const ALL: [Exercise; 3] = [Exercise::Ex1, Exercise::Ex2, Exercise::Ex3];
 
     /// `ex1`, `ex2`, `ex3`.
-    pub(crate) fn id(self) -> &'static str {
+    pub fn id(self) -> &'static str {
         match self {
             Exercise::Ex1 => "ex1",
             Exercise::Ex2 => "ex2",
