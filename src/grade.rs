@@ -55,6 +55,9 @@ pub enum GradeCommand {
     /// Write the Gradescope autograder zip (setup.sh, run_autograder, the grader's sources; no
     /// solutions) and, with --classroom, a GitHub Classroom workflow.
     Bundle(BundleArgs),
+    /// Print every task's points, each exercise's total and the total to reach (bonus
+    /// excluded): the figure to set an assignment's points to.
+    Points,
 }
 
 /// Arguments of `stereolab grade batch`.
@@ -127,13 +130,20 @@ pub fn run(args: GradeArgs) -> Result<()> {
     match command {
         Some(GradeCommand::Batch(b)) => return batch(b),
         Some(GradeCommand::Bundle(b)) => return bundle(b),
+        Some(GradeCommand::Points) => {
+            out!(
+                "{}",
+                grade::points::points_text(&grade::points::points_table()?)
+            );
+            return Ok(());
+        }
         None => {}
     }
     let exercise = exercise.ok_or_else(|| {
         Error::invalid(
             "EXERCISE",
             "",
-            "expected ex1, ex2, ex3, all, batch or bundle",
+            "expected ex1, ex2, ex3, all, batch, bundle or points",
         )
     })?;
     let opts = grade::GradeOptions {

@@ -13,6 +13,8 @@ use std::sync::{Mutex, MutexGuard};
 use serde_json::Value;
 
 use crate::common::{out_dir, root};
+use stereolab_grade::Exercise;
+use stereolab_grade::points;
 
 static BUILDS: Mutex<()> = Mutex::new(());
 
@@ -106,8 +108,13 @@ pub(crate) fn test_named<'a>(v: &'a Value, name: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no test {name} in {v}"))
 }
 
+/// The points to reach and the bonus points of `exercises`, from the task specs.
+pub(crate) fn spec_totals(exercises: &[Exercise]) -> (f64, f64) {
+    points::totals(&points::points_table().expect("the specs"), exercises)
+}
+
 /// A test's points for a complete answer: its `max_score`, or for a bonus task (extra credit,
-/// `max_score` 0) the bonus points, which the full report's table states.
+/// `max_score` 0) the bonus points its spec gives.
 pub(crate) fn full_points(t: &Value) -> f64 {
     let max = t["max_score"].as_f64().expect("max_score");
     if t["tags"]
@@ -115,7 +122,13 @@ pub(crate) fn full_points(t: &Value) -> f64 {
         .is_some_and(|tags| tags.iter().any(|x| x == "bonus"))
     {
         assert_eq!(max, 0.0, "a bonus test is extra credit: {t}");
-        1.0
+        let name = t["name"].as_str().unwrap_or_default();
+        points::points_table()
+            .expect("the specs")
+            .iter()
+            .find(|p| name == format!("{} {} (bonus)", p.exercise.id(), p.name))
+            .unwrap_or_else(|| panic!("no bonus task {name} in the specs"))
+            .points
     } else {
         max
     }
@@ -128,11 +141,15 @@ fn solution_scores_full_marks_on_every_task() {
     for t in tests_of(&v) {
         assert_eq!(t["status"], "passed", "{}: {}", t["name"], t["output"]);
     }
-    // 19 + 5 + 5 points, plus ex1's Dubois bonus point.
-    assert_eq!(v["score"].as_f64(), Some(30.0), "{v}");
+    // Every point to reach and every bonus point.
+    let (reach, bonus) = spec_totals(&Exercise::ALL);
+    assert_eq!(v["score"].as_f64(), Some(reach + bonus), "{v}");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        stdout.contains("\nPASSED: 30.00 of 29.00 points"),
+        stdout.contains(&format!(
+            "\nPASSED: {:.2} of {reach:.2} points",
+            reach + bonus
+        )),
         "{stdout}"
     );
 }
@@ -158,8 +175,9 @@ fn untouched_stubs_score_zero_and_the_grader_exits_cleanly_with_the_table() {
         stdout.contains("ex1  frustum"),
         "the points table:\n{stdout}"
     );
+    let (reach, _) = spec_totals(&Exercise::ALL);
     assert!(
-        stdout.contains("NOT PASSED: 0.00 of 29.00 points"),
+        stdout.contains(&format!("NOT PASSED: 0.00 of {reach:.2} points")),
         "{stdout}"
     );
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
@@ -197,13 +215,14 @@ fn check_planted(what: &str, planted: &[Planted], name: &str) {
                 "{}: {task} should get hint [{hint}]:\n{output}",
                 p.mutant
             );
-            // A known mistake explains every failing answer: systematic, no partial credit.
-            // (Crashes, NaN and the dependency hint are not such a diagnosis.)
+            // A recognised mistake is named and keeps the partial credit of the checks that
+            // pass (the details say so); crashes, NaN and the dependency hint are no such
+            // diagnosis.
             if !["nan", "timeout", "depends-on"].contains(hint) {
-                assert_eq!(
-                    t["score"].as_f64(),
-                    Some(0.0),
-                    "{}: {task} has a systematic mistake: {output}",
+                assert!(
+                    output.contains(&format!("known mistake [{hint}]"))
+                        && output.contains("scores the checks that pass"),
+                    "{}: {task} names its mistake and scores its checks: {output}",
                     p.mutant
                 );
             }
@@ -315,7 +334,7 @@ fn d_instead_of_half_d_in_the_rig_loses_points_with_its_hint() {
 }
 
 #[test]
-fn mv_t_order_one_sided_depth_hue_to_360_and_degrees_lose_all_points_with_their_hints() {
+fn mv_t_order_one_sided_depth_hue_to_360_and_degrees_lose_points_with_their_hints() {
     check_planted(
         "all",
         &[
@@ -979,4 +998,52 @@ fn compare_exercise_without_the_gpu_feature_is_a_clear_error() {
         err.starts_with("error: ") && err.contains("built without the GPU path"),
         "{err}"
     );
+}
+
+/// `(2 points`, `1 bonus point`, `points to 23`: a figure quoted next to the word.
+fn quoted_points(text: &str) -> Vec<String> {
+    let words: Vec<&str> = text.split_whitespace().collect();
+    let number = |w: &str| {
+        w.trim_matches(|c: char| !c.is_ascii_digit() && c != '.')
+            .parse::<f64>()
+            .is_ok()
+    };
+    words
+        .windows(3)
+        .filter(|w| {
+            let point = |x: &str| {
+                x.trim_matches(|c: char| !c.is_alphabetic())
+                    .starts_with("point")
+            };
+            (number(w[0]) && (point(w[1]) || (w[1] == "bonus" && point(w[2]))))
+                || (point(w[0]) && w[1] == "to" && number(w[2]))
+        })
+        .map(|w| w.join(" "))
+        .collect()
+}
+
+#[test]
+fn the_stubs_and_the_instructors_guide_quote_no_points_and_name_where_they_are_printed() {
+    assert_eq!(
+        quoted_points("Task `a` (2 points, image check)"),
+        ["(2 points, image"]
+    );
+    assert_eq!(quoted_points("(1 bonus point)").len(), 1);
+    assert_eq!(
+        quoted_points("set the points to 23: the"),
+        ["points to 23:"]
+    );
+    let guide = std::fs::read_to_string(root().join("exercises/INSTRUCTORS.md")).unwrap();
+    assert_eq!(
+        quoted_points(&guide),
+        Vec::<String>::new(),
+        "INSTRUCTORS.md"
+    );
+    assert!(guide.contains("stereolab grade points"), "INSTRUCTORS.md");
+    for krate in ["ex1_stereo", "ex2_chromadepth", "ex3_sirds"] {
+        let stubs =
+            std::fs::read_to_string(repo_exercises().join(krate).join("src/stubs.rs")).unwrap();
+        assert_eq!(quoted_points(&stubs), Vec::<String>::new(), "{krate}");
+        assert!(stubs.contains("`stereolab grade points`"), "{krate}");
+    }
 }

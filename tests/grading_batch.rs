@@ -8,7 +8,10 @@ use std::process::{Command, Output};
 use serde_json::Value;
 
 use crate::common::out_dir;
-use crate::grading::{full_points, grade, repo_exercises, take_turn, target_dir, tests_of};
+use crate::grading::{
+    full_points, grade, repo_exercises, spec_totals, take_turn, target_dir, tests_of,
+};
+use stereolab_grade::Exercise;
 
 /// Gradescope's values for `visibility` (results.json and each test).
 const VISIBILITY: [&str; 4] = ["hidden", "after_due_date", "after_published", "visible"];
@@ -138,9 +141,10 @@ fn results_json_follows_gradescopes_fields_with_the_bonus_as_extra_credit() {
         "gs_solution",
     );
     let max = check_gradescope_schema(&v);
-    // 19 + 5 + 5 points to reach; ex1's Dubois bonus point beyond them.
-    assert_eq!(max, 29.0, "{v}");
-    assert_eq!(v["score"].as_f64(), Some(30.0), "{v}");
+    // The points to reach; the bonus points beyond them.
+    let (reach, bonus_points) = spec_totals(&Exercise::ALL);
+    assert_eq!(max, reach, "{v}");
+    assert_eq!(v["score"].as_f64(), Some(reach + bonus_points), "{v}");
     assert!(v["execution_time"].is_u64(), "{v}");
     let bonus: Vec<&Value> = tests_of(&v)
         .iter()
@@ -158,10 +162,10 @@ fn results_json_follows_gradescopes_fields_with_the_bonus_as_extra_credit() {
         assert_eq!(t["status"], "passed", "{t}");
     }
     assert!(
-        v["output"]
-            .as_str()
-            .unwrap()
-            .contains("PASSED: 30.00 of 29.00"),
+        v["output"].as_str().unwrap().contains(&format!(
+            "PASSED: {:.2} of {reach:.2}",
+            reach + bonus_points
+        )),
         "the full report is the top-level output: {v}"
     );
 
@@ -254,6 +258,12 @@ fn batch_grades_every_submission_folder_and_writes_a_sorted_csv() {
     );
     std::fs::create_dir_all(subs.join("dana")).unwrap();
     std::fs::create_dir_all(subs.join(".hidden")).unwrap();
+    // A single file named by the crate (as Gradescope takes it), under a name a spreadsheet
+    // would read as a formula.
+    write(
+        &subs.join("=1+1/ex2_chromadepth.rs"),
+        &repo_file(k, "solution.rs"),
+    );
     let results = base.join("results");
     let out = stereolab(&[
         "grade",
@@ -275,23 +285,37 @@ fn batch_grades_every_submission_folder_and_writes_a_sorted_csv() {
         String::from_utf8_lossy(&out.stderr)
     );
     let csv = std::fs::read_to_string(results.join("scores.csv")).unwrap();
+    let (reach, _) = spec_totals(&[Exercise::Ex2]);
     assert_eq!(
         csv,
-        "submission,ex2,total,max,passed\n\
-         \"bob, jr\",5.00,5.00,5.00,true\n\
-         carl,0.00,0.00,5.00,false\n\
-         dana,0.00,0.00,5.00,false\n\
-         zoe,5.00,5.00,5.00,true\n"
+        format!(
+            "submission,ex2,total,max,passed\n\
+             '=1+1,{reach:.2},{reach:.2},{reach:.2},true\n\
+             \"bob, jr\",{reach:.2},{reach:.2},{reach:.2},true\n\
+             carl,0.00,0.00,{reach:.2},false\n\
+             dana,0.00,0.00,{reach:.2},false\n\
+             zoe,{reach:.2},{reach:.2},{reach:.2},true\n"
+        )
     );
-    for name in ["bob, jr", "carl", "dana", "zoe"] {
+    let here = base.display().to_string();
+    for name in ["=1+1", "bob, jr", "carl", "dana", "zoe"] {
         let v = read_json(&results.join(name).join("results.json"));
         check_gradescope_schema(&v);
-        assert!(results.join(name).join("report.txt").is_file(), "{name}");
+        assert!(v["execution_time"].is_u64(), "{name}: {v}");
+        let report = std::fs::read_to_string(results.join(name).join("report.txt")).unwrap();
+        assert!(!report.contains(&here), "{name}: {report}");
+        assert!(!v.to_string().contains(&here), "{name}: {v}");
     }
     let carl = std::fs::read_to_string(results.join("carl/report.txt")).unwrap();
     assert!(carl.contains("does not compile"), "{carl}");
     let dana = std::fs::read_to_string(results.join("dana/report.txt")).unwrap();
-    assert!(dana.contains("stubs.rs"), "names the missing file: {dana}");
+    assert!(
+        dana.contains("ex2_chromadepth: missing file: no `ex2_chromadepth/src/stubs.rs`")
+            && dana.contains("`ex2_chromadepth.rs`")
+            && dana.contains("hint [missing-file]")
+            && !dana.contains("does not compile"),
+        "names the missing file and where it was looked for: {dana}"
+    );
     assert!(!results.join(".hidden").exists());
 }
 
@@ -455,8 +479,9 @@ fn the_gradescope_bundle_runs_in_an_autograder_layout() {
     submit(&root, &files);
     run_script(&root, "run_autograder");
     let v = read_json(&root.join("results/results.json"));
-    assert_eq!(check_gradescope_schema(&v), 29.0, "{v}");
-    assert_eq!(v["score"].as_f64(), Some(30.0), "{v}");
+    let (reach, bonus) = spec_totals(&Exercise::ALL);
+    assert_eq!(check_gradescope_schema(&v), reach, "{v}");
+    assert_eq!(v["score"].as_f64(), Some(reach + bonus), "{v}");
     let tasks = tests_of(&v).len();
 
     // The untouched stubs in the handout's layout, one folder down.

@@ -153,8 +153,9 @@ pub fn grade_batch(
                     let Some((name, dir)) = subs.get(k) else {
                         break;
                     };
+                    let started = std::time::Instant::now();
                     let entry = grade_one(opts, name, dir);
-                    if let Err(e) = write_entry(&opts.out, &entry) {
+                    if let Err(e) = write_entry(&opts.out, &entry, started.elapsed()) {
                         failure
                             .lock()
                             .unwrap_or_else(|e| e.into_inner())
@@ -213,12 +214,13 @@ fn grade_one(opts: &BatchOptions, name: &str, dir: &Path) -> BatchEntry {
     }
 }
 
-/// results.json and report.txt of one submission (each written whole or not at all).
-fn write_entry(out: &Path, entry: &BatchEntry) -> Result<()> {
+/// results.json (with Gradescope's `execution_time`, whole seconds) and report.txt of one
+/// submission (each written whole or not at all; folders of this machine left out of both).
+fn write_entry(out: &Path, entry: &BatchEntry, took: std::time::Duration) -> Result<()> {
     let dir = out.join(&entry.name);
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-    let (json, text) = match &entry.report {
-        Ok(r) => (r.gradescope(), r.text()),
+    let (mut json, text) = match &entry.report {
+        Ok(r) => (r.gradescope(), super::report::without_dirs(&r.text())),
         Err(e) => (
             serde_json::json!({
                 "score": 0.0,
@@ -230,18 +232,26 @@ fn write_entry(out: &Path, entry: &BatchEntry) -> Result<()> {
             format!("not graded: {e}\n"),
         ),
     };
+    json["execution_time"] = took.as_secs().into();
     let json = serde_json::to_string_pretty(&json)
         .map_err(|e| Error::io(&dir, std::io::Error::other(e)))?;
     stereolab_core::files::write_bytes(&dir.join("results.json"), json.as_bytes())?;
     stereolab_core::files::write_bytes(&dir.join("report.txt"), text.as_bytes())
 }
 
-/// A CSV field: quoted when it holds a comma, quote or line break.
+/// A CSV field: quoted when it holds a comma, quote or line break; a field a spreadsheet would
+/// read as a formula (starting with `=`, `+`, `-`, `@`, a tab or a carriage return) gets a
+/// leading `'`, which spreadsheets show as text.
 pub(crate) fn csv_field(s: &str) -> String {
+    let s = if s.starts_with(['=', '+', '-', '@', '\t', '\r']) {
+        format!("'{s}")
+    } else {
+        s.to_string()
+    };
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
-        s.to_string()
+        s
     }
 }
 
@@ -287,5 +297,143 @@ mod tests {
         assert_eq!(csv_field("alice"), "alice");
         assert_eq!(csv_field("a,b"), "\"a,b\"");
         assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+    }
+
+    #[test]
+    fn csv_fields_a_spreadsheet_reads_as_formulas_start_with_a_quote() {
+        for (name, field) in [
+            ("=1+1", "'=1+1"),
+            ("+cmd", "'+cmd"),
+            ("-2", "'-2"),
+            ("@SUM(A1)", "'@SUM(A1)"),
+            ("=HYPERLINK(\"x\",1)", "\"'=HYPERLINK(\"\"x\"\",1)\""),
+            ("bob-2", "bob-2"),
+        ] {
+            assert_eq!(csv_field(name), field, "{name}");
+        }
+        let entries = [BatchEntry {
+            name: "=cmd|' /C calc'!A0".into(),
+            report: Err("x".into()),
+        }];
+        let csv = scores_csv(&[Exercise::Ex2], &entries);
+        assert_eq!(
+            csv.lines().nth(1),
+            Some("'=cmd|' /C calc'!A0,,,,error"),
+            "{csv}"
+        );
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("stereolab-batch-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn a_single_file_per_crate_is_a_submission_directly_or_one_folder_down() {
+        let base = scratch("single");
+        let alice = base.join("alice");
+        std::fs::create_dir_all(&alice).unwrap();
+        std::fs::write(alice.join("ex1_stereo.rs"), "pub fn f() {}\n").unwrap();
+        assert_eq!(
+            submission_root(&alice, &[Exercise::Ex1]),
+            Some(alice.clone())
+        );
+        assert_eq!(
+            stubs_path(&alice, Exercise::Ex1, false),
+            alice.join("ex1_stereo.rs")
+        );
+        // The handout's layout is taken first when both are there.
+        let layout = alice.join("ex1_stereo/src/stubs.rs");
+        std::fs::create_dir_all(layout.parent().unwrap()).unwrap();
+        std::fs::write(&layout, "pub fn g() {}\n").unwrap();
+        assert_eq!(stubs_path(&alice, Exercise::Ex1, false), layout);
+        let bob = base.join("bob");
+        std::fs::create_dir_all(bob.join("upload")).unwrap();
+        std::fs::write(bob.join("upload/ex3_sirds.rs"), "pub fn f() {}\n").unwrap();
+        assert_eq!(
+            submission_root(&bob, &Exercise::ALL),
+            Some(bob.join("upload"))
+        );
+        let _ = std::fs::remove_dir_all(&base);
+    }
+
+    #[test]
+    fn a_missing_file_is_named_with_where_it_was_looked_for_and_its_own_hint() {
+        let base = scratch("missing");
+        let Err(why) = crate::submission_binary(
+            &base,
+            Exercise::Ex2,
+            false,
+            &base,
+            crate::BuildMode {
+                sandboxed: false,
+                timeout: crate::BuildMode::DEFAULT_TIMEOUT,
+            },
+        ) else {
+            panic!("an empty submission builds nothing");
+        };
+        assert_eq!(why.id, "missing-file");
+        for looked in [
+            "`ex2_chromadepth/src/stubs.rs`",
+            "`exercises/ex2_chromadepth/src/stubs.rs`",
+            "`ex2_chromadepth.rs`",
+        ] {
+            assert!(why.message.contains(looked), "{looked}: {}", why.message);
+        }
+        assert!(!why.message.contains("compile"), "{}", why.message);
+        assert!(
+            !why.message.contains(&base.display().to_string()),
+            "{}",
+            why.message
+        );
+        assert!(why.hint.contains("ex2_chromadepth.rs"), "{}", why.hint);
+        let _ = std::fs::remove_dir_all(&base);
+    }
+
+    #[test]
+    fn results_json_has_execution_time_and_report_txt_names_no_folder_of_this_machine() {
+        use super::super::report::ExerciseResult;
+        use super::super::score::TaskResult;
+        let base = scratch("entry");
+        let strip = base.join("alice/images/ex2_hsv_ramp.png");
+        let task = TaskResult {
+            exercise: "ex2",
+            name: "hsv_ramp",
+            points: 2.0,
+            bonus: false,
+            score: 1.4,
+            passed: 1,
+            total: 1,
+            image_passed: Some(false),
+            details: vec![format!(
+                "image ramp: expected | diff | actual: {}",
+                strip.display()
+            )],
+            hint: None,
+            hidden: None,
+        };
+        let entry = BatchEntry {
+            name: "alice".into(),
+            report: Ok(Report {
+                exercises: vec![ExerciseResult {
+                    exercise: Exercise::Ex2,
+                    build_error: None,
+                    tasks: vec![task],
+                }],
+            }),
+        };
+        write_entry(&base, &entry, std::time::Duration::from_millis(2600)).unwrap();
+        let json: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(base.join("alice/results.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(json["execution_time"], serde_json::json!(2), "{json}");
+        let text = std::fs::read_to_string(base.join("alice/report.txt")).unwrap();
+        assert!(text.contains("actual: ex2_hsv_ramp.png"), "{text}");
+        assert!(!text.contains(&base.display().to_string()), "{text}");
+        let _ = std::fs::remove_dir_all(&base);
     }
 }

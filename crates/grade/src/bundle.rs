@@ -181,25 +181,34 @@ fi
     )
 }
 
-/// `.github/workflows/classroom.yml` for a GitHub Classroom repository made from the handout.
-pub const CLASSROOM_YML: &str = r#"# GitHub Classroom: grades every push of the handout repository with stereolab's grader.
-name: Autograding
+/// `.github/workflows/classroom.yml` for a GitHub Classroom repository made from the handout:
+/// feedback on every push, not a grade (it runs the student's own, editable copy of the grader,
+/// and Classroom reads no points from an artifact).
+pub const CLASSROOM_YML: &str = r#"# GitHub Classroom: FEEDBACK ONLY, NOT A GRADE.
+# On every push this runs the grader of this repository (the student's own copy, which the
+# student can edit) and shows its report in the job's log; results.json is kept as an artifact.
+# GitHub Classroom reads no points from it, and a result from an editable grader is no grade:
+# official grades come from the instructor's Gradescope autograder or `stereolab grade batch`.
+name: Feedback (not the grade)
 on: [push, workflow_dispatch]
 permissions:
   contents: read
 jobs:
-  grade:
+  feedback:
+    name: Grader feedback (not the grade)
     runs-on: ubuntu-latest
     timeout-minutes: 30
     steps:
       - uses: actions/checkout@v4
       - uses: dtolnay/rust-toolchain@stable
       - uses: Swatinem/rust-cache@v2
-      - name: Grade
+      - name: Feedback from this repository's grader (not the grade)
         run: cargo run --release -p stereolab -- grade all --json results.json
-      - uses: actions/upload-artifact@v4
+      - name: Keep the feedback's results.json (not read as points)
+        if: always()
+        uses: actions/upload-artifact@v4
         with:
-          name: results
+          name: feedback-results
           path: results.json
 "#;
 
@@ -305,4 +314,35 @@ pub fn write_classroom(dir: &Path) -> Result<std::path::PathBuf> {
     }
     stereolab_core::files::write_bytes(&path, CLASSROOM_YML.as_bytes())?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_classroom_workflow_says_it_is_feedback_only_in_its_comments_and_step_names() {
+        let header: Vec<&str> = CLASSROOM_YML
+            .lines()
+            .take_while(|l| l.starts_with('#'))
+            .collect();
+        let header = header.join("\n");
+        assert!(header.contains("FEEDBACK ONLY, NOT A GRADE"), "{header}");
+        assert!(header.contains("official grades come from"), "{header}");
+        let names: Vec<&str> = CLASSROOM_YML
+            .lines()
+            .filter_map(|l| {
+                let l = l.trim_start().trim_start_matches("- ");
+                l.strip_prefix("name: ")
+            })
+            .collect();
+        assert!(names.len() >= 4, "{names:?}");
+        for n in names.iter().filter(|n| !n.starts_with("feedback-")) {
+            assert!(
+                n.contains("not"),
+                "step or job named without saying it is no grade: {n}"
+            );
+        }
+        assert!(!CLASSROOM_YML.to_lowercase().contains("autograding"));
+    }
 }

@@ -175,7 +175,8 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     .map_err(|e| Error::parse(&manifest_path, None, e.to_string()))?;
     let workspace = format!("{workspace}\n{profiles}");
     std::fs::write(dir.join("Cargo.toml"), workspace).map_err(io(dir))?;
-    std::fs::write(dir.join("README.md"), HANDOUT_README).map_err(io(dir))?;
+    let readme = handout_readme(&super::points::points_table()?);
+    std::fs::write(dir.join("README.md"), readme).map_err(io(dir))?;
     // The course's own copies of the source documents (not redistributable, so not in the
     // repository): copied in when the instructor names the folder that holds them.
     if let Some(docs) = documents {
@@ -192,19 +193,33 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
+/// The handout's README: [`HANDOUT_README`] with each exercise's points from `table`.
+fn handout_readme(table: &[super::points::TaskPoints]) -> String {
+    super::Exercise::ALL
+        .into_iter()
+        .fold(HANDOUT_README.to_string(), |text, ex| {
+            text.replace(
+                &format!("{{points:{}}}", ex.crate_name()),
+                &super::points::exercise_points(table, ex),
+            )
+        })
+}
+
+/// The handout's README; `{points:<crate>}` stands for the crate's points (see
+/// [`handout_readme`]).
 const HANDOUT_README: &str = r#"# Stereo rendering exercises
 
 Three exercises, one crate each:
 
 | crate | topic | source (see `stereolab/docs/sources.md`) | points |
 | --- | --- | --- | --- |
-| `ex1_stereo` | stereo frusta, anaglyphs, remapping, visibility, parallax, a random-dot pair | the exercise slides, *Exercise 1: Stereoscopy* | see `grade` |
-| `ex2_chromadepth` | the ChromaDepth ramp and texgen | Bailey, Clark: *Using ChromaDepth to obtain Inexpensive Single-image Stereovision for Scientific Visualization* | 5 |
-| `ex3_sirds` | single-image random-dot stereograms | Petz, Goldlücke, Magnor: *Hardware-accelerated Autostereogram Rendering for Interactive 3D Visualization* | 5 |
+| `ex1_stereo` | stereo frusta, anaglyphs, remapping, visibility, parallax, a random-dot pair | the exercise slides, *Exercise 1: Stereoscopy* | {points:ex1_stereo} |
+| `ex2_chromadepth` | the ChromaDepth ramp and texgen | Bailey, Clark: *Using ChromaDepth to obtain Inexpensive Single-image Stereovision for Scientific Visualization* | {points:ex2_chromadepth} |
+| `ex3_sirds` | single-image random-dot stereograms | Petz, Goldlücke, Magnor: *Hardware-accelerated Autostereogram Rendering for Interactive 3D Visualization* | {points:ex3_sirds} |
 
 Complete the `todo!`s in each crate's `src/stubs.rs`. Every stub's doc comment states the task,
-its points, the formula's source and the conventions (right-handed, NDC z in [-1, 1], eye
-index 0 = left).
+the formula's source and the conventions (right-handed, NDC z in [-1, 1], eye index 0 = left);
+`cargo run -p stereolab -- grade points` prints every task's points (the table above sums them).
 
 What is here:
 - `ex1_stereo/`, `ex2_chromadepth/`, `ex3_sirds/`: your crates. **Only `src/stubs.rs` is
@@ -242,8 +257,9 @@ running fast). Later runs start at once. Each `grade` then builds your crates in
   real renderer, compared with the reference picture. The image check carries 30% of the task's
   points, the numeric checks 70%, in proportion to the inputs you get right.
 - A mistake the grader recognizes (swapped eyes, a transposed matrix, degrees for radians, …)
-  is named in a hint. When every failing answer matches such a mistake, the task scores 0: the
-  formula is wrong, not an input.
+  is named in a hint. The task still scores the checks your answer passes, like any other
+  answer: a recognized mistake never scores below an unrecognized answer that passes fewer
+  checks.
 - The instructor may grade extra hidden inputs beside the ones you see.
 - A task whose function panics, loops (killed after 10 s), crashes or runs out of memory
   (1 GiB) loses that task only.
@@ -274,6 +290,28 @@ mod tests {
             assert_eq!(p["opt-level"].as_integer(), Some(0), "{t}");
             assert_eq!(p["debug"].as_bool(), Some(false), "{t}");
         }
+    }
+
+    #[test]
+    fn the_handout_readme_takes_each_exercises_points_from_the_specs_and_states_the_partial_credit_rule()
+     {
+        let table = super::super::points::points_table().expect("the grading scene loads");
+        let text = handout_readme(&table);
+        assert!(!text.contains("{points:"), "{text}");
+        for ex in super::super::Exercise::ALL {
+            let cell = super::super::points::exercise_points(&table, ex);
+            assert!(
+                text.contains(&format!("| {cell} |\n")),
+                "{}: {cell}\n{text}",
+                ex.crate_name()
+            );
+        }
+        assert!(text.contains("grade points"), "{text}");
+        assert!(
+            text.contains("still scores the checks your answer passes"),
+            "{text}"
+        );
+        assert!(!text.contains("scores 0"), "{text}");
     }
 
     #[test]

@@ -18,6 +18,7 @@ pub mod export;
 pub mod fixture;
 #[cfg(feature = "gpu")]
 pub mod gpu_compare;
+pub mod points;
 pub mod report;
 pub mod sandbox;
 pub mod score;
@@ -55,7 +56,7 @@ impl Exercise {
     pub const ALL: [Exercise; 3] = [Exercise::Ex1, Exercise::Ex2, Exercise::Ex3];
 
     /// `ex1`, `ex2`, `ex3`.
-    pub(crate) fn id(self) -> &'static str {
+    pub fn id(self) -> &'static str {
         match self {
             Exercise::Ex1 => "ex1",
             Exercise::Ex2 => "ex2",
@@ -169,21 +170,40 @@ pub fn default_work_dir() -> PathBuf {
         .join("stereolab-grade")
 }
 
-/// The file of `ex` a submission in `dir` provides: `<crate>/src/stubs.rs` (or `solution.rs`),
-/// also looked for under `exercises/`.
-pub(crate) fn stubs_path(dir: &Path, ex: Exercise, solution: bool) -> PathBuf {
+/// Where a submission may hold the file of `ex`, relative to its folder, in the order looked
+/// for: `<crate>/src/stubs.rs` (or `solution.rs`), the same under `exercises/`, and for the
+/// stubs a single file named by the crate (`ex1_stereo.rs`).
+pub(crate) fn stubs_candidates(ex: Exercise, solution: bool) -> Vec<PathBuf> {
     let file = if solution { "solution.rs" } else { "stubs.rs" };
-    let direct = dir.join(ex.crate_name()).join("src").join(file);
-    let nested = dir
-        .join("exercises")
-        .join(ex.crate_name())
-        .join("src")
-        .join(file);
-    if !direct.is_file() && nested.is_file() {
-        nested
-    } else {
-        direct
+    let direct = Path::new(ex.crate_name()).join("src").join(file);
+    let mut candidates = vec![direct.clone(), Path::new("exercises").join(direct)];
+    if !solution {
+        candidates.push(PathBuf::from(format!("{}.rs", ex.crate_name())));
     }
+    candidates
+}
+
+/// The file of `ex` a submission in `dir` provides: the first of [`stubs_candidates`] that is
+/// there, else the first.
+pub(crate) fn stubs_path(dir: &Path, ex: Exercise, solution: bool) -> PathBuf {
+    let candidates = stubs_candidates(ex, solution);
+    candidates
+        .iter()
+        .map(|c| dir.join(c))
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| dir.join(&candidates[0]))
+}
+
+/// Why an exercise's crate was not built: what the report prints, and the hint its tasks get.
+pub(crate) struct NotBuilt {
+    /// The hint's id: `missing-file`, `unreadable-file` or `build`.
+    pub id: &'static str,
+    /// What to do, for the hint.
+    pub hint: String,
+    /// Why the tasks were not run, for their details.
+    pub what: &'static str,
+    /// What happened, paths relative to the submission: printed after the crate's name.
+    pub message: String,
 }
 
 /// The stubs file at `path` inside the submission `dir`, as the bytes of a regular file: a
@@ -243,27 +263,67 @@ fn read_stubs(path: &Path, dir: &Path) -> Result<String> {
 }
 
 /// Builds the binary of `ex` from the submission in `dir` (see [`build`]); `Err` is what to
-/// tell the student: the compiler's messages, or the file that is missing.
+/// tell the student: the file that is missing or unreadable, or the compiler's messages.
 pub(crate) fn submission_binary(
     dir: &Path,
     ex: Exercise,
     solution: bool,
     work: &Path,
     mode: BuildMode,
-) -> std::result::Result<Binary, String> {
+) -> std::result::Result<Binary, NotBuilt> {
     let path = stubs_path(dir, ex, solution);
-    let stubs = read_stubs(&path, dir).map_err(|e| {
-        if solution && !path.exists() {
-            format!(
-                "no {} here: the instructor's solution is not part of a handout ({e})",
-                path.display()
+    let rel = path
+        .strip_prefix(dir)
+        .unwrap_or(&path)
+        .display()
+        .to_string();
+    if !path.is_file() {
+        let looked: Vec<String> = stubs_candidates(ex, solution)
+            .iter()
+            .map(|c| format!("`{}`", c.display()))
+            .collect();
+        let (message, hint) = if solution {
+            (
+                format!("no `{rel}`: the instructor's solution is not part of a handout"),
+                format!("grade the stubs, or the repository's `exercises/` for `{rel}`"),
             )
         } else {
-            format!("the submission's {}: {e}", path.display())
+            (
+                format!(
+                    "missing file: no `{rel}` in the submission (looked for {} in the \
+                     submission's folder)",
+                    looked.join(", ")
+                ),
+                format!(
+                    "submit `{rel}` (the handout's layout) or a single file named `{}.rs`",
+                    ex.crate_name()
+                ),
+            )
+        };
+        return Err(NotBuilt {
+            id: "missing-file",
+            hint,
+            what: "the file is missing",
+            message,
+        });
+    }
+    let stubs = read_stubs(&path, dir).map_err(|e| {
+        let e = e.to_string().replace(&path.display().to_string(), &rel);
+        NotBuilt {
+            id: "unreadable-file",
+            what: "the file cannot be read",
+            hint: format!("submit `{rel}` as UTF-8 text of a normal size"),
+            message: format!("the submission's `{rel}` cannot be read: {e}"),
         }
     })?;
-    let sources = build::Sources::new(ex, stubs)?;
-    build::build(ex, &sources, work, mode)
+    let compile = |log: String| NotBuilt {
+        id: "build",
+        what: "the crate does not compile",
+        hint: "fix the compile errors printed above first".into(),
+        message: format!("does not compile:\n{log}"),
+    };
+    let sources = build::Sources::new(ex, stubs).map_err(compile)?;
+    build::build(ex, &sources, work, mode).map_err(compile)
 }
 
 /// The exercises folder: `given`, else `./exercises`, else `.` when it holds `ex1_stereo`.
@@ -319,13 +379,13 @@ pub fn grade(opts: &GradeOptions, scene: Scene) -> Result<Report> {
         let specs = ex.tasks(&fx);
         let result =
             match submission_binary(&opts.dir, ex, opts.solution, &opts.work, opts.build_mode()) {
-                Err(log) => ExerciseResult {
+                Err(why) => ExerciseResult {
                     exercise: ex,
-                    build_error: Some(log),
                     tasks: specs
                         .iter()
-                        .map(|s| TaskResult::not_built(ex.id(), s))
+                        .map(|s| TaskResult::not_built(ex.id(), s, &why))
                         .collect(),
+                    build_error: Some(why.message),
                 },
                 Ok(binary) => {
                     let mut tasks: Vec<TaskResult> = specs
@@ -375,7 +435,7 @@ pub fn render_exercise(
     };
     check_sandbox(Policy::for_this_user(Policy::Auto))?;
     let binary = submission_binary(dir, ex, solution, &default_work_dir(), mode)
-        .map_err(|log| Error::invalid(ex.crate_name(), "cannot be built", log))?;
+        .map_err(|why| Error::invalid(ex.crate_name(), "cannot be built", why.message))?;
     let mut lines = Vec::new();
     for spec in ex.tasks(&fx) {
         let Some(img) = &spec.image else { continue };

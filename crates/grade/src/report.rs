@@ -17,7 +17,8 @@ pub(crate) const MIN_POINTS_PER_EXERCISE: f64 = 2.0;
 pub struct ExerciseResult {
     /// Which exercise.
     pub exercise: Exercise,
-    /// The compiler's errors when the crate did not build.
+    /// Why the crate was not built, when it was not: its file missing or unreadable, or
+    /// `does not compile:` and the compiler's errors.
     pub build_error: Option<String>,
     /// One result per task.
     pub tasks: Vec<TaskResult>,
@@ -31,11 +32,13 @@ impl ExerciseResult {
 
     /// Points to reach: bonus tasks excluded.
     pub fn max(&self) -> f64 {
-        self.tasks
-            .iter()
-            .filter(|t| !t.bonus)
-            .map(|t| t.points)
-            .sum()
+        round2(
+            self.tasks
+                .iter()
+                .filter(|t| !t.bonus)
+                .map(|t| t.points)
+                .sum(),
+        )
     }
 }
 
@@ -58,7 +61,7 @@ impl Report {
 
     /// Points to reach, bonus excluded.
     pub fn max(&self) -> f64 {
-        self.exercises.iter().map(ExerciseResult::max).sum()
+        round2(self.exercises.iter().map(ExerciseResult::max).sum())
     }
 
     /// The course's rule over the exercises graded.
@@ -138,7 +141,7 @@ impl Report {
         );
         for e in &self.exercises {
             if let Some(err) = &e.build_error {
-                let _ = writeln!(s, "{}: does not compile:\n{err}", e.exercise.crate_name());
+                let _ = writeln!(s, "{}: {err}", e.exercise.crate_name());
             }
             for t in &e.tasks {
                 let image = match t.image_passed {
@@ -281,8 +284,8 @@ impl Report {
                 tests.push(json!({
                     "name": format!("{name} (hidden cases)"),
                     "number": format!("{}.{}", t.exercise.trim_start_matches("ex"), tests.len() + 1),
-                    "score": h.score,
-                    "max_score": if t.bonus { 0.0 } else { h.points },
+                    "score": round2(h.score),
+                    "max_score": if t.bonus { 0.0 } else { round2(h.points) },
                     "status": if h.score >= h.points { "passed" } else { "failed" },
                     "visibility": "after_published",
                     "tags": [t.exercise, "hidden"],
@@ -337,8 +340,10 @@ fn cap(text: &str, max: usize) -> String {
 }
 
 /// The grader's machine's folders dropped from the words that name a file (`/tmp/x/ex1_a.png`
-/// becomes `ex1_a.png`): results.json goes to students, the paths mean nothing to them.
-fn without_dirs(text: &str) -> String {
+/// becomes `ex1_a.png`, `/home/me/x/src/stubs.rs:3:5` becomes `stubs.rs:3:5`, a relative source
+/// path such as `ex1_stereo/src/stubs.rs` stays): results.json and
+/// a batch's report.txt go to students, the paths mean nothing to them.
+pub(crate) fn without_dirs(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for (k, line) in text.split('\n').enumerate() {
         if k > 0 {
@@ -350,10 +355,18 @@ fn without_dirs(text: &str) -> String {
                 out.push(' ');
             }
             first = false;
+            let bare = word
+                .trim_end_matches([',', ';', ')', '`', ':'])
+                .trim_end_matches(|c: char| c.is_ascii_digit() || c == ':');
+            // Sources only when absolute: a relative one is the submission's own path.
+            let absolute = word
+                .trim_start_matches(['`', '(', '\'', '"'])
+                .starts_with('/');
             let is_file = word.contains('/')
-                && [".png", ".txt", ".json"]
+                && ([".png", ".txt", ".json"]
                     .iter()
-                    .any(|ext| word.trim_end_matches([',', ';', ')']).ends_with(ext));
+                    .any(|ext| bare.ends_with(ext))
+                    || (absolute && bare.ends_with(".rs")));
             match word.rsplit_once('/') {
                 Some((_, name)) if is_file => out.push_str(name),
                 _ => out.push_str(word),
@@ -461,10 +474,39 @@ mod tests {
     }
 
     #[test]
+    fn results_json_rounds_every_score_and_max_score_to_hundredths() {
+        let mut t = task("link_row", 3.0, false, 2.1 + 0.9);
+        t.hidden = Some(super::super::score::HiddenResult {
+            score: 0.1 + 0.2,
+            points: 3.0 * 0.3,
+            passed: 1,
+            total: 3,
+            details: Vec::new(),
+        });
+        let report = Report {
+            exercises: vec![ExerciseResult {
+                exercise: Exercise::Ex3,
+                build_error: None,
+                tasks: vec![t, task("a", 0.1, false, 0.1), task("b", 0.2, false, 0.2)],
+            }],
+        };
+        let v = report.gradescope();
+        let hidden = &v["tests"][1];
+        assert_eq!(hidden["max_score"], json!(0.9), "{hidden}");
+        assert_eq!(hidden["score"], json!(0.3), "{hidden}");
+        assert_eq!(v["extra_data"]["max_score"], json!(3.3), "{v}");
+        assert_eq!(v["score"], json!(3.3), "{v}");
+    }
+
+    #[test]
     fn without_dirs_keeps_file_names_only() {
         assert_eq!(
             without_dirs("image a: x; expected | diff | actual: /home/me/out/ex1_a.png\n  b/c d"),
             "image a: x; expected | diff | actual: ex1_a.png\n  b/c d"
+        );
+        assert_eq!(
+            without_dirs("  --> /home/me/ex1_stereo/src/stubs.rs:12:5\n  src/lib.rs, a/b"),
+            "  --> stubs.rs:12:5\n  src/lib.rs, a/b"
         );
     }
 }

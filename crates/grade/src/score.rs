@@ -61,8 +61,12 @@ pub struct HiddenResult {
 }
 
 impl TaskResult {
-    /// A task not run because the crate did not build.
-    pub(crate) fn not_built(exercise: &'static str, spec: &TaskSpec) -> TaskResult {
+    /// A task not run because the crate was not built (`why`).
+    pub(crate) fn not_built(
+        exercise: &'static str,
+        spec: &TaskSpec,
+        why: &crate::NotBuilt,
+    ) -> TaskResult {
         TaskResult {
             exercise,
             name: spec.name,
@@ -72,11 +76,8 @@ impl TaskResult {
             passed: 0,
             total: spec.cases.len(),
             image_passed: spec.image.as_ref().map(|_| false),
-            details: vec!["not run: the crate does not compile".into()],
-            hint: Some((
-                "build".into(),
-                "fix the compile errors printed above first".into(),
-            )),
+            details: vec![format!("not run: {}", why.what)],
+            hint: Some((why.id.into(), why.hint.clone())),
             hidden: None,
         }
     }
@@ -362,7 +363,7 @@ pub(crate) fn evaluate(
                 t.details.push(printed(what, text, *total));
             }
         }
-        let points = spec.points * HIDDEN_SHARE;
+        let points = round2(spec.points * HIDDEN_SHARE);
         let frac = t.passed as f64 / spec.hidden.len() as f64;
         HiddenResult {
             score: round2(points * frac),
@@ -376,7 +377,7 @@ pub(crate) fn evaluate(
         Some(h) => spec.points - h.points,
         None => spec.points,
     };
-    let mut score = round2(public_points * raw + hidden.as_ref().map_or(0.0, |h| h.score));
+    let score = round2(public_points * raw + hidden.as_ref().map_or(0.0, |h| h.score));
     let lost = score < spec.points;
     let known = if lost && run.ending.is_none() && non_finite == 0 {
         diagnose(spec, &failing)
@@ -384,13 +385,12 @@ pub(crate) fn evaluate(
         None
     };
     if let Some((id, _)) = &known {
-        // A systematic mistake: one known wrong formula explains every failing answer, so the
-        // answers that pass do so by coincidence (an eye or a setup where the mistake happens
-        // not to show). No partial credit for it.
-        score = 0.0;
+        // A recognised mistake is named, and scored like any other answer: by the checks it
+        // passes. A rule that took more away from it would give a recognised answer fewer points
+        // than an unrecognised one that passes fewer checks.
         details.push(format!(
-            "every failing answer is what the known mistake [{id}] gives: a systematic \
-             mistake scores 0 points (partial credit is for scattered failures)"
+            "every failing answer is what the known mistake [{id}] gives (see the hint); the \
+             task scores the checks that pass, as any answer does"
         ));
     }
     let hint = if !lost {
@@ -586,6 +586,183 @@ fn check_pictures(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spec::{ImageCheck, Mistake};
+    use stereolab_core::framebuffer::Framebuffer;
+
+    /// A task of `n` exact cases (case `k` answers `k`), one known mistake (answering
+    /// `k + 1000`) and, with `image`, an image check that passes when its input is answered `1`.
+    fn synthetic_task(n: usize, points: f64, image: bool) -> TaskSpec {
+        let cases = (0..n)
+            .map(|k| Case {
+                label: format!("case {k}"),
+                input: serde_json::json!(k),
+                expected: vec![k as f64],
+            })
+            .collect();
+        let picture = |fill: u8| Framebuffer::new(8, 8, [fill, fill, fill, 255]).expect("8×8");
+        TaskSpec {
+            name: "synthetic",
+            points,
+            bonus: false,
+            tolerance: Tolerance::EXACT,
+            cases,
+            mistakes: vec![Mistake {
+                id: "off-by-1000",
+                hint: "the known mistake",
+                answers: (0..n).map(|k| vec![k as f64 + 1000.0]).collect(),
+            }],
+            image: image.then(|| ImageCheck {
+                inputs: vec![serde_json::json!("picture")],
+                build: Box::new(move |answers: &[Option<Vec<f64>>]| {
+                    let right = answers.first().cloned().flatten() == Some(vec![1.0]);
+                    vec![Picture {
+                        name: "synthetic".into(),
+                        expected: picture(0),
+                        actual: picture(if right { 0 } else { 200 }),
+                    }]
+                }),
+            }),
+            depends_on: &[],
+            hidden: Vec::new(),
+        }
+    }
+
+    /// The first `passed` cases right; the others wrong the known way (`recognised`) or some
+    /// other way; the image input answered right or wrong.
+    fn synthetic_run(n: usize, passed: usize, recognised: bool, image_right: bool) -> Run {
+        let mut replies: Vec<Result<Vec<f64>, String>> = (0..n)
+            .map(|k| {
+                Ok(vec![if k < passed {
+                    k as f64
+                } else if recognised {
+                    k as f64 + 1000.0
+                } else {
+                    -1.0 - k as f64
+                }])
+            })
+            .collect();
+        replies.push(Ok(vec![if image_right { 1.0 } else { 0.0 }]));
+        Run {
+            replies,
+            ending: None,
+            stdout: (String::new(), 0),
+            stderr: (String::new(), 0),
+        }
+    }
+
+    fn scratch_dir(name: &str) -> std::path::PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("stereolab-score-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("scratch folder");
+        dir
+    }
+
+    #[test]
+    fn a_recognised_mistake_is_named_and_scores_its_checks_never_below_a_worse_unrecognised_answer()
+    {
+        let out = scratch_dir("pairs");
+        // 56 of 58 checks and the picture right, failing the known way, against 55 of 58 and
+        // the picture wrong, failing some other way (one point, as `visible`).
+        let spec = synthetic_task(58, 1.0, true);
+        let known = evaluate("ex1", &spec, &synthetic_run(58, 56, true, true), None, &out);
+        let other = evaluate(
+            "ex1",
+            &spec,
+            &synthetic_run(58, 55, false, false),
+            None,
+            &out,
+        );
+        assert_eq!(
+            known.hint.as_ref().map(|h| h.0.as_str()),
+            Some("off-by-1000")
+        );
+        assert_eq!(other.hint.as_ref().map(|h| h.0.as_str()), Some("mismatch"));
+        assert_eq!(known.score, round2(0.7 * 56.0 / 58.0 + 0.3), "{known:?}");
+        assert_eq!(other.score, round2(0.7 * 55.0 / 58.0), "{other:?}");
+        assert!(known.score > other.score);
+        // 14 of 20 failing the known way against 10 of 20 failing another way, both pictures
+        // wrong (two points, as `stereo_matrices`).
+        let spec = synthetic_task(20, 2.0, true);
+        let known = evaluate(
+            "ex1",
+            &spec,
+            &synthetic_run(20, 14, true, false),
+            None,
+            &out,
+        );
+        let other = evaluate(
+            "ex1",
+            &spec,
+            &synthetic_run(20, 10, false, false),
+            None,
+            &out,
+        );
+        assert_eq!(
+            known.hint.as_ref().map(|h| h.0.as_str()),
+            Some("off-by-1000")
+        );
+        assert_eq!((known.score, other.score), (0.98, 0.7));
+        assert!(
+            known
+                .details
+                .iter()
+                .any(|d| d.contains("[off-by-1000]") && d.contains("scores the checks that pass")),
+            "{:?}",
+            known.details
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    #[test]
+    fn more_checks_passed_never_score_fewer_points_recognised_or_not() {
+        let out = scratch_dir("monotone");
+        let n = 20;
+        for image in [false, true] {
+            let spec = synthetic_task(n, 2.0, image);
+            let mut scored: Vec<(usize, bool, bool, f64)> = Vec::new();
+            for passed in 0..=n {
+                for recognised in [false, true] {
+                    for image_right in [false, true] {
+                        let r = evaluate(
+                            "ex1",
+                            &spec,
+                            &synthetic_run(n, passed, recognised, image_right),
+                            None,
+                            &out,
+                        );
+                        scored.push((passed, image_right, recognised, r.score));
+                    }
+                }
+            }
+            for &(p, img, rec, s) in &scored {
+                for &(q, img2, rec2, t) in &scored {
+                    // Image checks only count where the task has one.
+                    let at_least = p >= q && (!image || img || !img2);
+                    assert!(
+                        !at_least || s >= t,
+                        "{p} passed (image {img}, recognised {rec}) scores {s}, below {t} for \
+                         {q} passed (image {img2}, recognised {rec2})"
+                    );
+                }
+            }
+        }
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    #[test]
+    fn hidden_points_are_rounded_to_hundredths() {
+        let mut spec = synthetic_task(2, 3.0, false);
+        spec.hidden = spec.cases.clone();
+        let mut run = synthetic_run(2, 2, false, false);
+        run.replies.pop();
+        // The hidden cases are answered by a process of their own.
+        let hidden = run.clone();
+        let out = scratch_dir("hidden");
+        let r = evaluate("ex3", &spec, &run, Some(&hidden), &out);
+        let _ = std::fs::remove_dir_all(&out);
+        let h = r.hidden.expect("hidden cases");
+        assert_eq!((h.points, h.score, r.score), (0.9, 0.9, 3.0), "{h:?}");
+    }
 
     #[test]
     fn matrices_print_as_rows_with_the_worst_row_and_column_and_indices_as_integers() {

@@ -635,14 +635,9 @@ pub fn compare(
     pairs
 }
 
-/// A CSV field of text: escaped as `scores.csv`'s are, and with a `'` before a leading `=`,
-/// `+`, `-`, `@`, tab or carriage return so a spreadsheet does not take it for a formula.
+/// A CSV field of text, escaped as `scores.csv`'s are (a formula-like name gets a `'`).
 fn text_field(s: &str) -> String {
-    if s.starts_with(['=', '+', '-', '@', '\t', '\r']) {
-        csv_field(&format!("'{s}"))
-    } else {
-        csv_field(s)
-    }
+    csv_field(s)
 }
 
 /// The report: what was compared and the pairs found.

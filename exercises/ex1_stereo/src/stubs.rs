@@ -1,11 +1,12 @@
 //! Your code: complete every `todo!`. Each doc comment states the task, where its formula comes
-//! from, and the conventions; `stereolab grade ex1` scores each function on its own.
+//! from, and the conventions; `stereolab grade ex1` scores each function on its own and
+//! `stereolab grade points` prints each task's points.
 
 use exercise_api::Lighting;
 use exercise_api::{AnaglyphKind, AnaglyphMatrices, EyeView, ScreenSetup, StereoSetup, Texture};
 use glam::{Mat4, Vec2, Vec3};
 
-/// Task `frustum` (2 points): the projection matrix `P_frustum(l, r, b, t, n, f)`.
+/// Task `frustum`: the projection matrix `P_frustum(l, r, b, t, n, f)`.
 ///
 /// Source: the exercise slides, "Projection Matrix – View Frustum" (OpenGL's `glFrustum`):
 /// ```text
@@ -22,7 +23,7 @@ pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
     todo!("P_frustum(l={l:?}, r={r:?}, b={b:?}, t={t:?}, n={n:?}, f={f:?})")
 }
 
-/// Task `stereo_frustum` (2 points): the arguments `[l, r, b, t, n, f]` of eye `eye`'s
+/// Task `stereo_frustum`: the arguments `[l, r, b, t, n, f]` of eye `eye`'s
 /// `P_frustum±` in the off-axis (parallel-axis, asymmetric frustum) stereo rig.
 ///
 /// Source: the exercise slides, "Projection Matrix Stereo Case": the mono frustum has
@@ -36,7 +37,7 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
     todo!("frustum bounds of eye {eye:?} for {setup:?}")
 }
 
-/// Task `sheet_frustum` (1 point): the arguments `[l, r, b, t, n, f]` of eye `eye`'s
+/// Task `sheet_frustum`: the arguments `[l, r, b, t, n, f]` of eye `eye`'s
 /// `P_frustum±` in the exercise slides' own, screen-relative terms.
 ///
 /// Source: the exercise slides, "Projection Matrix – View Frustum" and "Projection Matrix Stereo
@@ -57,7 +58,7 @@ pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
     todo!("frustum bounds of eye {eye:?} for {screen:?}")
 }
 
-/// Task `stereo_matrices` (2 points, image check): eye `eye`'s view and projection, given the
+/// Task `stereo_matrices` (image check): eye `eye`'s view and projection, given the
 /// camera's (cyclopean) modelview `modelview`.
 ///
 /// Source: the exercise slides, "Transformation Matrices – Effect on lighting". `T±` moves the world so
@@ -77,7 +78,7 @@ pub fn stereo_matrices(
     todo!("view and projection of eye {eye:?}, {lighting:?}, {setup:?}, MV = {modelview:?}")
 }
 
-/// Task `anaglyph_matrices` (2 points, image check): the matrices `ML`, `MR` of
+/// Task `anaglyph_matrices` (image check): the matrices `ML`, `MR` of
 /// `out = clamp(ML · left + MR · right)` for `kind`.
 ///
 /// Source: the exercise slides, "Anaglyph" (after 3dtv.at): true, gray, color and half-color anaglyphs for
@@ -88,7 +89,7 @@ pub fn anaglyph_matrices(kind: AnaglyphKind) -> AnaglyphMatrices {
     todo!("ML and MR of the {kind:?} anaglyph")
 }
 
-/// Task `finalize_pixel` (2 points, image check): one pixel of the finalize shader, the pass
+/// Task `finalize_pixel` (image check): one pixel of the finalize shader, the pass
 /// that combines the two eyes' color textures into the anaglyph.
 ///
 /// Source: the exercise slides, "Multi Pass Rendering" (a final shader program combining the two
@@ -102,7 +103,7 @@ pub fn finalize_pixel(left: [f32; 3], right: [f32; 3], m: &AnaglyphMatrices) -> 
     todo!("finalize left {left:?}, right {right:?} with {m:?}")
 }
 
-/// Bonus task `dubois_matrices` (1 bonus point): Dubois' least-squares red-cyan matrices.
+/// Bonus task `dubois_matrices`: Dubois' least-squares red-cyan matrices.
 ///
 /// Source: Eric Dubois (2001), the CRT-derived numbers as in three.js' `AnaglyphEffect.js`
 /// (listed in `stereolab/docs/anaglyph-matrices.md` of the handout): six significant digits.
@@ -112,7 +113,7 @@ pub fn dubois_matrices() -> AnaglyphMatrices {
     todo!("Dubois red-cyan ML and MR")
 }
 
-/// Task `remap` (2 points, image check): where the surface point seen by the left eye at
+/// Task `remap` (image check): where the surface point seen by the left eye at
 /// texture coordinate `uv_left` with stored depth `depth_left` appears in the right image.
 ///
 /// Source: the exercise slides, "Stereo Rendering – Remapping":
@@ -128,7 +129,7 @@ pub fn remap(mvp_left: Mat4, mvp_right: Mat4, uv_left: Vec2, depth_left: f32) ->
     todo!("remap uv {uv_left:?} depth {depth_left:?} with MVP_l {mvp_left:?}, MVP_r {mvp_right:?}")
 }
 
-/// Task `remap_right_to_left` (1 point, image check): the other direction of [`remap`]: where
+/// Task `remap_right_to_left` (image check): the other direction of [`remap`]: where
 /// the surface point seen by the RIGHT eye at texture coordinate `uv_right` with stored depth
 /// `depth_right` appears in the LEFT image.
 ///
@@ -150,7 +151,7 @@ pub fn remap_right_to_left(
     )
 }
 
-/// Task `visible` (1 point, image check): is the left eye's surface point also visible to the
+/// Task `visible` (image check): is the left eye's surface point also visible to the
 /// right eye?
 ///
 /// Source: the exercise slides, "Visibility Check": look up the right eye's depth texture at the remapped
@@ -171,7 +172,7 @@ pub fn visible(
     )
 }
 
-/// Task `rds_right` (2 points, image check): the right image of Julesz's random-dot stereo
+/// Task `rds_right` (image check): the right image of Julesz's random-dot stereo
 /// pair, built from your [`remap_right_to_left`] and [`visible`].
 ///
 /// Source: the SIRDS paper (Petz et al.), §1 (Julesz's random-dot stereograms: depth from
@@ -216,7 +217,7 @@ pub fn rds_right(
     )
 }
 
-/// Task `parallax` (1 point): the screen parallax of a point at eye distance `z`.
+/// Task `parallax`: the screen parallax of a point at eye distance `z`.
 ///
 /// Source: the exercise slides, "Parallax and Eye Separation": `p(z) = d · (1 − z0 / z)` with `z` and
 /// `z0` positive distances in front of the eyes and `d` the eye separation. Negative in front
@@ -226,7 +227,7 @@ pub fn parallax(z: f32, zero_parallax: f32, eye_separation: f32) -> f32 {
     todo!("p(z = {z:?}) with z0 = {zero_parallax:?}, d = {eye_separation:?}")
 }
 
-/// Task `parallax_color` (1 point, image check): parallax shown as color (the exercise slides: "blue
+/// Task `parallax_color` (image check): parallax shown as color (the exercise slides: "blue
 /// negative, red positive").
 ///
 /// The mapping: `t = clamp(p / max_abs, −1, 1)`; positive `t` gives `[t, 0, 0]` (red), negative

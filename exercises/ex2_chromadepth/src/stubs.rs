@@ -1,9 +1,10 @@
 //! Your code: complete every `todo!`. Each doc comment states the task, where its formula comes
-//! from, and the conventions; `stereolab grade ex2` scores each function on its own.
+//! from, and the conventions; `stereolab grade ex2` scores each function on its own and
+//! `stereolab grade points` prints each task's points.
 
 use glam::Vec3;
 
-/// Task `hsv_ramp` (2 points, image check): the ChromaDepth color at ramp position `t`.
+/// Task `hsv_ramp` (image check): the ChromaDepth color at ramp position `t`.
 ///
 /// Source: the ChromaDepth article, "Creating ChromaDepth Scenes": a 1D texture running red (near, `t = 0`)
 /// through green to blue (far, `t = 1`), interpolated in HSV: hue `240° · t`, saturation 1,
@@ -13,7 +14,7 @@ pub fn hsv_ramp(t: f32) -> [f32; 3] {
     todo!("ramp color at t = {t:?}")
 }
 
-/// Task `texgen` (2 points, image check): the eye-linear texgen plane `[A, B, C, D]` of
+/// Task `texgen` (image check): the eye-linear texgen plane `[A, B, C, D]` of
 /// `s = A x + B y + C z + D` so that `s = 0` at distance `d1` in front of the eye and `s = 1` at
 /// `d2`.
 ///
@@ -24,7 +25,7 @@ pub fn texgen(d1: f32, d2: f32) -> [f32; 4] {
     todo!("texgen plane for D1 = {d1:?}, D2 = {d2:?}")
 }
 
-/// Task `depth_range` (1 point): `[D1, D2]` from a bounding sphere of the scene.
+/// Task `depth_range`: `[D1, D2]` from a bounding sphere of the scene.
 ///
 /// Source: the ChromaDepth article: "fit a spherical bounding volume around the center of the scene, and set
 /// D1 and D2 to the limits of the sphere". `center` is in eye space (looking down −Z, so its

@@ -1,9 +1,10 @@
 //! Your code: complete every `todo!`. Each doc comment states the task, where its formula comes
-//! from, and the conventions; `stereolab grade ex3` scores each function on its own.
+//! from, and the conventions; `stereolab grade ex3` scores each function on its own and
+//! `stereolab grade points` prints each task's points.
 
 use exercise_api::{SirdsGeometry, SirdsSetup};
 
-/// Task `disparity_constant_direction` (1 point): the distance between the two projections of a
+/// Task `disparity_constant_direction`: the distance between the two projections of a
 /// point at depth `z` behind the image plane, assuming every eye ray meets the image plane at
 /// the angle `phi` (radians).
 ///
@@ -13,7 +14,7 @@ pub fn disparity_constant_direction(z: f32, phi: f32) -> f32 {
     todo!("d for z = {z:?}, phi = {phi:?} rad")
 }
 
-/// Task `disparity_constant_eyes` (1 point): the same distance for eyes `a` apart at distance
+/// Task `disparity_constant_eyes`: the same distance for eyes `a` apart at distance
 /// `f` in front of the image plane (all in pixels), the point centered in front of the eyes.
 ///
 /// Source: the SIRDS paper (Petz et al.), §2.2, Eq. (3): `d = a z / (z + f)`.
@@ -22,7 +23,7 @@ pub fn disparity_constant_eyes(z: f32, geometry: &SirdsGeometry) -> f32 {
     todo!("d for z = {z:?} with {geometry:?}")
 }
 
-/// Task `link_row` (3 points, image check): the per-scan-line constraints of a SIRDS with
+/// Task `link_row` (image check): the per-scan-line constraints of a SIRDS with
 /// hidden-surface removal (the SIRDS paper's §2–3, after its reference 5: Thimbleby, Inglis and Witten,
 /// "Displaying 3D images", IEEE Computer 27(10), 1994).
 ///
