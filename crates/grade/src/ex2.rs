@@ -9,7 +9,7 @@ use serde_json::json;
 
 use super::ex1::flat;
 use super::fixture::Fixture;
-use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
+use super::spec::{Case, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use stereolab::render::chromadepth::ChromaDepthShader;
 use stereolab::scene::Scene;
 use stereolab_core::effects::chromadepth::ChromaDepthSettings;
@@ -149,10 +149,10 @@ fn ramp_task() -> TaskSpec {
                 answers: each(&|t| hue_to_rgb(240.0 * t)),
             },
         ],
-        image: Some(ImageCheck {
-            inputs: strip_ts.iter().map(|t| json!(t)).collect(),
-            build: Box::new(build),
-        }),
+        image: Some(crate::pictures::check(
+            strip_ts.iter().map(|t| json!(t)).collect(),
+            Box::new(build),
+        )),
     }
 }
 
@@ -269,10 +269,10 @@ fn texgen_task(fx: &Fixture) -> TaskSpec {
                 }),
             },
         ],
-        image: Some(ImageCheck {
-            inputs: vec![json!(range)],
-            build: Box::new(pictures),
-        }),
+        image: Some(crate::pictures::check(
+            vec![json!(range)],
+            Box::new(pictures),
+        )),
     }
 }
 

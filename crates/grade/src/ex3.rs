@@ -9,7 +9,7 @@ use serde_json::json;
 
 use super::ex1::flat;
 use super::fixture::{Fixture, unproject};
-use super::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
+use super::spec::{Case, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use crate::exercise::{SirdsGeometry, SirdsSetup};
 use stereolab_core::effects::sirds::disparity::{separation_eye_distance, separation_view_angle};
 use stereolab_core::effects::sirds::per_pixel::RowLinker;
@@ -303,14 +303,13 @@ fn link_task(fx: &Fixture) -> TaskSpec {
                 answers: each(Linking::NoRowAlternation),
             },
         ],
-        image: Some(ImageCheck {
-            inputs: rows
-                .iter()
+        image: Some(crate::pictures::check(
+            rows.iter()
                 .enumerate()
                 .map(|(y, r)| json!([r, y, SETUP]))
                 .collect(),
-            build: Box::new(build),
-        }),
+            Box::new(build),
+        )),
     }
 }
 

@@ -4,28 +4,7 @@
 use std::path::Path;
 
 use stereolab_core::error::{Error, Result};
-
-/// Lines between these markers (inclusive) are the instructor's and are dropped from the handout.
-pub(crate) const SOLUTION_BEGIN: &str = "solution-begin";
-/// See [`SOLUTION_BEGIN`].
-pub(crate) const SOLUTION_END: &str = "solution-end";
-
-/// Removes every `solution-begin` … `solution-end` block (marker lines included).
-pub(crate) fn strip_solution(text: &str) -> String {
-    let mut out = String::new();
-    let mut skipping = false;
-    for line in text.lines() {
-        if line.contains(SOLUTION_BEGIN) {
-            skipping = true;
-        } else if line.contains(SOLUTION_END) {
-            skipping = false;
-        } else if !skipping {
-            out.push_str(line);
-            out.push('\n');
-        }
-    }
-    out
-}
+use stereolab_grade_core::build::{HANDOUT_PROFILE, strip_solution};
 
 fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
     move |e| Error::io(path, e)
@@ -49,21 +28,6 @@ fn copy_tree(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()>
     }
     Ok(())
 }
-
-/// The handout workspace's build profile: no optimization and no debug info for the grader and
-/// every dependency, proc macros included. The grader's work (64×48 fixtures, a few thousand
-/// numbers per task) takes well under a second unoptimized; what a student waits for is the
-/// first build of the grader and its dependencies (docs/performance.md, "A student's first grade").
-pub(crate) const HANDOUT_PROFILE: &str = "\
-[profile.dev]
-opt-level = 0
-debug = false
-incremental = false
-
-[profile.dev.package.\"*\"]
-opt-level = 0
-debug = false
-";
 
 /// The handout's copy of stereolab's manifest and the versions its crates share: the command's
 /// package and dependencies (whose default features compile no window, GPU, zip or allocator

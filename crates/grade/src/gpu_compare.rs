@@ -73,7 +73,7 @@ pub fn compare_exercise(
         timeout: super::BuildMode::DEFAULT_TIMEOUT,
     };
     let binary = submission_binary(dir, ex, solution, &default_work_dir(), mode)
-        .map_err(|log| Error::invalid(ex.crate_name(), "cannot be built", log))?;
+        .map_err(|why| Error::invalid(ex.crate_name(), "cannot be built", why.message))?;
     let run = child::run(&binary, TASK, &inputs, limits);
     let expected = r.render_views(
         &GpuScene::upload(r, scene)?,

@@ -8,7 +8,7 @@ use crate::exercise::{
     reference_matrices,
 };
 use crate::fixture::Fixture;
-use crate::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance};
+use crate::spec::{Case, Mistake, Picture, TaskSpec, Tolerance};
 use stereolab_core::effects::anaglyph::AnaglyphKind::DuboisRedCyan;
 use stereolab_core::effects::anaglyph::anaglyph_pixel;
 use stereolab_core::framebuffer::Framebuffer;
@@ -128,10 +128,10 @@ pub(super) fn anaglyph_task(fx: &Fixture) -> TaskSpec {
                 answers: each(&swapped_pair),
             },
         ],
-        image: Some(ImageCheck {
-            inputs: kinds.iter().map(|k| json!(k)).collect(),
-            build: Box::new(build),
-        }),
+        image: Some(crate::pictures::check(
+            kinds.iter().map(|k| json!(k)).collect(),
+            Box::new(build),
+        )),
     }
 }
 

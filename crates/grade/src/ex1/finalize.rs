@@ -11,7 +11,7 @@ use crate::exercise::{
     AnaglyphKind, AnaglyphMatrices, ColorMatrix, exercise_matrices, reference_matrices,
 };
 use crate::fixture::Fixture;
-use crate::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
+use crate::spec::{Case, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use stereolab_core::effects::anaglyph::AnaglyphKind::DuboisRedCyan;
 use stereolab_core::effects::anaglyph::anaglyph_pixel;
 use stereolab_core::framebuffer::Framebuffer;
@@ -271,10 +271,7 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
                 }),
             },
         ],
-        image: Some(ImageCheck {
-            inputs: image_inputs,
-            build: Box::new(build),
-        }),
+        image: Some(crate::pictures::check(image_inputs, Box::new(build))),
     }
 }
 

@@ -5,7 +5,7 @@ use serde_json::json;
 
 use super::{flat, left_samples};
 use crate::fixture::Fixture;
-use crate::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
+use crate::spec::{Case, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use stereolab_core::shade::to_rgba8;
 
 pub(super) fn parallax_task() -> TaskSpec {
@@ -182,9 +182,9 @@ pub(super) fn parallax_color_task(fx: &Fixture) -> TaskSpec {
                 }),
             },
         ],
-        image: Some(ImageCheck {
-            inputs: samples.iter().map(|(_, _, p)| json!([p, max])).collect(),
-            build: Box::new(build),
-        }),
+        image: Some(crate::pictures::check(
+            samples.iter().map(|(_, _, p)| json!([p, max])).collect(),
+            Box::new(build),
+        )),
     }
 }

@@ -17,9 +17,7 @@ use serde_json::{Value, json};
 use super::remap::{RemapVariant, remap_reference};
 use super::{HIDDEN_SETUPS, eyes, random_setup};
 use crate::fixture::{Fixture, pixel_uv};
-use crate::spec::{
-    Case, ImageCheck, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases,
-};
+use crate::spec::{Case, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases};
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab::scene::Scene;
@@ -417,10 +415,7 @@ pub(super) fn rds_task(fx: &Fixture) -> TaskSpec {
             })
             .collect(),
         mistakes,
-        image: Some(ImageCheck {
-            inputs: image_inputs,
-            build: Box::new(build),
-        }),
+        image: Some(crate::pictures::check(image_inputs, Box::new(build))),
     }
 }
 

@@ -7,9 +7,7 @@ use serde_json::json;
 use super::view_samples;
 use super::{HIDDEN_SETUPS, eyes, random_setup};
 use crate::fixture::Fixture;
-use crate::spec::{
-    Case, ImageCheck, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases,
-};
+use crate::spec::{Case, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases};
 use stereolab_core::effects::remap::{Precision, Remapped, Remapper};
 use stereolab_core::math::{CameraMode, Lighting};
 
@@ -334,10 +332,7 @@ fn remap_direction_task(fx: &Fixture, from: usize) -> TaskSpec {
                 }),
             },
         ],
-        image: Some(ImageCheck {
-            inputs: image_inputs,
-            build: Box::new(build),
-        }),
+        image: Some(crate::pictures::check(image_inputs, Box::new(build))),
     }
 }
 

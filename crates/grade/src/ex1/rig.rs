@@ -7,7 +7,7 @@ use serde_json::{Value, json};
 use super::{HIDDEN_SETUPS, MATRIX_TOLERANCE, blank, camera, eyes, flat, random_setup, setups};
 use crate::exercise::StereoSetup;
 use crate::fixture::Fixture;
-use crate::spec::{Case, ImageCheck, Mistake, Picture, TaskSpec, hidden_cases};
+use crate::spec::{Case, Mistake, Picture, TaskSpec, hidden_cases};
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab_core::framebuffer::Framebuffer;
@@ -227,10 +227,7 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
                 answers: mv_t,
             },
         ],
-        image: Some(ImageCheck {
-            inputs,
-            build: Box::new(build),
-        }),
+        image: Some(crate::pictures::check(inputs, Box::new(build))),
     }
 }
 

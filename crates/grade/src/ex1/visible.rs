@@ -5,9 +5,7 @@ use serde_json::json;
 use super::remap::{stereolab_remap, texel_of};
 use super::{flat, left_samples};
 use crate::fixture::Fixture;
-use crate::spec::{
-    Case, ImageCheck, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases,
-};
+use crate::spec::{Case, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases};
 
 /// The visibility inputs `(uv_right, remapped, stored, tolerance)` of a left pixel, using the
 /// reference remap and a nearest lookup in the right depth buffer.
@@ -205,10 +203,10 @@ pub(super) fn visible_task(fx: &Fixture) -> TaskSpec {
                 answers: each("one-sided"),
             },
         ],
-        image: Some(ImageCheck {
-            inputs: fixture_inputs.iter().map(|(_, _, i)| json!(i)).collect(),
-            build: Box::new(build),
-        }),
+        image: Some(crate::pictures::check(
+            fixture_inputs.iter().map(|(_, _, i)| json!(i)).collect(),
+            Box::new(build),
+        )),
     }
 }
 

@@ -15,9 +15,9 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
-use crate::exercise::decode_reply;
-use crate::exercise::protocol::ANSWER_FD_ENV;
 use crate::sandbox::{Jail, Sandbox, User};
+use exercise_api::decode_reply;
+use exercise_api::protocol::ANSWER_FD_ENV;
 
 /// A built submission binary and the SHA-256 of its bytes when it was built.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -538,7 +538,7 @@ fn kill_group(pid: u32) {
 /// Makes this process the reaper of its orphaned descendants (Linux), so a process a task
 /// starts in a new session of its own, to outlive the task, comes back to the grader and is
 /// killed ([`reap_orphans`]).
-pub(crate) fn become_subreaper() {
+pub fn become_subreaper() {
     #[cfg(target_os = "linux")]
     // SAFETY: plain syscall with constant arguments.
     unsafe {

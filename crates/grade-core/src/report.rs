@@ -343,7 +343,7 @@ fn cap(text: &str, max: usize) -> String {
 /// becomes `ex1_a.png`, `/home/me/x/src/stubs.rs:3:5` becomes `stubs.rs:3:5`, a relative source
 /// path such as `ex1_stereo/src/stubs.rs` stays): results.json and
 /// a batch's report.txt go to students, the paths mean nothing to them.
-pub(crate) fn without_dirs(text: &str) -> String {
+pub fn without_dirs(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for (k, line) in text.split('\n').enumerate() {
         if k > 0 {

@@ -5,16 +5,10 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 
 use super::child::Run;
-use super::spec::{
-    Case, HIDDEN_SHARE, IMAGE_MAX_COVERAGE_PERCENT, IMAGE_MAX_MEAN_DIFF, IMAGE_SHARE, Picture,
-    TaskSpec, Tolerance,
-};
-use stereolab::compare::{ascii_map, compare, coverage, write_diff_strip};
+use super::spec::{Case, HIDDEN_SHARE, IMAGE_SHARE, TaskSpec, Tolerance};
 
 /// Failing cases printed per task (the rest are counted).
 const SHOWN_FAILURES: usize = 3;
-/// ASCII maps are printed for rasters up to this width.
-const ASCII_MAX_WIDTH: u32 = 64;
 
 /// How one task scored.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,11 +56,7 @@ pub struct HiddenResult {
 
 impl TaskResult {
     /// A task not run because the crate was not built (`why`).
-    pub(crate) fn not_built(
-        exercise: &'static str,
-        spec: &TaskSpec,
-        why: &crate::NotBuilt,
-    ) -> TaskResult {
+    pub fn not_built(exercise: &'static str, spec: &TaskSpec, why: &crate::NotBuilt) -> TaskResult {
         TaskResult {
             exercise,
             name: spec.name,
@@ -283,7 +273,7 @@ fn tally(cases: &[Case], replies: &[Result<Vec<f64>, String>], tol: &Tolerance) 
 /// (the hidden cases, answered by a process of their own, so nothing the public run prints can
 /// show them); failing pictures are written to `out_dir` as `expected | diff | actual` strips
 /// named `<exercise>_<picture>.png`.
-pub(crate) fn evaluate(
+pub fn evaluate(
     exercise: &'static str,
     spec: &TaskSpec,
     run: &Run,
@@ -326,9 +316,16 @@ pub(crate) fn evaluate(
                     .and_then(|r| r.as_ref().ok().cloned())
             })
             .collect();
-        let built = catch_unwind(AssertUnwindSafe(|| (img.build)(&answers)));
-        match built {
-            Ok(pictures) => check_pictures(exercise, &pictures, out_dir, &mut details),
+        let judged = catch_unwind(AssertUnwindSafe(|| {
+            let mut lines = Vec::new();
+            let ok = (img.judge)(exercise, &answers, out_dir, &mut lines);
+            (ok, lines)
+        }));
+        match judged {
+            Ok((ok, lines)) => {
+                details.extend(lines);
+                ok
+            }
             Err(_) => {
                 details.push("image check: the picture could not be built from the answers".into());
                 false
@@ -450,7 +447,7 @@ fn round2(x: f64) -> f64 {
 /// After all tasks of an exercise are scored: a task that lost points while a task it calls
 /// (`depends_on`) lost points too gets the hint to fix that one first; its own diagnosis is kept
 /// in the hint's text.
-pub(crate) fn blame_dependencies(specs: &[TaskSpec], results: &mut [TaskResult]) {
+pub fn blame_dependencies(specs: &[TaskSpec], results: &mut [TaskResult]) {
     let failed: Vec<&'static str> = results
         .iter()
         .filter(|r| r.score < r.points)
@@ -516,78 +513,10 @@ fn diagnose(spec: &TaskSpec, failing: &[(usize, Vec<f64>)]) -> Option<(String, S
         .map(|m| (m.id.to_string(), m.hint.to_string()))
 }
 
-/// Compares each picture; writes strips and ASCII maps for the failing ones.
-fn check_pictures(
-    exercise: &str,
-    pictures: &[Picture],
-    out_dir: &Path,
-    details: &mut Vec<String>,
-) -> bool {
-    let mut all = true;
-    let mut mapped = false;
-    for p in pictures {
-        let m = match compare(&p.expected, &p.actual) {
-            Ok(m) => m,
-            Err(e) => {
-                details.push(format!("image {}: {e}", p.name));
-                all = false;
-                continue;
-            }
-        };
-        let ok = m.coverage_mismatch_percent() <= IMAGE_MAX_COVERAGE_PERCENT
-            && m.mean_channel_diff <= IMAGE_MAX_MEAN_DIFF;
-        if ok {
-            continue;
-        }
-        all = false;
-        let mut line = format!(
-            "image {}: coverage mismatch {:.2}% (tolerance {IMAGE_MAX_COVERAGE_PERCENT}%), mean channel difference {:.2} (tolerance {IMAGE_MAX_MEAN_DIFF}), max {}",
-            p.name,
-            m.coverage_mismatch_percent(),
-            m.mean_channel_diff,
-            m.max_channel_diff
-        );
-        match write_diff_strip(
-            &p.expected,
-            &p.actual,
-            out_dir,
-            &format!("{exercise}_{}", p.name),
-        ) {
-            Ok(path) => {
-                let _ = write!(line, "; expected | diff | actual: {}", path.display());
-            }
-            Err(e) => {
-                let _ = write!(line, "; diff image not written: {e}");
-            }
-        }
-        // One map per task (the first failing picture): the others are in their strips.
-        if p.expected.width() <= ASCII_MAX_WIDTH && m.coverage_mismatch > 0 && !mapped {
-            mapped = true;
-            let _ = write!(
-                line,
-                "\n  coverage (# both, ! extra, ? missed):\n{}",
-                ascii_map(
-                    &coverage(&p.expected),
-                    &coverage(&p.actual),
-                    p.expected.width() as usize,
-                    ASCII_MAX_WIDTH as usize
-                )
-                .lines()
-                .map(|l| format!("    {l}"))
-                .collect::<Vec<_>>()
-                .join("\n")
-            );
-        }
-        details.push(line);
-    }
-    all
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::spec::{ImageCheck, Mistake};
-    use stereolab_core::framebuffer::Framebuffer;
 
     /// A task of `n` exact cases (case `k` answers `k`), one known mistake (answering
     /// `k + 1000`) and, with `image`, an image check that passes when its input is answered `1`.
@@ -599,7 +528,6 @@ mod tests {
                 expected: vec![k as f64],
             })
             .collect();
-        let picture = |fill: u8| Framebuffer::new(8, 8, [fill, fill, fill, 255]).expect("8×8");
         TaskSpec {
             name: "synthetic",
             points,
@@ -613,14 +541,14 @@ mod tests {
             }],
             image: image.then(|| ImageCheck {
                 inputs: vec![serde_json::json!("picture")],
-                build: Box::new(move |answers: &[Option<Vec<f64>>]| {
+                judge: Box::new(|_, answers: &[Option<Vec<f64>>], _, details| {
                     let right = answers.first().cloned().flatten() == Some(vec![1.0]);
-                    vec![Picture {
-                        name: "synthetic".into(),
-                        expected: picture(0),
-                        actual: picture(if right { 0 } else { 200 }),
-                    }]
+                    if !right {
+                        details.push("image synthetic: differs".into());
+                    }
+                    right
                 }),
+                show: None,
             }),
             depends_on: &[],
             hidden: Vec::new(),

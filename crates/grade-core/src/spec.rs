@@ -1,8 +1,8 @@
 //! What a task is to the grader: inputs, expected answers, tolerance, known mistakes, images.
 
-use serde_json::Value;
+use std::path::Path;
 
-use stereolab_core::framebuffer::Framebuffer;
+use serde_json::Value;
 
 /// A numeric tolerance: an answer element `a` matches `e` when `|a − e| ≤ abs + rel · |e|`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,7 +17,7 @@ pub struct Tolerance {
 
 impl Tolerance {
     /// Exact equality (integers, booleans, indices).
-    pub(crate) const EXACT: Tolerance = Tolerance {
+    pub const EXACT: Tolerance = Tolerance {
         abs: 0.0,
         rel: 0.0,
         why: "exact: integers and booleans",
@@ -25,7 +25,7 @@ impl Tolerance {
 
     /// Whether `actual` matches `expected` element by element (same length, all finite where
     /// expected is finite).
-    pub(crate) fn accepts(&self, expected: &[f64], actual: &[f64]) -> bool {
+    pub fn accepts(&self, expected: &[f64], actual: &[f64]) -> bool {
         expected.len() == actual.len()
             && expected
                 .iter()
@@ -58,7 +58,7 @@ pub struct Case {
 /// A known wrong formula: what it answers for each case. When a student's failing answers all
 /// match it, the grader names it.
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Mistake {
+pub struct Mistake {
     /// Short stable name, printed in brackets (`[swapped-eyes]`).
     pub id: &'static str,
     /// What to check, in words a student can act on.
@@ -67,39 +67,29 @@ pub(crate) struct Mistake {
     pub answers: Vec<Vec<f64>>,
 }
 
-/// One image compared: the reference's and the one built from the student's answers.
-#[derive(Clone, Debug)]
-pub(crate) struct Picture {
-    /// File-name-friendly name (`stereo_matrices_left_per_eye`).
-    pub name: String,
-    /// Reference.
-    pub expected: Framebuffer,
-    /// From the student's answers.
-    pub actual: Framebuffer,
-}
+/// Judges an image check: given the exercise's id, the student's answers to
+/// [`ImageCheck::inputs`] (`None` where the code panicked or gave no answer), and the folder for
+/// pictures, says whether the pictures match, adding lines to the details.
+pub type Judge = Box<dyn Fn(&str, &[Option<Vec<f64>>], &Path, &mut Vec<String>) -> bool>;
 
-/// Builds the student's pictures from the answers to [`ImageCheck::inputs`] (`None` where the
-/// student's code panicked or gave no answer).
-pub(crate) type PictureBuilder = Box<dyn Fn(&[Option<Vec<f64>>]) -> Vec<Picture>>;
+/// Shows an image check's pictures (`render --exercise`): every picture written to the folder,
+/// one line each.
+pub type Show = Box<dyn Fn(&[Option<Vec<f64>>], &Path) -> Vec<String>>;
 
-/// An image check: the student's functions plugged into the real pipeline vs the reference.
-pub(crate) struct ImageCheck {
+/// An image check: the student's functions plugged into the real pipeline vs the reference
+/// (the instructor's grader), or, where no renderer is at hand (a handout's grader), the
+/// answers its pictures are drawn from against the reference's.
+pub struct ImageCheck {
     /// Inputs whose answers the pictures are built from.
     pub inputs: Vec<Value>,
-    /// The builder.
-    pub build: PictureBuilder,
+    /// The judge.
+    pub judge: Judge,
+    /// Every picture, for `render --exercise` (`None` where no renderer is at hand).
+    pub show: Option<Show>,
 }
 
-/// Largest share of pixels whose coverage may differ, in percent. A matrix inside the numeric
-/// tolerance (1e-4 relative) moves an edge by well under 0.01 pixel at these sizes, which flips
-/// only pixels whose centers lie that close to an edge: a handful, far below 1%.
-pub(crate) const IMAGE_MAX_COVERAGE_PERCENT: f64 = 1.0;
-/// Largest mean RGB difference (0..255). Answers inside the numeric tolerances change an 8-bit
-/// channel by at most one step on a few pixels; a real mistake changes whole regions.
-pub(crate) const IMAGE_MAX_MEAN_DIFF: f64 = 1.0;
-
 /// A task: one stub, scored on its own.
-pub(crate) struct TaskSpec {
+pub struct TaskSpec {
     /// The stub's name and the task name in the protocol.
     pub name: &'static str,
     /// Points for a complete answer.
@@ -123,30 +113,30 @@ pub(crate) struct TaskSpec {
 }
 
 /// Share of a task's points the image check carries when the task has one.
-pub(crate) const IMAGE_SHARE: f64 = 0.3;
+pub const IMAGE_SHARE: f64 = 0.3;
 
 /// Share of a task's points its hidden cases carry when it has some; the public cases and the
 /// image check share the rest as before (so without a seed a task scores exactly as it did).
-pub(crate) const HIDDEN_SHARE: f64 = 0.3;
+pub const HIDDEN_SHARE: f64 = 0.3;
 
 /// The environment variable holding the instructor's seed for the hidden cases (a u64).
 pub const SEED_VAR: &str = "STEREOLAB_GRADER_SEED";
 
 /// The instructor's seed from [`SEED_VAR`]; `None` (no hidden cases) when unset or not a u64,
 /// so students' local runs and the repository's tests see exactly the public cases.
-pub(crate) fn grader_seed() -> Option<u64> {
+pub fn grader_seed() -> Option<u64> {
     std::env::var(SEED_VAR).ok()?.trim().parse().ok()
 }
 
 /// A small deterministic generator for hidden cases: splitmix64 (Steele, Lea and Flood,
 /// "Fast splittable pseudorandom number generators", 2014; the seeding generator of
 /// xoshiro). The same seed and task name give the same cases on every machine.
-pub(crate) struct SplitMix64(u64);
+pub struct SplitMix64(u64);
 
 impl SplitMix64 {
     /// A generator for `task`'s hidden cases under `seed` (the name is hashed in with FNV-1a so
     /// that tasks draw different numbers).
-    pub(crate) fn for_task(seed: u64, task: &str) -> SplitMix64 {
+    pub fn for_task(seed: u64, task: &str) -> SplitMix64 {
         let mut h: u64 = 0xcbf2_9ce4_8422_2325;
         for b in task.bytes() {
             h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
@@ -155,7 +145,7 @@ impl SplitMix64 {
     }
 
     /// The next 64 random bits.
-    pub(crate) fn next_u64(&mut self) -> u64 {
+    pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
@@ -164,7 +154,7 @@ impl SplitMix64 {
     }
 
     /// Uniform in `[lo, hi)`, rounded to 3 decimals so that a case prints readably.
-    pub(crate) fn range(&mut self, lo: f32, hi: f32) -> f32 {
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
         let u = (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let x = f64::from(lo) + u * f64::from(hi - lo);
         ((x * 1000.0).round() / 1000.0).clamp(f64::from(lo), f64::from(hi)) as f32
@@ -173,7 +163,7 @@ impl SplitMix64 {
 
 /// `count` hidden cases for `task` from `make` (given the generator and the case number), or
 /// none when no seed is set.
-pub(crate) fn hidden_cases(
+pub fn hidden_cases(
     task: &str,
     count: usize,
     mut make: impl FnMut(&mut SplitMix64, usize) -> Case,

@@ -33,11 +33,47 @@ use sha2::{Digest, Sha256};
 
 use super::Exercise;
 use super::child::{Binary, spawn_tracked, untrack};
-use super::export::strip_solution;
 use super::sandbox::{self, Jail, Sandbox, User};
 
 /// The largest stubs file the grader reads from a submission.
 pub(crate) const MAX_STUBS_BYTES: u64 = 1 << 20;
+
+/// Lines between these markers (inclusive) are the instructor's and are dropped from the handout.
+pub const SOLUTION_BEGIN: &str = "solution-begin";
+/// See [`SOLUTION_BEGIN`].
+pub const SOLUTION_END: &str = "solution-end";
+
+/// Removes every `solution-begin` … `solution-end` block (marker lines included).
+pub fn strip_solution(text: &str) -> String {
+    let mut out = String::new();
+    let mut skipping = false;
+    for line in text.lines() {
+        if line.contains(SOLUTION_BEGIN) {
+            skipping = true;
+        } else if line.contains(SOLUTION_END) {
+            skipping = false;
+        } else if !skipping {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// The handout workspace's build profile: no optimization and no debug info for the grader and
+/// every dependency, proc macros included. The grader's work (64×48 fixtures, a few thousand
+/// numbers per task) takes well under a second unoptimized; what a student waits for is the
+/// first build of the grader and its dependencies (docs/performance.md, "A student's first grade").
+pub const HANDOUT_PROFILE: &str = "\
+[profile.dev]
+opt-level = 0
+debug = false
+incremental = false
+
+[profile.dev.package.\"*\"]
+opt-level = 0
+debug = false
+";
 
 /// The grader's own copy of an exercise crate (everything but the stubs).
 struct Template {
@@ -93,7 +129,7 @@ pub(crate) fn exercise_api_dir() -> PathBuf {
 
 /// The build's manifest: the exercise's own, without the instructor's `solution` feature, with
 /// `exercise-api` by absolute path, as a workspace of its own with stereolab's profiles (the
-/// handout's, [`super::export::HANDOUT_PROFILE`], in a handout).
+/// handout's, [`HANDOUT_PROFILE`], in a handout).
 fn manifest(ex: Exercise) -> Result<String, String> {
     let text = strip_solution(template(ex).manifest);
     let mut table: toml::Table =
@@ -113,7 +149,7 @@ fn manifest(ex: Exercise) -> Result<String, String> {
     // debug info: the exercise crates compile fastest).
     let profile = match repository_profile()? {
         Some(p) => Some(p),
-        None => toml::from_str::<toml::Table>(super::export::HANDOUT_PROFILE)
+        None => toml::from_str::<toml::Table>(HANDOUT_PROFILE)
             .map_err(|e| format!("the handout's profile: {e}"))?
             .remove("profile"),
     };
@@ -471,7 +507,7 @@ fn artifact(out: &std::process::Output, dir: &Path, name: &str) -> Result<PathBu
 
 /// In a student's handout (whose copy of stereolab's manifest has no profiles), the handout
 /// workspace's own target folder: the exercise builds then use the same profile
-/// ([`super::export::HANDOUT_PROFILE`]) and reuse the dependencies the grader's build compiled
+/// ([`HANDOUT_PROFILE`]) and reuse the dependencies the grader's build compiled
 /// there (glam; 7 of the first grade's 18 CPU-s). `cargo run` holds no lock on it while the
 /// grader runs. `None` in the repository: `work/target`.
 fn handout_target() -> Option<PathBuf> {
@@ -497,7 +533,7 @@ fn reported_hash(bin: &Path) -> Option<String> {
     let mut jail = super::child::task_jail(bin, &scratch.0);
     // Without the answer pipe the hash goes to stdout.
     jail.env
-        .retain(|(k, _)| k != crate::exercise::protocol::ANSWER_FD_ENV);
+        .retain(|(k, _)| k != exercise_api::protocol::ANSWER_FD_ENV);
     let mut cmd = sandbox.command(&jail, user.as_ref(), bin, &["--source-hash".into()]);
     cmd.stdin(Stdio::null())
         .stdout(Stdio::piped())
