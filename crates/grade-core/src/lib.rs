@@ -11,6 +11,8 @@
 
 pub mod build;
 pub mod child;
+pub mod data;
+pub mod points;
 pub mod report;
 pub mod sandbox;
 pub mod score;

@@ -549,6 +549,7 @@ mod tests {
                     right
                 }),
                 show: None,
+                reference: None,
             }),
             depends_on: &[],
             hidden: Vec::new(),

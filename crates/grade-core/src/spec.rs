@@ -86,6 +86,9 @@ pub struct ImageCheck {
     pub judge: Judge,
     /// Every picture, for `render --exercise` (`None` where no renderer is at hand).
     pub show: Option<Show>,
+    /// Writes the reference pictures to the folder and returns their file names (for a
+    /// handout's data; `None` where no renderer is at hand).
+    pub reference: Option<Show>,
 }
 
 /// A task: one stub, scored on its own.

@@ -1,10 +1,18 @@
-//! `stereolab exercises export DIR`: the student handout — the exercise crates with their stubs,
-//! tests and the stereolab library (with the grader and its assets), without the solutions.
+//! `stereolab exercises export DIR`: the student handout — the exercise crates with their stubs
+//! and tests, the slides and docs, and a grader that carries the course's public cases as data:
+//! no solution, and no reference implementation (neither stereolab's library nor the task specs'
+//! code).
 
 use std::path::Path;
 
 use stereolab_core::error::{Error, Result};
 use stereolab_grade_core::build::{HANDOUT_PROFILE, strip_solution};
+use stereolab_grade_core::data::{exercise_data, task_to_data};
+use stereolab_grade_core::{
+    BuildMode, Exercise, Limits, child, default_work_dir, submission_binary,
+};
+
+use crate::fixture::{Fixture, grading_scene};
 
 fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
     move |e| Error::io(path, e)
@@ -29,43 +37,134 @@ fn copy_tree(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()>
     Ok(())
 }
 
-/// The handout's copy of stereolab's manifest and the versions its crates share: the command's
-/// package and dependencies (whose default features compile no window, GPU, zip or allocator
-/// code), without the workspace, the repository's own tests and examples and the profiles (the handout's
-/// workspace sets them); and the `[workspace.dependencies]` table the crates inherit from,
-/// for the handout's workspace manifest.
-fn library_manifest(text: &str, path: &Path) -> Result<(String, toml::Table)> {
-    let mut table: toml::Table =
+/// The versions the crates share (`[workspace.dependencies]` of stereolab's manifest), for the
+/// handout's workspace manifest.
+fn shared_versions(text: &str, path: &Path) -> Result<toml::Table> {
+    let table: toml::Table =
         toml::from_str(text).map_err(|e| Error::parse(path, None, e.message().to_string()))?;
-    let shared = table
-        .remove("workspace")
+    table
+        .get("workspace")
         .and_then(|w| w.get("dependencies").and_then(|d| d.as_table()).cloned())
-        .ok_or_else(|| Error::parse(path, None, "no [workspace.dependencies] table"))?;
-    table.remove("test");
-    table.remove("example");
-    table.remove("profile");
-    let manifest = toml::to_string(&table).map_err(|e| Error::parse(path, None, e.to_string()))?;
-    Ok((manifest, shared))
+        .ok_or_else(|| Error::parse(path, None, "no [workspace.dependencies] table"))
+}
+
+/// The handout's grader package (`stereolab/Cargo.toml`): `crates/grade-handout`'s manifest
+/// named `stereolab` with a `stereolab` binary, so that `cargo run -p stereolab -- grade ex1`
+/// reads as in the repository, its grade-core beside it.
+fn handout_grader_manifest(root: &Path) -> Result<String> {
+    let path = root.join("crates/grade-handout/Cargo.toml");
+    let text = std::fs::read_to_string(&path).map_err(io(&path))?;
+    let mut table: toml::Table =
+        toml::from_str(&text).map_err(|e| Error::parse(&path, None, e.message().to_string()))?;
+    let fail = |what: &str| Error::parse(&path, None, format!("no {what}"));
+    table
+        .get_mut("package")
+        .and_then(|p| p.as_table_mut())
+        .ok_or_else(|| fail("[package]"))?
+        .insert("name".into(), "stereolab".into());
+    let bin = toml::Table::from_iter([
+        ("name".to_string(), toml::Value::from("stereolab")),
+        ("path".to_string(), toml::Value::from("src/main.rs")),
+    ]);
+    table.insert(
+        "bin".into(),
+        toml::Value::Array(vec![toml::Value::Table(bin)]),
+    );
+    table
+        .get_mut("dependencies")
+        .and_then(|d| d.get_mut("stereolab-grade-core"))
+        .and_then(|d| d.as_table_mut())
+        .ok_or_else(|| fail("stereolab-grade-core dependency"))?
+        .insert("path".into(), "crates/grade-core".into());
+    toml::to_string(&table).map_err(|e| Error::parse(&path, None, e.to_string()))
+}
+
+/// The task data of every exercise into `data` (`ex1.json`…, `pictures/<exercise>/`): the
+/// specs the instructor's grader computes, without hidden cases, with the reference's answers
+/// to the image checks' inputs (the instructor's solution built and run) and the reference
+/// pictures.
+fn write_task_data(root: &Path, data: &Path) -> Result<()> {
+    let fx = Fixture::new(grading_scene()?)?;
+    let mode = BuildMode {
+        sandboxed: false,
+        timeout: BuildMode::DEFAULT_TIMEOUT,
+    };
+    for ex in Exercise::ALL {
+        let binary =
+            submission_binary(&root.join("exercises"), ex, true, &default_work_dir(), mode)
+                .map_err(|why| {
+                    Error::invalid(ex.crate_name(), "the instructor's solution", why.message)
+                })?;
+        let pictures = data.join("pictures").join(ex.id());
+        let mut tasks = Vec::new();
+        for spec in crate::tasks(ex, &fx) {
+            let Some(img) = &spec.image else {
+                tasks.push(task_to_data(&spec, None, &[]));
+                continue;
+            };
+            let run = child::run(&binary, spec.name, &img.inputs, Limits::DEFAULT);
+            let expected: Vec<Option<Vec<f64>>> = (0..img.inputs.len())
+                .map(|k| run.replies.get(k).and_then(|r| r.as_ref().ok().cloned()))
+                .collect();
+            if run.ending.is_some() || expected.iter().any(Option::is_none) {
+                return Err(Error::invalid(
+                    ex.crate_name(),
+                    spec.name,
+                    "the instructor's solution does not answer every input of its image check",
+                ));
+            }
+            let written = img
+                .reference
+                .as_ref()
+                .map_or_else(Vec::new, |r| r(&expected, &pictures));
+            if let Some(e) = written.iter().find(|n| n.starts_with("error:")) {
+                return Err(Error::invalid(ex.crate_name(), spec.name, e.clone()));
+            }
+            let names: Vec<String> = written
+                .iter()
+                .map(|n| format!("pictures/{}/{n}", ex.id()))
+                .collect();
+            tasks.push(task_to_data(&spec, Some(&expected), &names));
+        }
+        let text = serde_json::to_string(&exercise_data(ex, tasks))
+            .map_err(|e| Error::internal("task data", e.to_string()))?;
+        let path = data.join(format!("{}.json", ex.id()));
+        stereolab_core::files::write_bytes(&path, text.as_bytes())?;
+    }
+    Ok(())
 }
 
 /// Writes the handout for the repository at `root` into `dir`:
-/// `dir/Cargo.toml` (a workspace of the three exercises, with the handout's build profile),
-/// `dir/stereolab/` (library, CLI with the grader, docs, assets), `dir/ex*/` (stubs, student tests,
-/// the grader's entry binary; no `solution.rs`, no `solution` feature), `dir/README.md`.
+/// `dir/Cargo.toml` (a workspace of the three exercises and the grader, with the handout's build
+/// profile), `dir/stereolab/` (the grader: `stereolab-grade-core` and the task data, no
+/// reference code and no renderer; the docs), `dir/ex*/` (stubs, student tests, the grader's
+/// entry binary; no `solution.rs`, no `solution` feature), `dir/slides/`, `dir/README.md`.
 ///
 /// # Errors
-/// Unreadable sources or an unwritable `dir`.
+/// Unreadable sources, the instructor's solution not building, or an unwritable `dir`.
 pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     let manifest_path = root.join("Cargo.toml");
     let manifest = std::fs::read_to_string(&manifest_path).map_err(io(&manifest_path))?;
     let lib = dir.join("stereolab");
     std::fs::create_dir_all(&lib).map_err(io(&lib))?;
-    let (package, shared) = library_manifest(&manifest, &manifest_path)?;
-    std::fs::write(lib.join("Cargo.toml"), package).map_err(io(&lib))?;
-    // The command's source and the library crates it depends on.
-    copy_tree(&root.join("src"), &lib.join("src"), &|_| false)?;
-    copy_tree(&root.join("crates"), &lib.join("crates"), &|_| false)?;
-    // The crate documentation includes docs/formulas.md, and the code cites the rest.
+    let shared = shared_versions(&manifest, &manifest_path)?;
+    std::fs::write(lib.join("Cargo.toml"), handout_grader_manifest(root)?).map_err(io(&lib))?;
+    // The grader: its command, the shared machinery and the one error type; nothing else of
+    // stereolab (every other crate holds reference code).
+    copy_tree(
+        &root.join("crates/grade-handout/src"),
+        &lib.join("src"),
+        &|_| false,
+    )?;
+    for krate in ["grade-core", "error"] {
+        copy_tree(
+            &root.join("crates").join(krate),
+            &lib.join("crates").join(krate),
+            &|_| false,
+        )?;
+    }
+    write_task_data(root, &lib.join("data"))?;
+    // The stubs and the README cite the docs (sources, formulas, the anaglyph matrices).
     copy_tree(&root.join("docs"), &lib.join("docs"), &|_| false)?;
     // The course decks, at the handout's top level: Markdown, figures, the npm manifest and
     // lock file to build them; not a local `npm ci` or build.
@@ -73,10 +172,6 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
         p.parent() == Some(&root.join("slides"))
             && (p.ends_with("node_modules") || p.ends_with("build"))
     })?;
-    // The scenes with their models and terrain, and the font the library compiles in.
-    for assets in ["assets/scenes", "assets/fonts"] {
-        copy_tree(&root.join(assets), &lib.join(assets), &|_| false)?;
-    }
     // The lock file twice: the handout's workspace resolves from it, and the grader compiles it
     // in (every build of a submission resolves from the same versions).
     for (from, to) in [
@@ -86,18 +181,18 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     ] {
         std::fs::copy(&from, &to).map_err(io(&from))?;
     }
-    // The grader's templates (manifest, lib.rs, main.rs of each exercise) and exercise-api, the
-    // one crate a student's crate depends on besides glam.
+    // The grader's templates (manifest, lib.rs, main.rs and the untouched stubs of each
+    // exercise) and exercise-api, the one crate a student's crate depends on besides glam.
     copy_tree(
         &root.join("exercises/exercise-api"),
         &lib.join("exercises/exercise-api"),
         &|_| false,
     )?;
     let mut members = Vec::new();
-    for ex in super::Exercise::ALL {
+    for ex in Exercise::ALL {
         let name = ex.crate_name();
         let from = root.join("exercises").join(name);
-        for file in ["Cargo.toml", "src/lib.rs", "src/main.rs"] {
+        for file in ["Cargo.toml", "src/lib.rs", "src/main.rs", "src/stubs.rs"] {
             let (src, dst) = (from.join(file), lib.join("exercises").join(name).join(file));
             if let Some(parent) = dst.parent() {
                 std::fs::create_dir_all(parent).map_err(io(parent))?;
@@ -195,7 +290,9 @@ What is here:
   `02-rig.md` (frusta, stereo matrices), `03-finalize.md` (anaglyphs), `04-remap.md`
   (remapping, visibility, the random-dot pair); `ex2_chromadepth`: `05-chromadepth.md`; `ex3_sirds`:
   `06-sirds.md`. Read the Markdown as it is, or build HTML/PDF as `slides/README.md` says.
-- `stereolab/`: the renderer and the grader. `stereolab/docs/sources.md` names the course's
+- `stereolab/`: the grader. It holds the course's public test inputs with their expected
+  answers and the reference pictures (`stereolab/data/`), not the renderer or any reference
+  code. `stereolab/docs/sources.md` names the course's
   source documents (title, authors, where to get them); `stereolab/docs/formulas.md` collects the
   formulas; `stereolab/docs/anaglyph-matrices.md` holds the published anaglyph matrices the
   bonus task needs. `documents/`, when your instructor added it, holds the documents
@@ -206,20 +303,27 @@ What is here:
 ```sh
 cargo test -p ex1_stereo                                  # the worked examples of the sources
 cargo run -p stereolab -- grade ex1                       # points, hints (or ex2, ex3, all)
-cargo run -p stereolab -- render --exercise ex1 stereolab/assets/scenes/wuson.toml --out out
+cargo run -p stereolab -- grade points                    # every task's points
 ```
 
-**The first `cargo run -p stereolab` compiles the grader**: stereolab with its command line
-only (no viewer window, GPU path or C allocator) and its dependencies, unoptimized (this
-workspace's profile: the grader's pictures are small, so compiling fast matters more than
-running fast). Later runs start at once. Each `grade` then builds your crates in `target/stereolab-grade/` in seconds.
+**The first `cargo run -p stereolab` compiles the grader** and its few dependencies,
+unoptimized (this workspace's profile: compiling fast matters more than running fast). Later
+runs start at once. Each `grade` then builds your crates in `target/stereolab-grade/` in
+seconds.
+
+To see your functions draw in the real renderer, beside the reference, clone the public
+stereolab repository and run `cargo run -- render --exercise ex1 assets/scenes/wuson.toml
+--exercises PATH/TO/THIS/HANDOUT --out out` there.
 
 ## How points are given
 
 - Each task is checked on many inputs (the numbers, with a tolerance printed beside every
-  failure) and, where it draws something, by an image check: your function plugged into the
-  real renderer, compared with the reference picture. The image check carries 30% of the task's
-  points, the numeric checks 70%, in proportion to the inputs you get right.
+  failure) and, where it draws something, by an image check: in the official grade your
+  function is plugged into the real renderer and its picture compared with the reference's;
+  this handout's grader, which has no renderer, compares the answers the picture is drawn from
+  with the reference's (answers within the tolerance draw the reference's picture). The image
+  check carries 30% of the task's points, the numeric checks 70%, in proportion to the inputs
+  you get right.
 - A mistake the grader recognizes (swapped eyes, a transposed matrix, degrees for radians, …)
   is named in a hint. The task still scores the checks your answer passes, like any other
   answer: a recognized mistake never scores below an unrecognized answer that passes fewer
@@ -237,8 +341,8 @@ and never reads it as an answer. Printing a lot slows a task down; remove it whe
 
 ## Pictures
 
-`grade` writes `expected | diff | actual` strips of failing image checks to `grade-out/`
-(cleared at each run). Open them next to the ASCII maps it prints.
+The reference pictures of every image check are in `stereolab/data/pictures/`; a failing
+image check names the ones to look at.
 "#;
 
 #[cfg(test)]

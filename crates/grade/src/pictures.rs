@@ -40,13 +40,46 @@ const ASCII_MAX_WIDTH: u32 = 64;
 pub(crate) fn check(inputs: Vec<Value>, build: PictureBuilder) -> ImageCheck {
     let build = Rc::new(build);
     let shown = Rc::clone(&build);
+    let reference = Rc::clone(&build);
     ImageCheck {
         inputs,
         judge: Box::new(move |exercise, answers, out_dir, details| {
             check_pictures(exercise, &build(answers), out_dir, details)
         }),
         show: Some(Box::new(move |answers, out| show(&shown(answers), out))),
+        reference: Some(Box::new(move |answers, out| {
+            write_references(&reference(answers), out)
+        })),
     }
+}
+
+/// How much a reference picture is enlarged (nearest pixel) to be looked at: the grader's
+/// pictures are a few dozen pixels wide.
+const REFERENCE_SCALE: u32 = 4;
+
+/// Writes each picture's reference as `<name>.png` in `out`, enlarged; the file names (an
+/// entry starting with `error:` for one that could not be written).
+fn write_references(pictures: &[Picture], out: &Path) -> Vec<String> {
+    pictures
+        .iter()
+        .map(|p| {
+            let img = p.expected.to_rgba_image();
+            let big = image::imageops::resize(
+                &img,
+                img.width() * REFERENCE_SCALE,
+                img.height() * REFERENCE_SCALE,
+                image::imageops::FilterType::Nearest,
+            );
+            let name = format!("{}.png", p.name);
+            match std::fs::create_dir_all(out)
+                .map_err(|e| stereolab_core::error::Error::io(out, e))
+                .and_then(|()| stereolab_core::files::write_png(&out.join(&name), &big))
+            {
+                Ok(()) => name,
+                Err(e) => format!("error: {e}"),
+            }
+        })
+        .collect()
 }
 
 /// Every picture written to `out` as `reference | diff | yours`, one line each.
