@@ -671,7 +671,15 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
             );
         }
     }
-    assert!(handout.join("stereolab/assets/scenes/wuson.toml").is_file());
+    // The grader's data: every exercise's public cases and the reference pictures.
+    for ex in ["ex1", "ex2", "ex3"] {
+        assert!(handout.join(format!("stereolab/data/{ex}.json")).is_file());
+    }
+    assert!(
+        handout
+            .join("stereolab/data/pictures/ex2/chromadepth_texgen.png")
+            .is_file()
+    );
     assert_includes_resolve(&handout.join("stereolab"));
     // The handout compiles the grader unoptimized, dependencies and proc macros included (the
     // repository's profile optimizes every dependency: 632 CPU-s against 109 for the grader).
@@ -713,7 +721,18 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
         "{text}{}",
         String::from_utf8_lossy(&tree.stderr)
     );
-    for heavy in ["eframe v", "wgpu v", "mimalloc v", "zip v", "cc v"] {
+    for heavy in [
+        "eframe v",
+        "wgpu v",
+        "mimalloc v",
+        "zip v",
+        "cc v",
+        "stereolab-core v",
+        "stereolab-pipeline v",
+        "stereolab-grade v",
+        "image v",
+        "tiny-skia v",
+    ] {
         assert!(
             !text.contains(heavy),
             "the handout's grader builds {heavy}:\n{text}"
@@ -804,6 +823,57 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
         "{}",
         String::from_utf8_lossy(&tests.stderr)
     );
+
+    // The handout's own grader, from its data alone: the solution scores full marks and a
+    // planted mistake is named, as the instructor's grader does.
+    let handout_grade = |stubs: &str, name: &str| -> Value {
+        let sub = handout.join(format!("sub-{name}"));
+        let file = sub.join("ex2_chromadepth/src/stubs.rs");
+        std::fs::create_dir_all(file.parent().unwrap()).unwrap();
+        std::fs::write(&file, stubs).unwrap();
+        let json = handout.join(format!("{name}.json"));
+        let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+            .current_dir(&handout)
+            .args([
+                "run",
+                "--offline",
+                "--quiet",
+                "-p",
+                "stereolab",
+                "--",
+                "grade",
+                "ex2",
+            ])
+            .arg("--exercises")
+            .arg(&sub)
+            .arg("--json")
+            .arg(&json)
+            .env("CARGO_TARGET_DIR", target_dir().join("handout-grader"))
+            .output()
+            .expect("run the handout's grader");
+        assert!(
+            out.status.success(),
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap()
+    };
+    let solution =
+        std::fs::read_to_string(repo_exercises().join("ex2_chromadepth/src/solution.rs")).unwrap();
+    assert_eq!(
+        handout_grade(&solution, "solution")["score"].as_f64(),
+        Some(5.0)
+    );
+    let sign = solution.replace("let c = -1.0 / (d2 - d1);", "let c = 1.0 / (d2 - d1);");
+    assert_ne!(sign, solution);
+    let v = handout_grade(&sign, "sign");
+    let texgen = test_named(&v, "ex2 texgen")["output"].as_str().unwrap();
+    assert!(
+        texgen.contains("hint [texgen-sign]") && texgen.contains("chromadepth_texgen.png"),
+        "{texgen}"
+    );
+    assert_eq!(v["score"].as_f64(), Some(3.0), "{v}");
 
     // A compile error costs its exercise only: the grader reports it and still exits cleanly.
     std::fs::write(
@@ -1045,5 +1115,106 @@ fn the_stubs_and_the_instructors_guide_quote_no_points_and_name_where_they_are_p
             std::fs::read_to_string(repo_exercises().join(krate).join("src/stubs.rs")).unwrap();
         assert_eq!(quoted_points(&stubs), Vec::<String>::new(), "{krate}");
         assert!(stubs.contains("`stereolab grade points`"), "{krate}");
+    }
+}
+
+/// Functions of every `.rs` file under `dir`, as `(file, function)` with their fingerprints
+/// (the similarity report's winnowing, the handout's stubs as base code).
+fn functions_under(
+    dir: &Path,
+    base: &std::collections::BTreeSet<u64>,
+) -> Vec<(PathBuf, stereolab_grade::similarity::Function)> {
+    files_under(dir)
+        .into_iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "rs"))
+        .flat_map(|f| {
+            let text = std::fs::read_to_string(&f).unwrap();
+            stereolab_grade::similarity::fingerprint_file(&text, base)
+                .into_iter()
+                .map(move |func| (f.clone(), func))
+        })
+        .collect()
+}
+
+#[test]
+fn the_exported_handout_holds_no_reference_function() {
+    use stereolab_grade::similarity::{DEFAULT_THRESHOLD, base_hashes, score};
+    let handout = out_dir("handout_no_reference");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(["exercises", "export"])
+        .arg(&handout)
+        .arg("--root")
+        .arg(root())
+        .output()
+        .expect("run export");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let base: std::collections::BTreeSet<u64> = Exercise::ALL
+        .iter()
+        .flat_map(|ex| {
+            let stubs = repo_exercises().join(ex.crate_name()).join("src/stubs.rs");
+            base_hashes(&std::fs::read_to_string(stubs).unwrap())
+        })
+        .collect();
+    // The reference: the instructor's solutions, stereolab's library and the grader's task
+    // specs (every function of them).
+    let mut reference = Vec::new();
+    for ex in Exercise::ALL {
+        let dir = repo_exercises().join(ex.crate_name()).join("src");
+        reference.extend(
+            functions_under(&dir, &base)
+                .into_iter()
+                .filter(|(f, _)| f.ends_with("solution.rs")),
+        );
+    }
+    for krate in ["core", "pipeline", "grade"] {
+        reference.extend(functions_under(
+            &root().join("crates").join(krate).join("src"),
+            &base,
+        ));
+    }
+    // The functions the handout must not hold, by name: the test would prove nothing without
+    // them among the references.
+    for name in [
+        "frustum",
+        "hsv_to_rgb",
+        "variant_links",
+        "sheet_reference",
+        "visible_reference",
+        "finalize_reference",
+        "remap_reference",
+        "link_row",
+        "stereo_matrices",
+    ] {
+        assert!(
+            reference
+                .iter()
+                .any(|(_, f)| f.name == name && f.fingerprints.len() >= 16),
+            "no reference function {name} to look for"
+        );
+    }
+    let shipped = functions_under(&handout, &base);
+    assert!(
+        shipped.len() > 100,
+        "{} functions in the handout",
+        shipped.len()
+    );
+    for (file, f) in &shipped {
+        for (rfile, r) in &reference {
+            if let Some((shared, sim)) = score(&f.fingerprints, &r.fingerprints) {
+                assert!(
+                    sim < DEFAULT_THRESHOLD,
+                    "{}: `{}` (line {}) is {sim:.2} similar ({shared} fingerprints) to `{}` of {}",
+                    file.display(),
+                    f.name,
+                    f.line,
+                    r.name,
+                    rfile.display()
+                );
+            }
+        }
     }
 }
