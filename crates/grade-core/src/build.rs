@@ -11,7 +11,7 @@
 //!   dependencies (glam, serde, `exercise-api`) are shared between submissions in one target
 //!   folder, so a warm build compiles only the student's crate.
 //! - **Sandboxed on the official paths.** There a submission compiles in the
-//!   [sandbox](crate::sandbox) as a user of its own, with a wall-clock limit: it sees its crate,
+//!   sandbox ([`crate::sandbox`]) as a user of its own, with a wall-clock limit: it sees its crate,
 //!   the toolchain, the registry's sources and the dependencies' artifacts (read-only, built
 //!   once from the untouched stubs into `work/deps`), and writes only its own target folder,
 //!   whose dependency artifacts are hard links to those (a build cannot change them: they are

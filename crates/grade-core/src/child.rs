@@ -537,7 +537,7 @@ fn kill_group(pid: u32) {
 
 /// Makes this process the reaper of its orphaned descendants (Linux), so a process a task
 /// starts in a new session of its own, to outlive the task, comes back to the grader and is
-/// killed ([`reap_orphans`]).
+/// killed (`reap_orphans`).
 pub fn become_subreaper() {
     #[cfg(target_os = "linux")]
     // SAFETY: plain syscall with constant arguments.

@@ -6,7 +6,7 @@
 //!
 //! What a sandboxed process sees and may do:
 //! - **Files**: `/usr` (and the `/bin`, `/lib` links into it) read-only, a private `/tmp`, a
-//!   fresh `/dev` and `/proc`, and the paths its [`Jail`] names, at their own paths: for a task
+//!   fresh `/dev` and `/proc`, and the paths its `Jail` names, at their own paths: for a task
 //!   its binary (read-only) and its scratch folder; for a build the crate, the toolchain, the
 //!   registry's sources and the shared dependency artifacts (read-only), and its own target
 //!   folder. Nothing else: not the grader's sources, its results, the seed, other submissions.
@@ -17,7 +17,7 @@
 //! - **Network**: none (a namespace with only a loopback that is down).
 //!
 //! Where no sandbox can be made (no `bwrap`, or user namespaces switched off), a student's own
-//! run still grades, unprotected, and [`Sandbox::note`] says so; the official paths (`grade
+//! run still grades, unprotected, and [`check_sandbox`](crate::check_sandbox) says so; the official paths (`grade
 //! batch`, the Gradescope bundle, any run as root) refuse to grade without one.
 
 use std::collections::BTreeSet;
