@@ -196,28 +196,27 @@ fn parse_memory(mib: u64) -> Result<u64> {
     }
 }
 
-fn parse_timeout(seconds: f64) -> Result<Duration> {
-    if seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0 {
+/// `seconds` as a duration when it lies in `range` (a positive lower end: `min` excluded when
+/// `open`), else an error naming `flag`.
+fn parse_seconds(flag: &str, seconds: f64, min: f64, open: bool) -> Result<Duration> {
+    let above = if open { seconds > min } else { seconds >= min };
+    if seconds.is_finite() && above && seconds <= 3600.0 {
         Ok(Duration::from_secs_f64(seconds))
     } else {
         Err(Error::invalid(
-            "--timeout",
+            flag,
             seconds,
-            "must be between 0 and 3600 seconds",
+            format!("must be between {min} and 3600 seconds"),
         ))
     }
 }
 
+fn parse_timeout(seconds: f64) -> Result<Duration> {
+    parse_seconds("--timeout", seconds, 0.0, true)
+}
+
 fn parse_build_timeout(seconds: f64) -> Result<Duration> {
-    if seconds.is_finite() && (1.0..=3600.0).contains(&seconds) {
-        Ok(Duration::from_secs_f64(seconds))
-    } else {
-        Err(Error::invalid(
-            "--build-timeout",
-            seconds,
-            "must be between 1 and 3600 seconds",
-        ))
-    }
+    parse_seconds("--build-timeout", seconds, 1.0, false)
 }
 
 fn batch(args: BatchArgs) -> Result<()> {

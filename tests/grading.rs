@@ -640,20 +640,7 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
     let handout = out_dir("handout");
     let documents = out_dir("handout_documents");
     std::fs::write(documents.join("course-copy.txt"), "the course's copy\n").unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
-        .args(["exercises", "export"])
-        .arg(&handout)
-        .arg("--root")
-        .arg(root())
-        .arg("--documents")
-        .arg(&documents)
-        .output()
-        .expect("run export");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    export_handout(&handout, Some(&documents));
     let files = files_under(&handout);
     assert!(
         !files.iter().any(|f| f.ends_with("solution.rs")),
@@ -1118,6 +1105,24 @@ fn the_stubs_and_the_instructors_guide_quote_no_points_and_name_where_they_are_p
     }
 }
 
+/// `stereolab exercises export DIR` of this repository, with the course's `documents` if given.
+fn export_handout(dir: &Path, documents: Option<&Path>) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_stereolab"));
+    cmd.args(["exercises", "export"])
+        .arg(dir)
+        .arg("--root")
+        .arg(root());
+    if let Some(d) = documents {
+        cmd.arg("--documents").arg(d);
+    }
+    let out = cmd.output().expect("run export");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// Functions of every `.rs` file under `dir`, as `(file, function)` with their fingerprints
 /// (the similarity report's winnowing, the handout's stubs as base code).
 fn functions_under(
@@ -1140,18 +1145,7 @@ fn functions_under(
 fn the_exported_handout_holds_no_reference_function() {
     use stereolab_grade::similarity::{DEFAULT_THRESHOLD, base_hashes, score};
     let handout = out_dir("handout_no_reference");
-    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
-        .args(["exercises", "export"])
-        .arg(&handout)
-        .arg("--root")
-        .arg(root())
-        .output()
-        .expect("run export");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    export_handout(&handout, None);
     let base: std::collections::BTreeSet<u64> = Exercise::ALL
         .iter()
         .flat_map(|ex| {
