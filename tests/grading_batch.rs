@@ -511,4 +511,62 @@ fn the_gradescope_bundle_runs_in_an_autograder_layout() {
         v["output"].as_str().unwrap().contains("ex1_stereo.rs"),
         "{v}"
     );
+    // Attacks on the official path, as Gradescope runs it (as root here: sandboxed).
+    let secret = base.join("secret.txt");
+    write(&secret, &format!("{}\n", crate::grading_sandbox::SECRET));
+    let t = crate::grading_sandbox::Targets {
+        results: root.join("results"),
+        results_json: root.join("results/results.json"),
+        scores: root.join("results/scores.csv"),
+        work: root.join("work/build"),
+        secret: secret.clone(),
+    };
+    let krate = crate::grading_sandbox::KRATE;
+    let said = |v: &Value| -> String {
+        let mut text = v["output"].as_str().unwrap_or("").to_string();
+        for t in tests_of(v) {
+            text.push_str(t["output"].as_str().unwrap_or(""));
+        }
+        text
+    };
+    // A hopper that outlives its task to rewrite results.json.
+    let hopper = crate::grading_sandbox::spliced("hopper", &t);
+    submit(&root, &[(format!("{krate}.rs"), hopper)]);
+    run_script(&root, "run_autograder");
+    let written = std::fs::read_to_string(root.join("results/results.json")).unwrap();
+    std::thread::sleep(std::time::Duration::from_secs(3));
+    assert_eq!(
+        std::fs::read_to_string(root.join("results/results.json")).unwrap(),
+        written,
+        "results.json changed after the grader finished"
+    );
+    let v = read_json(&root.join("results/results.json"));
+    assert!(said(&v).contains("hopper started"), "{v}");
+    assert_eq!(v["score"].as_f64(), Some(5.0), "{v}");
+    // A /proc reader looking for the seed.
+    submit(
+        &root,
+        &[(
+            format!("{krate}.rs"),
+            crate::grading_sandbox::spliced("proc_reader", &t),
+        )],
+    );
+    run_script(&root, "run_autograder");
+    let v = read_json(&root.join("results/results.json"));
+    let text = said(&v);
+    assert!(
+        text.contains("proc reader ran") && text.contains("found []"),
+        "{text}"
+    );
+    assert!(!text.contains("STEREOLAB_GRADER_SEED="), "{text}");
+    // A stubs file that is a link to a secret of the machine.
+    let sub = root.join("submission");
+    let _ = std::fs::remove_dir_all(&sub);
+    std::fs::create_dir_all(sub.join(format!("{krate}/src"))).unwrap();
+    std::os::unix::fs::symlink(&secret, sub.join(format!("{krate}/src/stubs.rs"))).unwrap();
+    run_script(&root, "run_autograder");
+    let v = read_json(&root.join("results/results.json"));
+    let text = said(&v);
+    assert!(text.contains("symbolic link"), "{text}");
+    assert!(!text.contains(crate::grading_sandbox::SECRET), "{text}");
 }

@@ -16,20 +16,27 @@ use crate::grading::{repo_exercises, take_turn, target_dir, tests_of};
 /// The instructor's seed for the hidden cases (never to appear in anything a task can reach).
 const SEED: &str = "9173548201";
 /// The text of a file of the grader's machine that no submission may read.
-const SECRET: &str = "TOPSECRET-7f3a91c4";
-const KRATE: &str = "ex2_chromadepth";
+pub(crate) const SECRET: &str = "TOPSECRET-7f3a91c4";
+pub(crate) const KRATE: &str = "ex2_chromadepth";
 const DEPTH_RANGE: &str = "pub fn depth_range(center: Vec3, radius: f32) -> [f32; 2] {\n";
 const DEPTH_RANGE_BODY: &str = "    [-center.z - radius, -center.z + radius]\n}";
 
 /// Paths the attacks aim at, substituted for their `@…@` placeholders.
-struct Targets {
-    results: PathBuf,
-    work: PathBuf,
-    secret: PathBuf,
+pub(crate) struct Targets {
+    /// The results folder (`@OUT@`).
+    pub results: PathBuf,
+    /// The results.json the hopper forges (`@RESULTS@`).
+    pub results_json: PathBuf,
+    /// The CSV of all scores (`@SCORES@`).
+    pub scores: PathBuf,
+    /// The grader's build folder (`@WORK@`).
+    pub work: PathBuf,
+    /// A file of the grader's machine (`@SECRET@`).
+    pub secret: PathBuf,
 }
 
 /// The instructor's ex2 solution with `attack`'s file spliced in (see the folder's README).
-fn spliced(attack: &str, t: &Targets) -> String {
+pub(crate) fn spliced(attack: &str, t: &Targets) -> String {
     let solution =
         std::fs::read_to_string(repo_exercises().join(KRATE).join("src/solution.rs")).unwrap();
     assert!(solution.contains(DEPTH_RANGE) && solution.contains(DEPTH_RANGE_BODY));
@@ -111,6 +118,8 @@ fn no_attack_in_a_batch_gains_a_point_or_reads_a_secret() {
     let subs = base.join("submissions");
     let t = Targets {
         results: base.join("results"),
+        results_json: base.join("results/hopper/results.json"),
+        scores: base.join("results/scores.csv"),
         work: base.join("work"),
         secret: base.join("secret.txt"),
     };
