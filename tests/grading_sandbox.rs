@@ -42,11 +42,8 @@ pub(crate) fn spliced(attack: &str, t: &Targets) -> String {
     assert!(solution.contains(DEPTH_RANGE) && solution.contains(DEPTH_RANGE_BODY));
     let code = std::fs::read_to_string(root().join(format!("tests/data/attacks/{attack}.rs")))
         .unwrap()
-        .replace(
-            "@RESULTS@",
-            &format!("{}/hopper/results.json", t.results.display()),
-        )
-        .replace("@SCORES@", &format!("{}/scores.csv", t.results.display()))
+        .replace("@RESULTS@", &t.results_json.display().to_string())
+        .replace("@SCORES@", &t.scores.display().to_string())
         .replace("@OUT@", &t.results.display().to_string())
         .replace("@WORK@", &t.work.display().to_string())
         .replace("@SECRET@", &t.secret.display().to_string());
