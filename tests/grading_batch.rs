@@ -559,6 +559,44 @@ fn the_gradescope_bundle_runs_in_an_autograder_layout() {
         "{text}"
     );
     assert!(!text.contains("STEREOLAB_GRADER_SEED="), "{text}");
+    // The other attacks: correct formulas beside them keep their points, nothing more.
+    for (attack, points) in [
+        ("input_printer", 5.0),
+        ("classmate", 4.0),
+        ("system_caller", 5.0),
+        ("signaller", 5.0),
+        ("include_outside", 0.0),
+        ("const_loop", 0.0),
+    ] {
+        submit(
+            &root,
+            &[(
+                format!("{krate}.rs"),
+                crate::grading_sandbox::spliced(attack, &t),
+            )],
+        );
+        let out = Command::new(root.join("source/run_autograder"))
+            .current_dir(&root)
+            .env("AUTOGRADER_ROOT", &root)
+            .env("STEREOLAB_BUILD_DIR", target_dir().join("stereolab-grade"))
+            .env("STEREOLAB_BUILD_TIMEOUT", "15")
+            .env("CARGO_TARGET_DIR", target_dir())
+            .env_remove("STEREOLAB_MUTANT")
+            .output()
+            .expect("run the script");
+        assert!(out.status.success(), "{attack}: {out:?}");
+        let v = read_json(&root.join("results/results.json"));
+        let text = said(&v);
+        assert_eq!(v["score"].as_f64(), Some(points), "{attack}: {text}");
+        assert!(
+            !text.contains(crate::grading_sandbox::SECRET)
+                && !text.contains("STEREOLAB_GRADER_SEED=")
+                && !text.contains("network-open"),
+            "{attack}: {text}"
+        );
+    }
+    assert!(!root.join("results/pwned").exists());
+
     // A stubs file that is a link to a secret of the machine.
     let sub = root.join("submission");
     let _ = std::fs::remove_dir_all(&sub);

@@ -169,7 +169,8 @@ done
 rm -f "$RES/results.json"
 if [ "$found" = 1 ]; then
     "$SRC/bin/stereolab" grade all --exercises "$STAGE" --json "$RES/results.json" \
-        --build-dir "${{STEREOLAB_BUILD_DIR:-$ROOT/work/build}}" --out "$ROOT/work/images"
+        --build-dir "${{STEREOLAB_BUILD_DIR:-$ROOT/work/build}}" --out "$ROOT/work/images" \
+        --build-timeout "${{STEREOLAB_BUILD_TIMEOUT:-120}}"
 fi
 if [ ! -s "$RES/results.json" ]; then
     cat > "$RES/results.json" <<'JSON'
