@@ -376,7 +376,13 @@ fn unzip(zip: &Path, dir: &Path) -> Vec<String> {
 
 /// Runs `script` of the bundle with `/autograder` at `root`.
 fn run_script(root: &Path, script: &str) -> Output {
+    run_script_with(root, script, &[])
+}
+
+/// [`run_script`] with `env` added.
+fn run_script_with(root: &Path, script: &str, env: &[(&str, &str)]) -> Output {
     let out = Command::new(root.join("source").join(script))
+        .envs(env.iter().copied())
         .current_dir(root)
         .env("AUTOGRADER_ROOT", root)
         .env("STEREOLAB_BIN", env!("CARGO_BIN_EXE_stereolab"))
@@ -522,13 +528,7 @@ fn the_gradescope_bundle_runs_in_an_autograder_layout() {
         secret: secret.clone(),
     };
     let krate = crate::grading_sandbox::KRATE;
-    let said = |v: &Value| -> String {
-        let mut text = v["output"].as_str().unwrap_or("").to_string();
-        for t in tests_of(v) {
-            text.push_str(t["output"].as_str().unwrap_or(""));
-        }
-        text
-    };
+    let said = crate::grading_sandbox::said;
     // A hopper that outlives its task to rewrite results.json.
     let hopper = crate::grading_sandbox::spliced("hopper", &t);
     submit(&root, &[(format!("{krate}.rs"), hopper)]);
@@ -575,16 +575,11 @@ fn the_gradescope_bundle_runs_in_an_autograder_layout() {
                 crate::grading_sandbox::spliced(attack, &t),
             )],
         );
-        let out = Command::new(root.join("source/run_autograder"))
-            .current_dir(&root)
-            .env("AUTOGRADER_ROOT", &root)
-            .env("STEREOLAB_BUILD_DIR", target_dir().join("stereolab-grade"))
-            .env("STEREOLAB_BUILD_TIMEOUT", "15")
-            .env("CARGO_TARGET_DIR", target_dir())
-            .env_remove("STEREOLAB_MUTANT")
-            .output()
-            .expect("run the script");
-        assert!(out.status.success(), "{attack}: {out:?}");
+        run_script_with(
+            &root,
+            "run_autograder",
+            &[("STEREOLAB_BUILD_TIMEOUT", "15")],
+        );
         let v = read_json(&root.join("results/results.json"));
         let text = said(&v);
         assert_eq!(v["score"].as_f64(), Some(points), "{attack}: {text}");

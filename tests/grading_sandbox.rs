@@ -91,16 +91,22 @@ fn texts_under(dir: &Path) -> BTreeMap<PathBuf, String> {
     out
 }
 
-/// All a submission's results say: report.txt and every test's output in results.json (a
-/// passing task's details, what its program printed among them, are only there).
-fn report(results: &Path, name: &str) -> String {
-    let mut text = std::fs::read_to_string(results.join(name).join("report.txt"))
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-    for t in tests_of(&results_json(results, name)) {
+/// All a results.json says: its top-level output and every test's (a passing task's details,
+/// what its program printed among them, are only there).
+pub(crate) fn said(v: &Value) -> String {
+    let mut text = v["output"].as_str().unwrap_or("").to_string();
+    for t in tests_of(v) {
         text.push('\n');
         text.push_str(t["output"].as_str().unwrap_or(""));
     }
     text
+}
+
+/// All a submission's results say: report.txt and [`said`] of its results.json.
+fn report(results: &Path, name: &str) -> String {
+    let text = std::fs::read_to_string(results.join(name).join("report.txt"))
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    format!("{text}\n{}", said(&results_json(results, name)))
 }
 
 fn results_json(results: &Path, name: &str) -> Value {

@@ -32,7 +32,7 @@ use serde_json::Value;
 use sha2::{Digest, Sha256};
 
 use super::Exercise;
-use super::child::{Binary, spawn_tracked, untrack};
+use super::child::{Binary, Rlimits, Scratch, spawn_tracked, task_jail, untrack};
 use super::sandbox::{self, Jail, Sandbox, User};
 
 /// The largest stubs file the grader reads from a submission.
@@ -212,6 +212,20 @@ impl BuildMode {
     /// The default limit of a sandboxed build (`--build-timeout`): a cold build of an exercise
     /// crate against the shared dependencies takes seconds.
     pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(120);
+
+    /// A plain build (trusted code: the instructor's solution, a student's own run).
+    pub const PLAIN: BuildMode = BuildMode {
+        sandboxed: false,
+        timeout: BuildMode::DEFAULT_TIMEOUT,
+    };
+
+    /// Sandboxed when `policy` requires it, stopped at `timeout`.
+    pub fn new(policy: super::Policy, timeout: Duration) -> BuildMode {
+        BuildMode {
+            sandboxed: policy == super::Policy::Required,
+            timeout,
+        }
+    }
 }
 
 /// Builds `sources` for `ex` under `work` (`work/bin/<crate>-<hash>`: the checked executable;
@@ -463,30 +477,26 @@ fn sandboxed_build(
         name.into(),
         "--message-format=json-render-diagnostics".into(),
     ];
-    let mut cmd = sandbox.command(&jail, user.as_ref(), &tc.sysroot.join("bin/cargo"), &args);
-    cmd.stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    super::child::limit_resources(
-        &mut cmd,
-        super::child::Rlimits {
-            memory: None,
-            cpu_seconds: Some(timeout.as_secs() * 4 + 1),
-            file_bytes: 1 << 30,
-            processes: user.as_ref().map(|_| 512),
-        },
-    );
-    let out = sandbox::output_within(&mut cmd, timeout).map_err(|e| {
-        if e.kind() == std::io::ErrorKind::TimedOut {
-            format!(
-                "the build was stopped at its time limit of {} s: does a constant, a macro or \
+    let limits = Rlimits {
+        memory: None,
+        cpu_seconds: Some(timeout.as_secs() * 4 + 1),
+        file_bytes: 1 << 30,
+        processes: user.as_ref().map(|_| 512),
+    };
+    let cargo = tc.sysroot.join("bin/cargo");
+    let out = sandbox
+        .output(&jail, user.as_ref(), &cargo, &args, limits, timeout)
+        .map_err(|e| {
+            if e.kind() == std::io::ErrorKind::TimedOut {
+                format!(
+                    "the build was stopped at its time limit of {} s: does a constant, a macro or \
                  a type take forever to compile?",
-                timeout.as_secs()
-            )
-        } else {
-            format!("cannot run cargo in the sandbox: {e}")
-        }
-    })?;
+                    timeout.as_secs()
+                )
+            } else {
+                format!("cannot run cargo in the sandbox: {e}")
+            }
+        })?;
     drop(user); // every process of the build's user ends here
     artifact(&out, &src, name)
 }
@@ -524,30 +534,30 @@ fn handout_target() -> Option<PathBuf> {
 /// The hash `bin --source-hash` prints, if it runs (in the sandbox: a submission's code may
 /// run before `main`) and prints one within 10 s.
 fn reported_hash(bin: &Path) -> Option<String> {
-    let scratch = super::child::Scratch::new().ok()?;
     let sandbox = Sandbox::get();
     let user = sandbox.user();
-    if let Some(u) = &user {
-        std::os::unix::fs::chown(&scratch.0, Some(u.id()), Some(u.id())).ok()?;
-    }
-    let mut jail = super::child::task_jail(bin, &scratch.0);
+    let scratch = Scratch::new(user.as_ref()).ok()?;
+    let mut jail = task_jail(bin, &scratch.0);
     // Without the answer pipe the hash goes to stdout.
     jail.env
         .retain(|(k, _)| k != exercise_api::protocol::ANSWER_FD_ENV);
-    let mut cmd = sandbox.command(&jail, user.as_ref(), bin, &["--source-hash".into()]);
-    cmd.stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null());
-    super::child::limit_resources(
-        &mut cmd,
-        super::child::Rlimits {
-            memory: Some(1 << 30),
-            cpu_seconds: Some(10),
-            file_bytes: 1 << 20,
-            processes: user.as_ref().map(|_| 16),
-        },
-    );
-    let out = sandbox::output_within(&mut cmd, Duration::from_secs(10)).ok()?;
+    let limits = Rlimits {
+        memory: Some(1 << 30),
+        cpu_seconds: Some(10),
+        file_bytes: 1 << 20,
+        processes: user.as_ref().map(|_| 16),
+    };
+    let args = ["--source-hash".into()];
+    let out = sandbox
+        .output(
+            &jail,
+            user.as_ref(),
+            bin,
+            &args,
+            limits,
+            Duration::from_secs(10),
+        )
+        .ok()?;
     drop(user);
     let text = String::from_utf8(out.stdout).ok()?;
     out.status.success().then(|| text.trim().to_string())

@@ -156,7 +156,8 @@ impl Drain {
 pub(crate) struct Scratch(pub(crate) PathBuf);
 
 impl Scratch {
-    pub(crate) fn new() -> std::io::Result<Scratch> {
+    /// A new folder, given to `user` when the run has one (it is the task's to write).
+    pub(crate) fn new(user: Option<&User>) -> std::io::Result<Scratch> {
         static NEXT: AtomicU64 = AtomicU64::new(0);
         let dir = std::env::temp_dir().join(format!(
             "stereolab-task-{}-{}",
@@ -164,7 +165,12 @@ impl Scratch {
             NEXT.fetch_add(1, Ordering::Relaxed)
         ));
         std::fs::create_dir_all(&dir)?;
-        Ok(Scratch(dir))
+        let scratch = Scratch(dir);
+        #[cfg(unix)]
+        if let Some(u) = user {
+            std::os::unix::fs::chown(&scratch.0, Some(u.id()), Some(u.id()))?;
+        }
+        Ok(scratch)
     }
 }
 
@@ -192,15 +198,15 @@ pub fn run(binary: &Binary, task: &str, inputs: &[Value], limits: Limits) -> Run
         run.ending = Some(no_start(e));
         return run;
     }
-    let scratch = match Scratch::new() {
+    let sandbox = Sandbox::get();
+    let user = sandbox.user();
+    let scratch = match Scratch::new(user.as_ref()) {
         Ok(s) => s,
         Err(e) => {
             run.ending = Some(no_start(e.to_string()));
             return run;
         }
     };
-    let sandbox = Sandbox::get();
-    let user = sandbox.user();
     let (answers, mut child) = match spawn(&binary.path, task, &scratch.0, limits, user.as_ref()) {
         Ok(x) => x,
         Err(e) => {
@@ -266,7 +272,10 @@ pub fn run(binary: &Binary, task: &str, inputs: &[Value], limits: Limits) -> Run
     let status = status.or_else(|| child.wait().ok());
     untrack(pid);
     drop(user); // kills whatever else ran as the task's user
-    reap_orphans();
+    if !sandbox.protected() {
+        // Unprotected, a process in a new session of its own outlives the group kill.
+        reap_orphans();
+    }
     // Everything the task printed: the pipes end now that its processes are gone.
     run.stdout = out.take(DRAIN_WAIT);
     run.stderr = err.take(DRAIN_WAIT);
@@ -428,9 +437,6 @@ fn spawn(
 
     let (reader, writer) = std::io::pipe()?;
     let wfd = writer.as_raw_fd();
-    if let Some(u) = user {
-        std::os::unix::fs::chown(dir, Some(u.id()), Some(u.id()))?;
-    }
     let mut cmd = Sandbox::get().command(&task_jail(binary, dir), user, binary, &[task.into()]);
     cmd.stdin(Stdio::piped())
         .stdout(Stdio::piped())
@@ -603,5 +609,29 @@ pub(crate) fn reap_orphans() {
                 libc::waitpid(pid, std::ptr::null_mut(), 0);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_binary_whose_bytes_changed_since_its_build_is_not_run() {
+        let dir = std::env::temp_dir().join(format!("stereolab-binary-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("task");
+        std::fs::write(&path, "#!/bin/sh\nexit 0\n").unwrap();
+        let binary = Binary::hashed(path.clone()).unwrap();
+        assert_eq!(binary.sha256.len(), 64);
+        assert_eq!(binary.verify(), Ok(()));
+        std::fs::write(&path, "#!/bin/sh\necho forged\n").unwrap();
+        let err = binary.verify().unwrap_err();
+        assert!(err.contains("changed since it was built"), "{err}");
+        let run = run(&binary, "task", &[], Limits::DEFAULT);
+        let ending = run.ending.expect("not run");
+        assert_eq!(ending.kind, "no-start", "{ending:?}");
+        assert!(run.replies.is_empty());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -104,11 +104,19 @@ pub struct GradeOptions {
 impl GradeOptions {
     /// How submissions are built under these options: sandboxed when the policy requires it.
     pub fn build_mode(&self) -> BuildMode {
-        BuildMode {
-            sandboxed: self.sandbox == Policy::Required,
-            timeout: self.build_timeout,
-        }
+        BuildMode::new(self.sandbox, self.build_timeout)
     }
+}
+
+/// How this process builds a submission outside a batch (`render --exercise`, the GPU
+/// comparison): sandboxed as root, plainly otherwise, once the sandbox is checked.
+///
+/// # Errors
+/// As root where no sandbox can be made.
+pub fn build_mode_for_this_user() -> Result<BuildMode> {
+    let policy = Policy::for_this_user(Policy::Auto);
+    check_sandbox(policy)?;
+    Ok(BuildMode::new(policy, BuildMode::DEFAULT_TIMEOUT))
 }
 
 /// Setup error unless `policy` can be met on this machine; for a student's run without a

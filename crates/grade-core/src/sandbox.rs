@@ -27,6 +27,8 @@ use std::process::{Command, Stdio};
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
+use crate::child::{Rlimits, limit_resources};
+
 /// How the grader isolates what it runs.
 #[derive(Clone, Debug)]
 pub(crate) enum Mechanism {
@@ -84,6 +86,11 @@ const UID_SLOTS: u32 = 1024;
 /// Grader processes whose user ranges do not overlap (by process id).
 const UID_RANGES: u32 = 100_000;
 const _: () = assert!(UID_BASE as u64 + UID_RANGES as u64 * UID_SLOTS as u64 <= i32::MAX as u64);
+
+/// The first of this process's run users.
+fn uid_base() -> u32 {
+    UID_BASE + (std::process::id() % UID_RANGES) * UID_SLOTS
+}
 
 /// This process runs as root.
 pub(crate) fn is_root() -> bool {
@@ -205,7 +212,7 @@ impl Sandbox {
         else {
             return None;
         };
-        let base = UID_BASE + (std::process::id() % UID_RANGES) * UID_SLOTS;
+        let base = uid_base();
         let mut users = self.users.lock().unwrap_or_else(|e| e.into_inner());
         let uid = (base..base + UID_SLOTS).find(|u| !users.contains(u))?;
         users.insert(uid);
@@ -221,7 +228,34 @@ impl Sandbox {
         program: &Path,
         args: &[OsString],
     ) -> Command {
-        let Mechanism::Bubblewrap { bwrap, setpriv } = &self.mechanism else {
+        self.mechanism
+            .command(jail, user.map(User::id), program, args)
+    }
+
+    /// [`Sandbox::command`] run to its end under `limits` and within `time` (its whole process
+    /// group killed then), stdin empty, stdout and stderr kept.
+    pub(crate) fn output(
+        &self,
+        jail: &Jail,
+        user: Option<&User>,
+        program: &Path,
+        args: &[OsString],
+        limits: Rlimits,
+        time: Duration,
+    ) -> std::io::Result<std::process::Output> {
+        let mut cmd = self.command(jail, user, program, args);
+        cmd.stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        limit_resources(&mut cmd, limits);
+        output_within(&mut cmd, time)
+    }
+}
+
+impl Mechanism {
+    /// See [`Sandbox::command`]; `uid`: the run's own user (root only).
+    fn command(&self, jail: &Jail, uid: Option<u32>, program: &Path, args: &[OsString]) -> Command {
+        let Mechanism::Bubblewrap { bwrap, setpriv } = self else {
             let mut cmd = Command::new(program);
             cmd.args(args).current_dir(&jail.cwd).env_clear();
             for (k, v) in &jail.env {
@@ -231,8 +265,8 @@ impl Sandbox {
         };
         let mut cmd = Command::new(bwrap);
         cmd.args(bwrap_args(jail, setpriv.is_some()));
-        if let (Some(setpriv), Some(user)) = (setpriv, user) {
-            let id = user.id().to_string();
+        if let (Some(setpriv), Some(uid)) = (setpriv, uid) {
+            let id = uid.to_string();
             cmd.arg(setpriv)
                 .args(["--reuid", &id, "--regid", &id, "--clear-groups"])
                 .args(["--bounding-set", "-all", "--inh-caps", "-all"])
@@ -365,27 +399,19 @@ fn detect() -> Mechanism {
         None
     };
     let mechanism = Mechanism::Bubblewrap { bwrap, setpriv };
-    let sandbox = Sandbox {
-        mechanism: mechanism.clone(),
-        users: Mutex::new(BTreeSet::new()),
-    };
+    // As root the probe runs as the first user of this process's range, as a run would.
+    let uid = is_root().then(uid_base);
     let jail = Jail {
         cwd: "/".into(),
         ..Jail::default()
     };
-    let user = sandbox.user().map(|u| {
-        let id = u.uid;
-        std::mem::forget(u); // the probe's sandbox is not the process's: nothing to free
-        User { uid: id }
-    });
-    let mut cmd = sandbox.command(&jail, user.as_ref(), Path::new("/usr/bin/true"), &[]);
+    let mut cmd = mechanism.command(&jail, uid, Path::new("/usr/bin/true"), &[]);
     cmd.stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped());
     let outcome = output_within(&mut cmd, Duration::from_secs(20));
-    if let Some(u) = user {
-        kill_all_of(u.uid);
-        std::mem::forget(u);
+    if let Some(uid) = uid {
+        kill_all_of(uid);
     }
     match outcome {
         Ok(out) if out.status.success() => mechanism,

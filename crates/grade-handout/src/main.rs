@@ -103,11 +103,21 @@ fn grade(args: GradeArgs) -> Result<()> {
             "missing: this grader runs in a handout made by `stereolab exercises export DIR`",
         ));
     }
-    // Every data file is read and checked before anything is built.
-    for ex in Exercise::ALL {
-        tasks(ex)?;
-    }
-    let specs_of = |ex: Exercise| -> Vec<TaskSpec> { tasks(ex).unwrap_or_default() };
+    // Every data file is read and checked once, before anything is built; each exercise's
+    // specs are then handed out once (grading and the points table ask for each once).
+    let loaded = Exercise::ALL
+        .into_iter()
+        .map(|ex| Ok((ex, tasks(ex)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let loaded = std::cell::RefCell::new(loaded);
+    let specs_of = |ex: Exercise| -> Vec<TaskSpec> {
+        let mut loaded = loaded.borrow_mut();
+        loaded
+            .iter()
+            .position(|(e, _)| *e == ex)
+            .map(|k| loaded.swap_remove(k).1)
+            .unwrap_or_default()
+    };
     if args.exercise == "points" {
         print!("{}", points_text(&points_of(&specs_of)));
         return Ok(());

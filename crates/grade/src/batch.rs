@@ -363,16 +363,9 @@ mod tests {
     #[test]
     fn a_missing_file_is_named_with_where_it_was_looked_for_and_its_own_hint() {
         let base = scratch("missing");
-        let Err(why) = crate::submission_binary(
-            &base,
-            Exercise::Ex2,
-            false,
-            &base,
-            crate::BuildMode {
-                sandboxed: false,
-                timeout: crate::BuildMode::DEFAULT_TIMEOUT,
-            },
-        ) else {
+        let Err(why) =
+            crate::submission_binary(&base, Exercise::Ex2, false, &base, crate::BuildMode::PLAIN)
+        else {
             panic!("an empty submission builds nothing");
         };
         assert_eq!(why.id, "missing-file");

@@ -66,12 +66,7 @@ pub fn compare_exercise(
         .map(|eye| ex1::eye_view_input(&setup, &modelview, eye, lighting))
         .collect();
     child::become_subreaper();
-    let policy = super::Policy::for_this_user(super::Policy::Auto);
-    super::check_sandbox(policy)?;
-    let mode = super::BuildMode {
-        sandboxed: policy == super::Policy::Required,
-        timeout: super::BuildMode::DEFAULT_TIMEOUT,
-    };
+    let mode = stereolab_grade_core::build_mode_for_this_user()?;
     let binary = submission_binary(dir, ex, solution, &default_work_dir(), mode)
         .map_err(|why| Error::invalid(ex.crate_name(), "cannot be built", why.message))?;
     let run = child::run(&binary, TASK, &inputs, limits);

@@ -73,11 +73,7 @@ pub fn render_exercise(
 ) -> Result<Vec<String>> {
     let fx = Fixture::new(scene)?;
     child::become_subreaper();
-    let mode = BuildMode {
-        sandboxed: Policy::for_this_user(Policy::Auto) == Policy::Required,
-        timeout: BuildMode::DEFAULT_TIMEOUT,
-    };
-    check_sandbox(Policy::for_this_user(Policy::Auto))?;
+    let mode = stereolab_grade_core::build_mode_for_this_user()?;
     let binary = submission_binary(dir, ex, solution, &default_work_dir(), mode)
         .map_err(|why| Error::invalid(ex.crate_name(), "cannot be built", why.message))?;
     let mut lines = Vec::new();
