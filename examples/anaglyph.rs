@@ -4,11 +4,10 @@
 
 use glam::{Mat4, Vec3};
 use stereolab::scene::Mesh;
-use stereolab_core::Framebuffer;
-use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
-use stereolab_core::math::{Camera, StereoRig, ZeroParallax};
-use stereolab_core::raster::{RasterOptions, rasterize_blinn_phong};
-use stereolab_core::shade::{BlinnPhong, Light};
+use stereolab_core::{
+    AnaglyphKind, AnaglyphOptions, BlinnPhong, Camera, Framebuffer, Light, RasterOptions,
+    StereoRig, ZeroParallax, anaglyph, rasterize_blinn_phong,
+};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or("anaglyph.png".into());

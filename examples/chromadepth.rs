@@ -6,12 +6,10 @@
 
 use glam::{Mat4, Vec3, Vec4};
 use stereolab::scene::Mesh;
-use stereolab_core::Framebuffer;
-use stereolab_core::effects::chromadepth::ramp::{Ramp, RampKind, Sampling};
-use stereolab_core::effects::chromadepth::texgen::{Texgen, auto_range};
-use stereolab_core::math::{look_at, perspective};
-use stereolab_core::raster::{RasterOptions, rasterize};
-use stereolab_core::shade::{Fragment, Shader, Varyings, to_rgba8};
+use stereolab_core::{
+    Fragment, Framebuffer, Ramp, RampKind, RampSampling, RasterOptions, Shader, Texgen, Varyings,
+    auto_range, look_at, perspective, rasterize, to_rgba8,
+};
 
 /// The texgen pass: one varying, `s`, from the eye-space position.
 struct ChromaDepth<'a> {
@@ -32,7 +30,9 @@ impl Shader for ChromaDepth<'_> {
         self.projection * eye
     }
     fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
-        Some(to_rgba8(self.ramp.sample(f.varyings[0], Sampling::Linear)))
+        Some(to_rgba8(
+            self.ramp.sample(f.varyings[0], RampSampling::Linear),
+        ))
     }
 }
 

@@ -6,11 +6,10 @@
 
 use glam::Mat4;
 use stereolab::scene::Mesh;
-use stereolab_core::Framebuffer;
-use stereolab_core::effects::sirds::{self, DepthMap, Settings};
-use stereolab_core::math::{Camera, StereoRig};
-use stereolab_core::raster::{RasterOptions, rasterize};
-use stereolab_core::shade::DepthOnly;
+use stereolab_core::{
+    Camera, DepthMap, DepthOnly, Framebuffer, RasterOptions, SirdsSettings, StereoRig, depth_range,
+    from_depth_map, rasterize,
+};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or("sirds.png".into());
@@ -40,10 +39,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &opts,
     );
 
-    let settings = Settings::default();
-    let range = sirds::depth_range(&settings, &fb, camera.near, camera.far)?;
+    let settings = SirdsSettings::default();
+    let range = depth_range(&settings, &fb, camera.near, camera.far)?;
     let depth = DepthMap::from_framebuffer(&fb, camera.near, camera.far, &range);
-    let stereogram = sirds::from_depth_map(depth, &settings)?;
+    let stereogram = from_depth_map(depth, &settings)?;
     let bytes = stereogram.pixels.concat();
     image::RgbaImage::from_raw(width, height, bytes)
         .ok_or("pixel count")?

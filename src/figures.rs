@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use stereolab_core::{Result, files};
+use stereolab_core::Result;
+use stereolab_core::read_text;
 use stereolab_figures as figures;
 
 /// Arguments of `stereolab figures`.
@@ -25,7 +26,7 @@ pub struct FiguresArgs {
 /// The scene or the benchmark rows cannot be loaded, or a figure cannot be drawn or written.
 pub fn run(args: FiguresArgs) -> Result<()> {
     let s = super::load_scene(&args.scene, &[], None)?;
-    let text = files::read_text(&args.bench, 1 << 20)?;
+    let text = read_text(&args.bench, 1 << 20)?;
     let bench = figures::bench::parse_csv(&text, &args.bench)?;
     let ctx = figures::Context {
         scene: &s,

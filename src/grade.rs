@@ -171,7 +171,7 @@ pub fn run(args: GradeArgs) -> Result<()> {
             .map_err(|e| Error::io(&path, std::io::Error::other(e)))?;
         // Written last, after every task's processes are gone, then read back: a leftover
         // process cannot have replaced it unnoticed.
-        stereolab_core::files::write_bytes(&path, text.as_bytes())?;
+        stereolab_core::write_bytes(&path, text.as_bytes())?;
         let back = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
         if back != text.as_bytes() {
             return Err(Error::invalid(

@@ -7,10 +7,9 @@ use stereolab::output::animate::{AnimationOptions, animate};
 use stereolab::output::sirds::{from_frame, save, stream_depth_map};
 use stereolab::plan::{Output, Plan};
 use stereolab::render::render;
-use stereolab_core::effects::sirds::decode::depth_from_separation;
-use stereolab_core::effects::sirds::depthfile::Near;
-use stereolab_core::effects::sirds::{DepthMap, Settings, SirdsSpec, from_depth_map};
-use stereolab_core::{Error, Result};
+use stereolab_core::{
+    DepthMap, Error, Near, Result, SirdsSettings, SirdsSpec, depth_from_separation, from_depth_map,
+};
 
 /// Arguments of `stereolab sirds`.
 #[derive(clap::Args, Debug)]
@@ -51,8 +50,8 @@ pub struct SirdsArgs {
     pub pair: Option<PathBuf>,
 }
 
-/// Settings from `--set sirds.key=value` alone (no scene file).
-fn settings_from_sets(sets: &[String]) -> Result<Settings> {
+/// SirdsSettings from `--set sirds.key=value` alone (no scene file).
+fn settings_from_sets(sets: &[String]) -> Result<SirdsSettings> {
     let mut text = String::new();
     for s in sets {
         let (k, v) = s
@@ -71,10 +70,7 @@ fn settings_from_sets(sets: &[String]) -> Result<Settings> {
     let spec: SirdsSpec = toml::from_str(&text)
         .map_err(|e| Error::invalid("--set", sets.join(" "), e.message().to_string()))?;
     // Paths typed on the command line are the user's own: not confined.
-    Settings::from_spec(
-        &spec,
-        &stereolab_core::files::InputRoot::anywhere(Path::new(".")),
-    )
+    SirdsSettings::from_spec(&spec, &stereolab_core::InputRoot::anywhere(Path::new(".")))
 }
 
 /// Whether `path` ends in one of `extensions` (ASCII case ignored).
@@ -178,11 +174,10 @@ fn report(args: &SirdsArgs) -> Result<String> {
     ))
 }
 
-/// `stereolab sirds --decode`: searches the full plausible separation range, decodes, writes
+/// `stereolab sirds --decode_sirds`: searches the full plausible separation range, decodes, writes
 /// the depth (and with `--pair` the two views and their anaglyph); returns the report.
 fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
-    use stereolab_core::effects::sirds::decode::{decode_auto, nearness_linear};
-    use stereolab_core::effects::sirds::search::SearchOptions;
+    use stereolab_core::{SeparationSearchOptions, decode_sirds_auto, nearness_linear};
 
     // Told the set-up: by the scene's [sirds] table (with --set applied), or by --set alone.
     let told = args.scene.is_some() || !args.sets.is_empty();
@@ -190,14 +185,14 @@ fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
         Some(scene) => super::load_scene(scene, &args.sets, None)?.sirds,
         None => settings_from_sets(&args.sets)?,
     };
-    let img = stereolab_core::framebuffer::open_image(path, "image")?.to_rgba8();
+    let img = stereolab_core::open_image(path, "image")?.to_rgba8();
     let (w, h) = img.dimensions();
     let pixels: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
     if told {
         return decode_told(args, path, out, &settings, &pixels, w, h);
     }
     let auto = super::with_spinner(&format!("decoding {}", path.display()), || {
-        decode_auto(&pixels, w, h, &SearchOptions::default())
+        decode_sirds_auto(&pixels, w, h, &SeparationSearchOptions::default())
     })
     .map_err(|e| e.in_file(path))?;
     let search = &auto.search;
@@ -256,26 +251,26 @@ fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
     Ok(report)
 }
 
-/// `--decode` told the viewing set-up (a scene or `--set sirds.*`): decodes over the
-/// separations the model can produce ([`DecodeOptions::for_disparity`]), no search, and maps
+/// `--decode_sirds` told the viewing set-up (a scene or `--set sirds.*`): decodes over the
+/// separations the model can produce ([`SirdsDecodeOptions::for_disparity`]), no search, and maps
 /// separation to depth through the model (eq. 1 or eq. 3; cross-eyed inverts depth).
 #[allow(clippy::too_many_arguments)]
 fn decode_told(
     args: &SirdsArgs,
     path: &Path,
     out: &Path,
-    settings: &Settings,
+    settings: &SirdsSettings,
     pixels: &[[u8; 4]],
     w: u32,
     h: u32,
 ) -> Result<String> {
-    use stereolab_core::effects::sirds::decode::{
-        DecodeOptions, Decoded, decode, matched_share_where_all_fit,
+    use stereolab_core::{
+        DecodedSirds, SirdsDecodeOptions, decode_sirds, matched_share_where_all_fit,
     };
     let d = settings.geometry.to_pixels()?;
-    let opts = DecodeOptions::for_disparity(&d);
+    let opts = SirdsDecodeOptions::for_disparity(&d);
     let decoded = super::with_spinner(&format!("decoding {}", path.display()), || {
-        decode(pixels, w, h, &opts)
+        decode_sirds(pixels, w, h, &opts)
     })
     .map_err(|e| e.in_file(path))?;
     let mut report = format!(
@@ -288,10 +283,8 @@ fn decode_told(
             "--set"
         },
         match d.model {
-            stereolab_core::effects::sirds::DisparityModel::ViewAngle =>
-                "eq. 1 (constant view angle)",
-            stereolab_core::effects::sirds::DisparityModel::EyeDistance =>
-                "eq. 3 (constant eye distance)",
+            stereolab_core::DisparityModel::ViewAngle => "eq. 1 (constant view angle)",
+            stereolab_core::DisparityModel::EyeDistance => "eq. 3 (constant eye distance)",
         },
         if settings.cross_eyed {
             "cross-eyed"
@@ -312,7 +305,7 @@ fn decode_told(
         "  {:.1}% of the pixels where every separation of the model fits matched\n",
         share * 100.0
     );
-    let judged = Decoded {
+    let judged = DecodedSirds {
         matched_share: share,
         ..decoded
     };
@@ -328,13 +321,12 @@ fn finish_decode(
     out: &Path,
     pixels: &[[u8; 4]],
     (w, h): (u32, u32),
-    decoded: &stereolab_core::effects::sirds::decode::Decoded,
+    decoded: &stereolab_core::DecodedSirds,
     z: Vec<f32>,
     (lo, hi): (u32, u32),
-    settings: &Settings,
+    settings: &SirdsSettings,
 ) -> Result<String> {
-    use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
-    use stereolab_core::effects::sirds::pair::views;
+    use stereolab_core::{AnaglyphKind, AnaglyphOptions, anaglyph, sirds_views};
     let z = z
         .into_iter()
         .map(|z| {
@@ -364,10 +356,10 @@ fn finish_decode(
         out.display()
     );
     if let Some(dir) = &args.pair {
-        let v = views(pixels, decoded, settings.cross_eyed)?;
-        let fb = |color: Vec<[u8; 4]>| -> Result<stereolab_core::framebuffer::Framebuffer> {
+        let v = sirds_views(pixels, decoded, settings.cross_eyed)?;
+        let fb = |color: Vec<[u8; 4]>| -> Result<stereolab_core::Framebuffer> {
             let depth = vec![1.0; color.len()];
-            stereolab_core::framebuffer::Framebuffer::from_buffers(w, h, color, depth)
+            stereolab_core::Framebuffer::from_buffers(w, h, color, depth)
         };
         let (left, right) = (fb(v.left)?, fb(v.right)?);
         let ana = anaglyph(
@@ -382,12 +374,12 @@ fn finish_decode(
             dir.join("anaglyph.png"),
         ];
         for p in &names {
-            stereolab_core::files::check_output_path(p)?;
+            stereolab_core::check_output_path(p)?;
         }
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        stereolab_core::files::write_png(&names[0], &left.to_rgba_image())?;
-        stereolab_core::files::write_png(&names[1], &right.to_rgba_image())?;
-        stereolab_core::files::write_png(&names[2], &ana)?;
+        stereolab_core::write_png(&names[0], &left.to_rgba_image())?;
+        stereolab_core::write_png(&names[1], &right.to_rgba_image())?;
+        stereolab_core::write_png(&names[2], &ana)?;
         report += &format!(
             "  stereo pair ({} viewing, background at zero parallax: {:.1} px)\n",
             if settings.cross_eyed {
@@ -432,5 +424,5 @@ fn write_depth(map: &DepthMap, out: &Path) -> Result<()> {
         image::DynamicImage::ImageLuma16(depth).write_to(&mut bytes, format)
     };
     encoded.map_err(|e| Error::invalid("--out", out.display(), e.to_string()))?;
-    stereolab_core::files::write_bytes(out, bytes.get_ref())
+    stereolab_core::write_bytes(out, bytes.get_ref())
 }

@@ -10,14 +10,15 @@ use stereolab::plan::{Output, Pass, Plan, Shading, View};
 use stereolab::render::chromadepth::{render_center_with, texgen_map};
 use stereolab::render::render;
 use stereolab::scene::{Scene, terrain, terrain_data};
-use stereolab_core::Error;
-use stereolab_core::effects::chromadepth::glasses::{self, Eye, pixel_shift};
-use stereolab_core::effects::chromadepth::ramp::{self, Ramp, RampKind, Sampling};
-use stereolab_core::effects::chromadepth::texgen::{Texgen, auto_range, eye_plane_specified_under};
-use stereolab_core::effects::chromadepth::{ChromaDepthSettings, TexgenMode};
-use stereolab_core::math::StereoRig;
+use stereolab_core::{
+    ChromaDepthSettings, Error, Eye, Ramp, RampKind, RampSampling, StereoRig, Texgen, TexgenMode,
+    auto_range, eye_plane_specified_under, pixel_shift,
+};
 
 use crate::common;
+use stereolab_core::{
+    DEFAULT_TEXELS, channel_weights, glasses_view, hue_degrees, ramp_exact, shift_map,
+};
 
 /// A scene from TOML text with a camera at the origin looking down −Z (view = identity), so eye
 /// space is world space; `meshes` are appended `[[mesh]]` tables.
@@ -162,20 +163,20 @@ fn auto_range_is_the_bounding_sphere_center_distance_minus_and_plus_radius() {
 
 #[test]
 fn ramp_first_texel_is_red_middle_green_last_blue() {
-    let r = Ramp::new(RampKind::Hsv, ramp::DEFAULT_TEXELS).expect("valid ramp");
+    let r = Ramp::new(RampKind::Hsv, DEFAULT_TEXELS).expect("valid ramp");
     let t = r.texels();
     assert_eq!(t.len(), 256);
     assert_eq!(t[0], Vec3::X, "first texel pure red");
     assert_eq!(t[255], Vec3::Z, "last texel pure blue");
     // 256 texels have no middle texel: s = 0.5 falls between texels 127 and 128 (hues 119.5°
     // and 120.5°); linear sampling there is green to 1/255.
-    let mid = r.sample(0.5, Sampling::Linear);
+    let mid = r.sample(0.5, RampSampling::Linear);
     assert_eq!(mid.y, 1.0);
     assert!(
         mid.x < 1.0 / 255.0 + 1e-6 && mid.z < 1.0 / 255.0 + 1e-6,
         "mid = {mid}"
     );
-    let hue = ramp::hue_degrees(mid).expect("has a hue");
+    let hue = hue_degrees(mid).expect("has a hue");
     assert!((hue - 120.0).abs() < 1e-3, "hue {hue}");
     // An odd texel count has a middle texel: exactly green.
     let odd = Ramp::new(RampKind::Hsv, 255).expect("valid ramp");
@@ -190,7 +191,7 @@ fn ramp_first_texel_is_red_middle_green_last_blue() {
 #[test]
 fn ramp_clamps_beyond_d2_and_before_d1() {
     let r = Ramp::new(RampKind::Hsv, 256).expect("valid ramp");
-    for sampling in [Sampling::Nearest, Sampling::Linear] {
+    for sampling in [RampSampling::Nearest, RampSampling::Linear] {
         for s in [1.0, 1.0001, 1.5, 7.0, 1e30, f32::INFINITY] {
             assert_eq!(
                 r.sample(s, sampling),
@@ -348,7 +349,7 @@ fn lit_chromadepth_keeps_the_hue() {
         .0;
     let (mut compared, mut darker) = (0, 0);
     for (u, l) in a.color().iter().zip(b.color()) {
-        let hue = |p: &[u8; 4]| ramp::hue_degrees(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32));
+        let hue = |p: &[u8; 4]| hue_degrees(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32));
         // Dim pixels lose hue precision to 8-bit rounding: compare where a channel is ≥ 64.
         if u[..3] == [0, 0, 0] || *l[..3].iter().max().expect("3") < 64 {
             continue;
@@ -373,8 +374,8 @@ fn redder_pixels_get_larger_inward_shifts() {
     for kind in [RampKind::Hsv, RampKind::RedWhiteBlue] {
         let mut last = f32::INFINITY;
         for k in 0..=200 {
-            let c = ramp::exact(kind, k as f32 / 200.0);
-            let rgba = stereolab_core::shade::to_rgba8(c);
+            let c = ramp_exact(kind, k as f32 / 200.0);
+            let rgba = stereolab_core::to_rgba8(c);
             let shift = pixel_shift(rgba, 10.0);
             assert!(
                 shift <= last,
@@ -391,7 +392,7 @@ fn redder_pixels_get_larger_inward_shifts() {
         assert_eq!(pixel_shift([0, 0, 255, 255], 10.0), 0.0, "blue stays");
         assert_eq!(pixel_shift([0, 0, 0, 255], 10.0), 0.0, "black stays");
     }
-    let w = glasses::channel_weights();
+    let w = channel_weights();
     assert!(w[0] > w[1] && w[1] > w[2], "red bent most: {w:?}");
 }
 
@@ -472,10 +473,10 @@ fn glasses_disparity_order_matches_depth_order() {
         &s.chromadepth,
     )
     .expect("ok");
-    let expected = stereolab_core::effects::anaglyph::anaglyph(
+    let expected = stereolab_core::anaglyph(
         &left,
         &right,
-        stereolab_core::effects::anaglyph::AnaglyphKind::Gray,
+        stereolab_core::AnaglyphKind::Gray,
         Default::default(),
     )
     .expect("same size");
@@ -502,7 +503,7 @@ fn glasses_shift_falls_with_depth_on_the_fault_valley() {
     s.set_size(160, 120).expect("valid size");
     let c = StereoRig::center(&s.camera, s.aspect()).expect("camera");
     let (fb, _) = render_center_with(&s, &c, &s.chromadepth).expect("renders");
-    let shifts = glasses::shift_map(&fb, 10.0);
+    let shifts = shift_map(&fb, 10.0);
     // Mean shift per depth decile of the covered pixels must fall from near to far.
     let mut covered: Vec<(f32, f32)> = fb
         .depth()
@@ -525,8 +526,8 @@ fn glasses_views_move_inward() {
     // One red pixel column on black: the left view moves it right, the right view left.
     let mut fb = stereolab_core::Framebuffer::new(21, 1, [0, 0, 0, 255]).expect("size");
     fb.color_mut()[10] = [255, 0, 0, 255];
-    let l = glasses::glasses_view(&fb, Eye::Left, 3.0);
-    let r = glasses::glasses_view(&fb, Eye::Right, 3.0);
+    let l = glasses_view(&fb, Eye::Left, 3.0);
+    let r = glasses_view(&fb, Eye::Right, 3.0);
     let at = |f: &stereolab_core::Framebuffer| f.color().iter().position(|p| p[0] == 255);
     assert_eq!(at(&l), Some(13));
     assert_eq!(at(&r), Some(7));
@@ -663,7 +664,7 @@ fn shipped_chromadepth_scenes_render_every_output() {
         let hues: Vec<f32> = fb
             .color()
             .iter()
-            .filter_map(|p| ramp::hue_degrees(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32)))
+            .filter_map(|p| hue_degrees(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32)))
             .collect();
         let (lo, hi) = hues
             .iter()

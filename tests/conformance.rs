@@ -6,9 +6,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use proptest::prelude::*;
 use stereolab::compare::ascii_map;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::raster::{RasterOptions, rasterize};
-use stereolab_core::shade::{Fragment, Shader, Varyings};
+use stereolab_core::{Fragment, Framebuffer, RasterOptions, Shader, Varyings, rasterize};
 
 use crate::common::failure_dir;
 
@@ -303,7 +301,7 @@ fn eye_triangle(tri: [Vec3; 3], width: u32, height: u32) -> Framebuffer {
             Some([255; 4])
         }
     }
-    let p: Mat4 = stereolab_core::math::perspective(60.0, width as f32 / height as f32, 1.0, 50.0);
+    let p: Mat4 = stereolab_core::perspective(60.0, width as f32 / height as f32, 1.0, 50.0);
     let shader = Eye {
         clip: tri.iter().map(|v| p * v.extend(1.0)).collect(),
     };
@@ -433,7 +431,7 @@ proptest! {
         tile_w in 5u32..40,
         tile_h in 3u32..30,
     ) {
-        use stereolab_core::raster::{Band, setup_triangles, traverse};
+        use stereolab_core::{RasterBand, setup_triangles, traverse};
         let clip: Vec<Vec4> = verts.iter().map(|&(x, y, z, w)| Vec4::new(x * w, y * w, z * w, w)).collect();
         let tris: Vec<[u32; 3]> = (0..10).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
         let shader = Gradient { clip };
@@ -448,7 +446,7 @@ proptest! {
                 let (tw, th) = (tile_w.min(W - x0), tile_h.min(H - y0));
                 let n = (tw * th) as usize;
                 let (mut color, mut depth) = (vec![[0, 0, 0, 255]; n], vec![1.0f32; n]);
-                let mut tile = Band { width: tw, x0, y0, color: &mut color, depth: &mut depth };
+                let mut tile = RasterBand { width: tw, x0, y0, color: &mut color, depth: &mut depth };
                 for t in &setups {
                     traverse(t, &shader, &mut tile, &opts);
                 }

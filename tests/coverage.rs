@@ -6,8 +6,10 @@ use std::collections::BTreeSet;
 
 use proptest::prelude::*;
 use stereolab::compare::ascii_map;
-use stereolab_core::raster::{RasterOptions, Setup, SetupTriangle, WindowVertex, setup_triangle};
-use stereolab_core::shade::{MAX_VARYINGS, Varyings};
+use stereolab_core::{
+    MAX_VARYINGS, RasterOptions, SetupTriangle, TriangleSetup, Varyings, WindowVertex,
+    setup_triangle,
+};
 
 /// The target: small, so that every pixel is tested, and not a multiple of 8 wide.
 const W: u32 = 37;
@@ -33,9 +35,9 @@ fn setup(v: Tri, bits: u32) -> Option<SetupTriangle> {
         ..RasterOptions::default()
     };
     match setup_triangle(wv, [&var; 3], 0, W, H, &opts) {
-        Setup::Triangle(t) => Some(t),
-        Setup::Empty => None,
-        Setup::Culled => unreachable!("culling is off"),
+        TriangleSetup::Triangle(t) => Some(t),
+        TriangleSetup::Empty => None,
+        TriangleSetup::Culled => unreachable!("culling is off"),
     }
 }
 

@@ -46,7 +46,7 @@ fn two_runs_and_one_vs_many_threads_give_identical_bytes() {
 /// SIRDS of a shipped scene (strip algorithm and TIW) under a pool of `threads` threads.
 fn sirds_bytes(threads: usize) -> Vec<Vec<[u8; 4]>> {
     use stereolab::output::sirds::from_frame;
-    use stereolab_core::effects::sirds::Algorithm;
+    use stereolab_core::SirdsAlgorithm;
     let mut scene = Scene::load(&asset("scenes/sirds_sphere.toml"), &[]).unwrap();
     scene.set_size(300, 150).unwrap();
     let pool = rayon::ThreadPoolBuilder::new()
@@ -55,7 +55,7 @@ fn sirds_bytes(threads: usize) -> Vec<Vec<[u8; 4]>> {
         .unwrap();
     pool.install(|| {
         let frame = render(&scene, &Plan::new(&[Output::Sirds])).unwrap();
-        [Algorithm::PerVertex, Algorithm::PerPixel]
+        [SirdsAlgorithm::PerVertex, SirdsAlgorithm::PerPixel]
             .into_iter()
             .map(|a| {
                 let mut s = scene.clone();
@@ -83,7 +83,7 @@ fn sirds_bytes_do_not_depend_on_the_thread_count() {
 /// Each scene is also rendered with the other filter, so nearest and bilinear both run.
 #[test]
 fn scalar_and_avx2_loops_write_the_same_files() {
-    if !stereolab_core::simd::avx2_available() {
+    if !stereolab_core::avx2_available() {
         eprintln!("scalar_and_avx2_loops_write_the_same_files: NOT RUN: no AVX2 here");
         return;
     }

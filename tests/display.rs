@@ -6,15 +6,12 @@ use stereolab::output::{Image, produce, report::effect_lines};
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
-use stereolab_core::effects::calibration::{
-    ARROW_COLOR, BLANK_COLOR, CalibrationLayout, VIEW_COLOR, calibration_screen,
+use stereolab_core::{
+    BACK_LEFT, BACK_RIGHT, CALIBRATION_ARROW_COLOR, CALIBRATION_BLANK_COLOR,
+    CALIBRATION_VIEW_COLOR, CalibrationLayout, DEFAULT_GHOSTING_LEAK, PARALLAX_VIOLATION_COLOR,
+    calibration_screen, ghost_risk, parallax_budget, parallax_image, parallax_map, rds_left,
+    violation_band,
 };
-use stereolab_core::effects::ghosting::{DEFAULT_LEAK, ghost_risk};
-use stereolab_core::effects::parallax::{
-    VIOLATION_COLOR, budget, parallax_image, parallax_map, violation_band,
-};
-use stereolab_core::effects::rds::rds_left;
-use stereolab_core::framebuffer::{BACK_LEFT, BACK_RIGHT};
 
 use crate::common::{asset, out_dir};
 
@@ -210,8 +207,8 @@ fn ghosting_leaks_the_set_share_of_the_other_eye_in_linear_light() {
         .flat_map(|y| (0..l.width()).map(move |x| (x, y)))
         .find(|&(x, y)| l.pixel(x, y)[..3] == [0, 0, 0] && r.pixel(x, y)[1] > 200)
         .expect("a ghost pixel");
-    let dec = |v: u8| stereolab_core::effects::anaglyph::srgb_to_linear(v as f32 / 255.0);
-    let enc = |v: f32| (stereolab_core::effects::anaglyph::linear_to_srgb(v) * 255.0).round() as u8;
+    let dec = |v: u8| stereolab_core::srgb_to_linear(v as f32 / 255.0);
+    let enc = |v: f32| (stereolab_core::linear_to_srgb(v) * 255.0).round() as u8;
     let other = r.pixel(x, y);
     for (c, leak) in [0.1f32, 0.2, 0.05].into_iter().enumerate() {
         assert_eq!(
@@ -227,7 +224,12 @@ fn ghosting_leaks_the_set_share_of_the_other_eye_in_linear_light() {
         .expect("a pixel the right eye leaves black");
     assert_eq!(out.get_pixel(bx, by).0, l.pixel(bx, by));
     // The defaults put green first.
-    const { assert!(DEFAULT_LEAK[1] > DEFAULT_LEAK[0] && DEFAULT_LEAK[1] > DEFAULT_LEAK[2]) };
+    const {
+        assert!(
+            DEFAULT_GHOSTING_LEAK[1] > DEFAULT_GHOSTING_LEAK[0]
+                && DEFAULT_GHOSTING_LEAK[1] > DEFAULT_GHOSTING_LEAK[2]
+        )
+    };
 }
 
 #[test]
@@ -277,14 +279,14 @@ fn calibration_arrows_sit_on_the_middle_row_of_each_view() {
     // The blank band: rows 364..404 black, all of them.
     for y in 364..404 {
         assert!(
-            (0..1024).all(|x| img.get_pixel(x, y).0 == BLANK_COLOR),
+            (0..1024).all(|x| img.get_pixel(x, y).0 == CALIBRATION_BLANK_COLOR),
             "row {y}"
         );
     }
     for y in [363, 404] {
         assert_eq!(
             img.get_pixel(1000, y).0,
-            VIEW_COLOR,
+            CALIBRATION_VIEW_COLOR,
             "row {y} is a view row"
         );
     }
@@ -294,7 +296,7 @@ fn calibration_arrows_sit_on_the_middle_row_of_each_view() {
         (404, 768, 586, 518, 700),
     ] {
         let rows: Vec<u32> = (top..bottom)
-            .filter(|&y| (0..1024).any(|x| img.get_pixel(x, y).0 == ARROW_COLOR))
+            .filter(|&y| (0..1024).any(|x| img.get_pixel(x, y).0 == CALIBRATION_ARROW_COLOR))
             .collect();
         let (first, last) = (rows[0], *rows.last().unwrap());
         assert_eq!(
@@ -302,20 +304,20 @@ fn calibration_arrows_sit_on_the_middle_row_of_each_view() {
             2 * cy,
             "arrow rows {first}..={last} about {cy}"
         );
-        assert_eq!(img.get_pixel(tip_col, cy).0, ARROW_COLOR);
-        assert_eq!(img.get_pixel(tail_col, cy).0, ARROW_COLOR);
+        assert_eq!(img.get_pixel(tip_col, cy).0, CALIBRATION_ARROW_COLOR);
+        assert_eq!(img.get_pixel(tail_col, cy).0, CALIBRATION_ARROW_COLOR);
     }
     // The top arrow points right (nothing right of the tip), the bottom one left.
-    assert_ne!(img.get_pixel(513, 182).0, ARROW_COLOR);
-    assert_ne!(img.get_pixel(510, 586).0, ARROW_COLOR);
+    assert_ne!(img.get_pixel(513, 182).0, CALIBRATION_ARROW_COLOR);
+    assert_ne!(img.get_pixel(510, 586).0, CALIBRATION_ARROW_COLOR);
     // Another blank interval moves the bottom arrow by the difference.
     // (30 rows: views of 369 rows, the bottom one from row 399, its arrow on row 583).
     let other = calibration_screen(1024, 768, 30).unwrap();
     let moved = CalibrationLayout::new(1024, 768, 30).unwrap();
     assert_eq!(moved.bottom_arrow_y, 583);
-    assert_eq!(other.get_pixel(700, 583).0, ARROW_COLOR);
-    assert_eq!(other.get_pixel(700, 573).0, ARROW_COLOR);
-    assert_eq!(img.get_pixel(700, 573).0, VIEW_COLOR);
+    assert_eq!(other.get_pixel(700, 583).0, CALIBRATION_ARROW_COLOR);
+    assert_eq!(other.get_pixel(700, 573).0, CALIBRATION_ARROW_COLOR);
+    assert_eq!(img.get_pixel(700, 573).0, CALIBRATION_VIEW_COLOR);
 }
 
 #[test]
@@ -325,11 +327,11 @@ fn window_violations_are_marked_on_the_parallax_image() {
     let fb = frame.view(View::Left).unwrap();
     let rig = scene.parallax_rig().unwrap();
     let map = parallax_map(fb, &rig).unwrap();
-    let b = budget(&map, fb.width(), fb.height());
+    let b = parallax_budget(&map, fb.width(), fb.height());
     assert!(b.window_violations[0] > 10, "{:?}", b.window_violations);
     let img = parallax_image(fb, &rig).unwrap();
     let band = violation_band(fb.width());
-    let yellow = |x: u32, y: u32| img.get_pixel(x, y).0 == VIOLATION_COLOR;
+    let yellow = |x: u32, y: u32| img.get_pixel(x, y).0 == PARALLAX_VIOLATION_COLOR;
     let marked_rows = (0..fb.height()).filter(|&y| yellow(0, y)).count();
     assert_eq!(marked_rows, b.window_violations[0]);
     for y in (0..fb.height()).filter(|&y| map[(y * fb.width()) as usize].is_some_and(|p| p < 0.0)) {
@@ -348,7 +350,7 @@ fn window_violations_are_marked_on_the_parallax_image() {
     let cfb = cf.view(View::Left).unwrap();
     let crig = clean.parallax_rig().unwrap();
     assert_eq!(
-        budget(
+        parallax_budget(
             &parallax_map(cfb, &crig).unwrap(),
             cfb.width(),
             cfb.height()
@@ -357,7 +359,7 @@ fn window_violations_are_marked_on_the_parallax_image() {
         [0; 4]
     );
     let cimg = parallax_image(cfb, &crig).unwrap();
-    assert!(!cimg.pixels().any(|p| p.0 == VIOLATION_COLOR));
+    assert!(!cimg.pixels().any(|p| p.0 == PARALLAX_VIOLATION_COLOR));
 }
 
 #[test]

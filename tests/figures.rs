@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use stereolab::scene::Scene;
-use stereolab_core::math::project_ndc;
+use stereolab_core::project_ndc;
 use stereolab_figures::parallax_curve;
 
 use crate::common::asset;
@@ -197,7 +197,7 @@ fn parallax_diagram_rays_meet_at_the_point() {
 /// on a rendered point; off-axis has none.
 #[test]
 fn vertical_parallax_map_is_zero_for_off_axis_and_not_for_toe_in() {
-    use stereolab_core::math::CameraMode;
+    use stereolab_core::CameraMode;
     use stereolab_figures::vertical_parallax_grid;
     let s = Scene::load(&asset("scenes/wuson.toml"), &[]).expect("scene");
     let toe = vertical_parallax_grid(&s, CameraMode::ToeIn, 8, 6).expect("grid");
@@ -216,10 +216,10 @@ fn vertical_parallax_map_is_zero_for_off_axis_and_not_for_toe_in() {
 /// strips use: both models meet at the background, and eq. 3's front separation is δ.
 #[test]
 fn sirds_figure_models_agree_at_the_background() {
-    use stereolab_core::effects::sirds::{DisparityModel, Geometry};
-    let g = Geometry::default();
+    use stereolab_core::{DisparityModel, SirdsGeometry};
+    let g = SirdsGeometry::default();
     let eq3 = g.to_pixels().expect("eq. 3");
-    let eq1 = Geometry {
+    let eq1 = SirdsGeometry {
         model: DisparityModel::ViewAngle,
         ..g
     }

@@ -132,7 +132,7 @@ proptest! {
         }
         bytes.extend(&body);
         std::fs::write(&path, &bytes).unwrap();
-        let _ = stereolab_core::framebuffer::open_image(&path, "fuzz image");
+        let _ = stereolab_core::open_image(&path, "fuzz image");
     }
 }
 

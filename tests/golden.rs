@@ -4,7 +4,7 @@
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::render;
 use stereolab::scene::Scene;
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::Framebuffer;
 
 use crate::common::{asset, failure_dir};
 

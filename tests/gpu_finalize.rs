@@ -9,16 +9,15 @@ use image::RgbaImage;
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab::scene::Scene;
-use stereolab_core::Framebuffer;
-use stereolab_core::effects::anaglyph::{self, AnaglyphKind, AnaglyphOptions};
-use stereolab_core::effects::occlusion::occlusion_image;
-use stereolab_core::effects::parallax::{parallax_image, parallax_map};
-use stereolab_core::effects::remap::{Precision, remap_color};
-use stereolab_core::math::EyeMatrices;
+use stereolab_core::{
+    AnaglyphKind, AnaglyphOptions, EyeMatrices, Framebuffer, Precision, occlusion_image,
+    parallax_image, parallax_map, remap_color,
+};
 use stereolab_gpu::GpuFinalize;
 
 use crate::common;
 use crate::gpu_parity::gpu;
+use stereolab_core::anaglyph;
 
 /// The real model's two eyes at 320×240, rendered by the CPU path, with their matrices.
 fn wuson_eyes() -> (Scene, [Framebuffer; 2], [EyeMatrices; 2]) {
@@ -94,7 +93,7 @@ fn wgsl_anaglyphs_match_the_cpu_within_one_step_on_identical_eyes() {
                         linear_light,
                         swap_eyes,
                     };
-                    let cpu = anaglyph::anaglyph(left, right, kind, options).expect("cpu");
+                    let cpu = anaglyph(left, right, kind, options).expect("cpu");
                     let gpu = fin.anaglyph(r, left, right, kind, options).expect("gpu");
                     let (max, n) = diff(&cpu, &gpu);
                     eprintln!(
@@ -201,9 +200,7 @@ const CREASE_PERCENT: f64 = 0.01;
 /// step of 4], because an ulp of `s` can cross a texel edge `k/N`.
 #[test]
 fn chromadepth_pass_matches_the_cpu_in_every_mode() {
-    use stereolab_core::effects::chromadepth::TexgenMode;
-    use stereolab_core::effects::chromadepth::ramp::{Ramp, Sampling};
-    use stereolab_core::math::StereoRig;
+    use stereolab_core::{Ramp, RampSampling, StereoRig, TexgenMode};
     use stereolab_gpu::GpuScene;
     let Some(r) = gpu() else { return };
     for name in ["chromadepth_fault", "chromadepth_molecule"] {
@@ -218,7 +215,7 @@ fn chromadepth_pass_matches_the_cpu_in_every_mode() {
             .max()
             .expect("two texels");
         let center = StereoRig::center(&scene.camera, scene.aspect()).expect("rig");
-        for sampling in [Sampling::Linear, Sampling::Nearest] {
+        for sampling in [RampSampling::Linear, RampSampling::Nearest] {
             for texgen in [TexgenMode::PerVertex, TexgenMode::PerPixel] {
                 for lit in [true, false] {
                     scene.chromadepth.sampling = sampling;
@@ -230,8 +227,8 @@ fn chromadepth_pass_matches_the_cpu_in_every_mode() {
                         .render_view(&gs, &center, Shading::ChromaDepth)
                         .expect("gpu");
                     let bound = match sampling {
-                        Sampling::Linear => 1,
-                        Sampling::Nearest => texel_step + 1,
+                        RampSampling::Linear => 1,
+                        RampSampling::Nearest => texel_step + 1,
                     };
                     let (max, n) = diff(&cpu.to_rgba_image(), &gpu.to_rgba_image());
                     let beyond = cpu

@@ -16,8 +16,7 @@ use stereolab::compare::{Metrics, ascii_map, compare, coverage, write_diff_strip
 use stereolab::plan::{Plan, Shading};
 use stereolab::render::render_view;
 use stereolab::scene::{Mesh, Object, Scene};
-use stereolab_core::math::EyeMatrices;
-use stereolab_core::{Framebuffer, Result};
+use stereolab_core::{EyeMatrices, Framebuffer, Result};
 use stereolab_gpu::parity::{compare_scene, depth_identity};
 use stereolab_gpu::{FullscreenPass, GpuRenderer, GpuScene};
 

@@ -7,8 +7,10 @@ use stereolab::output::sirds::scene_depth;
 use stereolab::plan::Plan;
 use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::scene::Scene;
-use stereolab_core::effects::sirds::decode::{DecodeOptions, decode, round_trip};
-use stereolab_core::effects::sirds::{Filter, Pattern, PerVertexOptions, Start};
+use stereolab_core::{
+    PerVertexOptions, SirdsDecodeOptions, SirdsPattern, StripFilter, StripStart, decode_sirds,
+    sirds_round_trip,
+};
 use stereolab_gpu::parity::compare_scene;
 use stereolab_gpu::sirds::GpuStrips;
 
@@ -46,14 +48,14 @@ fn gpu_strips_match_cpu_strips_and_decode() {
         let d = s.sirds.geometry.to_pixels().expect("valid");
         let g = StripGeometry::new(&s, &f.views.center, &range, &d, false);
         let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
-        for start in [Start::Left, Start::Center] {
-            for filter in [Filter::Nearest, Filter::Bilinear] {
+        for start in [StripStart::Left, StripStart::Center] {
+            for filter in [StripFilter::Nearest, StripFilter::Bilinear] {
                 let opts = PerVertexOptions {
                     start,
                     filter,
                     iterations: None,
                 };
-                let pattern = Pattern::Gray { seed: 11 };
+                let pattern = SirdsPattern::Gray { seed: 11 };
                 let cpu = per_vertex(&g, s.width, s.height, &d, &pattern, &opts, false)
                     .expect("cpu strips");
                 let gpu = strips
@@ -64,9 +66,10 @@ fn gpu_strips_match_cpu_strips_and_decode() {
                     (cpu.iterations, cpu.strip_width)
                 );
                 let (same, max) = parity(&cpu.pixels, &gpu.pixels);
-                let dopts = DecodeOptions::for_disparity(&d);
-                let decoded = decode(&gpu.pixels, s.width, s.height, &dopts).expect("decodes");
-                let rt = round_trip(&decoded, &intended, &dopts);
+                let dopts = SirdsDecodeOptions::for_disparity(&d);
+                let decoded =
+                    decode_sirds(&gpu.pixels, s.width, s.height, &dopts).expect("decodes");
+                let rt = sirds_round_trip(&decoded, &intended, &dopts);
                 let line = format!(
                     "{name:6} {start:?} {filter:?}: identical {:.4}%, max diff {max}, \
                      decoded within ±1 px {:.1}%\n",
@@ -130,7 +133,7 @@ fn gpu_strips_reject_too_few_iterations_like_the_cpu() {
         iterations: Some(2),
         ..PerVertexOptions::default()
     };
-    let pattern = Pattern::Gray { seed: 1 };
+    let pattern = SirdsPattern::Gray { seed: 1 };
     let strips = GpuStrips::new(r).expect("compiles");
     let gpu = strips.run(r, &g, s.width, s.height, &d, &pattern, &opts);
     let cpu = per_vertex(&g, s.width, s.height, &d, &pattern, &opts, false);

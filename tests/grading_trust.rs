@@ -119,7 +119,7 @@ fn a_solution_that_prints_a_megabyte_in_every_task_still_scores_full_marks() {
 fn a_submission_that_calls_stereolab_does_not_compile() {
     let _turn = take_turn();
     let cheat = format!(
-        "{}\npub fn cheat() -> glam::Mat4 {{ stereolab_core::math::frustum(-1.0, 1.0, -1.0, 1.0, 1.0, 10.0) }}\n",
+        "{}\npub fn cheat() -> glam::Mat4 {{ stereolab_core::frustum(-1.0, 1.0, -1.0, 1.0, 1.0, 10.0) }}\n",
         solution("ex2_chromadepth")
     );
     let dir = submission("cheat", &[("ex2_chromadepth", cheat)]);

@@ -247,7 +247,7 @@ fn a_render_that_draws_nothing_says_so() {
 }
 
 /// Catalogue: near/far ratios from 10 to 1e12, each depth mode against the f64 reference
-/// (`stereolab_core::reference`), on the depth benchmark's decal scene (pairs of squares 1/10 000
+/// (`stereolab_core::visible_f64`), on the depth benchmark's decal scene (pairs of squares 1/10 000
 /// of their depth apart). Tolerance: zero wrong or lost pixels (of those the reference decides)
 /// wherever the mode's predicted resolution `resolution_of` at the farthest pair (eye depth 90)
 /// is under a quarter of that pair's gap; reason: a resolution finer than the gap separates
@@ -292,10 +292,10 @@ fn catalogue_near_far_ratios_within_the_predicted_resolution_of_each_depth_mode(
 /// rounding of the formula. Before: 67 px (t_far − t_near rounded in f32).
 #[test]
 fn catalogue_sirds_depth_far_in_1e8_keeps_the_front_separation() {
-    use stereolab_core::effects::sirds::disparity::Geometry;
-    let g = Geometry {
+    use stereolab_core::SirdsGeometry;
+    let g = SirdsGeometry {
         depth_far_in: 1e8,
-        ..Geometry::default()
+        ..SirdsGeometry::default()
     };
     let d = g.to_pixels().expect("valid");
     assert!(
@@ -336,19 +336,20 @@ fn depth_mode_values_are_checked_by_name() {
 
 /// Draws `triangles` through `mvp` on the CPU, as triangle ids, and compares each pixel the
 /// f64 reference decides (the same f32 vertices through `mvp64`) with the reference's winner
-/// (`stereolab_core::reference`).
+/// (`stereolab_core::visible_f64`).
 fn against_reference_through(
     positions: &[glam::Vec3],
     triangles: &[[u32; 3]],
     (mvp, mvp64): (glam::Mat4, glam::DMat4),
     (width, height): (u32, u32),
-) -> stereolab_core::reference::Mismatch {
-    use stereolab_core::framebuffer::Framebuffer;
-    use stereolab_core::raster::{RasterOptions, rasterize};
-    use stereolab_core::reference::{IdShader, compare, soup, visible};
+) -> stereolab_core::Mismatch {
+    use stereolab_core::{
+        Framebuffer, IdShader, RasterOptions, compare_with_reference, rasterize, triangle_soup,
+        visible_f64,
+    };
     let world: Vec<glam::DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
-    let reference = visible(&world, triangles, &mvp64, width, height);
-    let soup_positions = soup(positions, triangles);
+    let reference = visible_f64(&world, triangles, &mvp64, width, height);
+    let soup_positions = triangle_soup(positions, triangles);
     let soup_triangles: Vec<[u32; 3]> = (0..triangles.len() as u32)
         .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
         .collect();
@@ -364,7 +365,7 @@ fn against_reference_through(
         &mut fb,
         &RasterOptions::default(),
     );
-    compare(&fb, &reference)
+    compare_with_reference(&fb, &reference)
 }
 
 /// [`against_reference_through`] for triangles in eye space (the camera at the origin looking
@@ -374,11 +375,11 @@ fn against_reference(
     triangles: &[[u32; 3]],
     (near, far): (f32, f32),
     (width, height): (u32, u32),
-) -> stereolab_core::reference::Mismatch {
+) -> stereolab_core::Mismatch {
     let aspect = width as f32 / height as f32;
     let (a, b) = (near * aspect, near);
-    let mvp = stereolab_core::math::frustum(-a, a, -b, b, near, far);
-    let mvp64 = stereolab_core::reference::frustum(
+    let mvp = stereolab_core::frustum(-a, a, -b, b, near, far);
+    let mvp64 = stereolab_core::frustum_f64(
         -f64::from(a),
         f64::from(a),
         -f64::from(b),
@@ -532,7 +533,7 @@ fn catalogue_chromadepth_d1_equal_to_d2_within_an_ulp() {
 /// refusal naming `t + f`, never an infinity or NaN passed on.
 #[test]
 fn catalogue_sirds_eq3_near_the_pole_stays_within_ulps_or_is_refused() {
-    use stereolab_core::effects::sirds::disparity::separation_eye_distance;
+    use stereolab_core::separation_eye_distance;
     let (a, f) = (180.0f32, 864.0f32);
     let mut t = -f + 1.0;
     let mut checked = 0;
@@ -571,13 +572,13 @@ fn catalogue_sirds_eq3_near_the_pole_stays_within_ulps_or_is_refused() {
 
 /// Catalogue: toe-in at extreme separations, from 1e-6 to 1e6 times the model's size. Each
 /// eye's f32 matrix (`StereoRig::eyes_for_image`, what every render uses) against the f64
-/// reference rig (`stereolab_core::reference::eye`) on the model's bounding-box corners and
+/// reference rig (`stereolab_core::eye_matrices_f64`) on the model's bounding-box corners and
 /// centre. Tolerance: 0.01 px on a 320×240 image for every point in front of the eye; a
 /// separation whose cameras overflow is refused by name instead (`1e20`, tested above).
 #[test]
 fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
     use glam::{DVec3, Vec3};
-    use stereolab_core::math::CameraMode;
+    use stereolab_core::CameraMode;
     let path = asset("scenes/anaglyph.toml");
     let (w, h) = (320u32, 240u32);
     let mut worst = 0.0f64;
@@ -610,7 +611,7 @@ fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
         }
         points.push(target);
         for (side, eye) in stereolab_core::Eye::BOTH.into_iter().zip(&eyes) {
-            let m64 = stereolab_core::reference::eye(
+            let m64 = stereolab_core::eye_matrices_f64(
                 &scene.rig,
                 &scene.camera,
                 aspect,
@@ -657,7 +658,7 @@ fn catalogue_toe_in_at_extreme_separations_matches_the_f64_rig() {
 #[test]
 fn catalogue_remap_at_near_far_1e_minus_6_stays_within_half_a_pixel() {
     use stereolab::plan::{Output as Out, Plan, View};
-    use stereolab_core::effects::remap::{Precision, remap_coordinates};
+    use stereolab_core::{Precision, remap_coordinates};
     let (w, h) = (160u32, 120u32);
     let sets = vec!["camera.near=2e-5".to_string()];
     let mut scene =
@@ -746,12 +747,12 @@ fn catalogue_coordinates_far_from_the_origin_against_the_f64_reference() {
         let eye = c + DVec3::new(0.5, 0.8, 6.0);
         // A 34° vertical field of view: the model fills most of the image.
         let (x, y) = (0.15 * near * aspect, 0.15 * near);
-        let mvp = stereolab_core::math::frustum(-x, x, -y, y, near, far)
-            * stereolab_core::math::look_at(eye.as_vec3(), c.as_vec3(), Vec3::Y);
+        let mvp = stereolab_core::frustum(-x, x, -y, y, near, far)
+            * stereolab_core::look_at(eye.as_vec3(), c.as_vec3(), Vec3::Y);
         let (n, f, a) = (f64::from(near), f64::from(far), f64::from(aspect));
         let (x, y) = (0.15 * n * a, 0.15 * n);
-        let mvp64 = stereolab_core::reference::frustum(-x, x, -y, y, n, f)
-            * stereolab_core::reference::look_at(eye, c, DVec3::Y);
+        let mvp64 = stereolab_core::frustum_f64(-x, x, -y, y, n, f)
+            * stereolab_core::look_at_f64(eye, c, DVec3::Y);
         let m = against_reference_through(&positions, &triangles, (mvp, mvp64), (w, h));
         assert!(m.covered > 2000, "t = {t:e}: {m:?}");
         let share = m.total() as f64 / m.covered as f64;

@@ -8,8 +8,7 @@ use stereolab::info::describe;
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::{CameraMode, ImageShift};
+use stereolab_core::{CameraMode, Framebuffer, ImageShift};
 
 use crate::common::asset;
 

@@ -1,7 +1,6 @@
 //! Stereo layouts, the StereoGraphics guide's above-below format included.
 
-use stereolab_core::effects::layout;
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::{Framebuffer, above_below, above_below_squashed, interleave, side_by_side};
 
 const RED: [u8; 4] = [255, 0, 0, 255];
 const BLUE: [u8; 4] = [0, 0, 255, 255];
@@ -17,7 +16,7 @@ fn pair(w: u32, h: u32) -> (Framebuffer, Framebuffer) {
 #[test]
 fn guides_above_below_1024x768_with_blank_40_has_364_row_views() {
     let (l, r) = pair(1024, 768);
-    let img = layout::above_below_squashed(&l, &r, 40).unwrap();
+    let img = above_below_squashed(&l, &r, 40).unwrap();
     assert_eq!(img.dimensions(), (1024, 768));
     for (rows, color) in [(0..364, RED), (364..404, BLACK), (404..768, BLUE)] {
         for y in rows.clone() {
@@ -40,23 +39,23 @@ fn above_below_squash_averages_row_pairs() {
             };
         }
     }
-    let img = layout::above_below_squashed(&l, &r, 0).unwrap();
+    let img = above_below_squashed(&l, &r, 0).unwrap();
     assert_eq!(img.get_pixel(1, 1).0, [128, 128, 128, 255]);
 }
 
 #[test]
 fn side_by_side_interlaced_and_checkerboard_pick_the_right_eye() {
     let (l, r) = pair(6, 4);
-    let sbs = layout::side_by_side(&l, &r).unwrap();
+    let sbs = side_by_side(&l, &r).unwrap();
     assert_eq!((sbs.get_pixel(5, 0).0, sbs.get_pixel(6, 0).0), (RED, BLUE));
-    let ab = layout::above_below(&l, &r).unwrap();
+    let ab = above_below(&l, &r).unwrap();
     assert_eq!((ab.get_pixel(0, 3).0, ab.get_pixel(0, 4).0), (RED, BLUE));
-    let rows = layout::interleave(&l, &r, |_, y| y % 2 == 0).unwrap();
+    let rows = interleave(&l, &r, |_, y| y % 2 == 0).unwrap();
     assert_eq!(
         (rows.get_pixel(3, 0).0, rows.get_pixel(3, 1).0),
         (RED, BLUE)
     );
-    let checker = layout::interleave(&l, &r, |x, y| (x + y) % 2 == 0).unwrap();
+    let checker = interleave(&l, &r, |x, y| (x + y) % 2 == 0).unwrap();
     assert_eq!(
         (
             checker.get_pixel(0, 0).0,
@@ -72,11 +71,11 @@ fn layouts_refuse_mismatched_eyes_and_blank_intervals_without_rows() {
     let l = Framebuffer::new(4, 4, RED).unwrap();
     let r = Framebuffer::new(5, 4, BLUE).unwrap();
     assert!(
-        layout::side_by_side(&l, &r)
+        side_by_side(&l, &r)
             .unwrap_err()
             .to_string()
             .contains("4x4 vs 5x4")
     );
     let r = Framebuffer::new(4, 4, BLUE).unwrap();
-    assert!(layout::above_below_squashed(&l, &r, 3).is_err());
+    assert!(above_below_squashed(&l, &r, 3).is_err());
 }

@@ -13,7 +13,7 @@ use glam::{Vec3, Vec4};
 use stereolab::plan::{Plan, View};
 use stereolab::render::render;
 use stereolab::scene::{Mesh, Scene, load_obj};
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::Framebuffer;
 
 use crate::common::out_dir;
 

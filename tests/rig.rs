@@ -2,9 +2,8 @@
 
 use glam::{Vec3, Vec3Swizzles};
 use proptest::prelude::*;
-use stereolab_core::Error;
-use stereolab_core::math::{
-    Camera, CameraMode, Lighting, Separation, StereoRig, ZeroParallax, frustum, project_ndc,
+use stereolab_core::{
+    Camera, CameraMode, Error, Lighting, Separation, StereoRig, ZeroParallax, frustum, project_ndc,
 };
 
 fn guide_camera() -> Camera {

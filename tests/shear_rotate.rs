@@ -6,7 +6,7 @@ use stereolab::output::shear_rotate::shear_vs_rotate;
 use stereolab::plan::{Output, Plan, Shading, View};
 use stereolab::render::render;
 use stereolab::scene::Scene;
-use stereolab_core::math::{CameraMode, Viewer};
+use stereolab_core::{CameraMode, Viewer};
 
 use crate::common::asset;
 
@@ -105,7 +105,7 @@ fn viewer_at_the_left_eye_puts_the_left_eye_at_the_camera() {
         CameraMode::Parallel,
         CameraMode::ImageShift,
     ] {
-        let rig = stereolab_core::math::StereoRig { mode, ..s.rig };
+        let rig = stereolab_core::StereoRig { mode, ..s.rig };
         let e = rig
             .eyes_for_image(&s.camera, s.width, s.height)
             .expect("eyes");
@@ -121,7 +121,7 @@ fn viewer_at_the_left_eye_puts_the_left_eye_at_the_camera() {
             e[1].eye_world
         );
         // The midpoint viewer: the camera halfway between the eyes.
-        let mid = stereolab_core::math::StereoRig {
+        let mid = stereolab_core::StereoRig {
             viewer: Viewer::Midpoint,
             ..rig
         }
@@ -132,7 +132,7 @@ fn viewer_at_the_left_eye_puts_the_left_eye_at_the_camera() {
         assert!((mid[1].eye_world - mid[0].eye_world).length() - d < 1e-4);
     }
     // Toe-in: both eyes still aim at the fusion point on the centre line between them.
-    let toe = stereolab_core::math::StereoRig {
+    let toe = stereolab_core::StereoRig {
         mode: CameraMode::ToeIn,
         ..s.rig
     };

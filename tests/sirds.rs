@@ -8,13 +8,11 @@ use stereolab::plan::{Output, Pass, Plan, Shading, View};
 use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
-use stereolab_core::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
-use stereolab_core::effects::sirds::disparity::{
-    separation_eye_distance, separation_view_angle, tan_phi_eye_distance,
-};
-use stereolab_core::effects::sirds::per_pixel::{PerPixelOptions, RowLinker, per_pixel};
-use stereolab_core::effects::sirds::{
-    Algorithm, DepthMap, DisparityModel, Filter, Geometry, Pattern, PerVertexOptions, Start,
+use stereolab_core::{
+    DepthMap, DisparityModel, PerPixelOptions, PerVertexOptions, RowLinker, SirdsAlgorithm,
+    SirdsDecodeOptions, SirdsGeometry, SirdsPattern, SirdsRoundTrip, StripFilter, StripStart,
+    decode_sirds, per_pixel, separation_eye_distance, separation_view_angle, sirds_round_trip,
+    tan_phi_eye_distance,
 };
 
 use crate::common;
@@ -80,16 +78,16 @@ pub(crate) fn frame(s: &Scene) -> Frame {
 }
 
 /// Renders `s`'s SIRDS, decodes it, compares with the separation of the depth pass.
-fn encode_decode(s: &Scene) -> (RoundTrip, f64) {
+fn encode_decode(s: &Scene) -> (SirdsRoundTrip, f64) {
     let f = frame(s);
     let sirds = from_frame(&f, s).expect("sirds");
     let (depth, _) = scene_depth(&f, s).expect("depth");
     let d = sirds.disparity;
     let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
-    let opts = DecodeOptions::for_disparity(&d);
-    let decoded = decode(&sirds.pixels, sirds.width, sirds.height, &opts).expect("decodes");
+    let opts = SirdsDecodeOptions::for_disparity(&d);
+    let decoded = decode_sirds(&sirds.pixels, sirds.width, sirds.height, &opts).expect("decodes");
     (
-        round_trip(&decoded, &intended, &opts),
+        sirds_round_trip(&decoded, &intended, &opts),
         decoded.matched_share,
     )
 }
@@ -118,7 +116,7 @@ fn eq3_constant_eye_distance_matches_hand_computed_values() {
     // eq. 2: tan φ = 2 (z + f) / a = 2 · 24 / 2.5 = 19.2.
     assert!((tan_phi_eye_distance(12.0, 2.5, 12.0) - 19.2).abs() < 1e-5);
     // The scene defaults (TIW): background 12 in behind → 90 px, front 8 in → 72 px.
-    let px = Geometry::default().to_pixels().expect("valid");
+    let px = SirdsGeometry::default().to_pixels().expect("valid");
     assert!(
         (px.max_separation() - 90.0).abs() < 1e-3,
         "{}",
@@ -151,7 +149,7 @@ fn eq3_at_or_behind_the_eyes_is_an_error_not_an_infinity() {
 fn separation_divides_as_tiw_writes_it() {
     // TIW: separation(Z) = round((1 − μZ) E / (2 − μZ)), E = round(2.5 · 72) = 180, μ = 1/3.
     // A public Rust port multiplies by (2 − μZ) instead: 360 px at Z = 0, not 90.
-    let d = Geometry::default().to_pixels().expect("valid");
+    let d = SirdsGeometry::default().to_pixels().expect("valid");
     let (e, mu) = (180.0f32, 1.0f32 / 3.0);
     for i in 0..=100 {
         let z = i as f32 / 100.0;
@@ -165,10 +163,10 @@ fn separation_divides_as_tiw_writes_it() {
 
 #[test]
 fn both_models_agree_at_the_background_and_invert_exactly() {
-    let eq3 = Geometry::default().to_pixels().expect("valid");
-    let eq1 = Geometry {
+    let eq3 = SirdsGeometry::default().to_pixels().expect("valid");
+    let eq1 = SirdsGeometry {
         model: DisparityModel::ViewAngle,
-        ..Geometry::default()
+        ..SirdsGeometry::default()
     }
     .to_pixels()
     .expect("valid");
@@ -197,9 +195,9 @@ fn sphere_over_ramp(w: u32, h: u32) -> DepthMap {
 fn per_pixel_linked_pixels_have_equal_colors() {
     // 150 rows: three streamed chunks of rows (64, 64, 22), so rows out of order would show.
     let depth = sphere_over_ramp(300, 150);
-    let d = Geometry::default().to_pixels().expect("valid");
+    let d = SirdsGeometry::default().to_pixels().expect("valid");
     for hidden_surface in [false, true] {
-        let pattern = Pattern::Color { seed: 7 };
+        let pattern = SirdsPattern::Color { seed: 7 };
         let opts = PerPixelOptions {
             hidden_surface,
             oversample: 1,
@@ -229,15 +227,15 @@ fn per_vertex_nearest_copies_are_exact() {
     let s = sphere();
     let f = frame(&s);
     let (_, range) = scene_depth(&f, &s).expect("depth");
-    let d = Geometry::default().to_pixels().expect("valid");
+    let d = SirdsGeometry::default().to_pixels().expect("valid");
     let g = StripGeometry::new(&s, &f.views.center, &range, &d, false);
-    for start in [Start::Left, Start::Center] {
+    for start in [StripStart::Left, StripStart::Center] {
         let opts = PerVertexOptions {
             start,
-            filter: Filter::Nearest,
+            filter: StripFilter::Nearest,
             iterations: None,
         };
-        let pattern = Pattern::Gray { seed: 3 };
+        let pattern = SirdsPattern::Gray { seed: 3 };
         let r = per_vertex(&g, s.width, s.height, &d, &pattern, &opts, true).expect("sirds");
         let links = r.links.expect("recorded");
         let w = s.width as usize;
@@ -277,10 +275,10 @@ fn decode_round_trip_every_algorithm_and_option() {
         ("sphere", sphere(), SPHERE_WITHIN_ONE),
     ] {
         let mut variants: Vec<(String, Scene)> = Vec::new();
-        for start in [Start::Left, Start::Center] {
-            for filter in [Filter::Nearest, Filter::Bilinear] {
+        for start in [StripStart::Left, StripStart::Center] {
+            for filter in [StripFilter::Nearest, StripFilter::Bilinear] {
                 let mut s = base.clone();
-                s.sirds.algorithm = Algorithm::PerVertex;
+                s.sirds.algorithm = SirdsAlgorithm::PerVertex;
                 s.sirds.per_vertex = PerVertexOptions {
                     start,
                     filter,
@@ -291,14 +289,14 @@ fn decode_round_trip_every_algorithm_and_option() {
         }
         for (hidden_surface, oversample) in [(false, 1), (true, 1), (true, 4)] {
             let mut s = base.clone();
-            s.sirds.algorithm = Algorithm::PerPixel;
+            s.sirds.algorithm = SirdsAlgorithm::PerPixel;
             s.sirds.per_pixel = PerPixelOptions {
                 hidden_surface,
                 oversample,
             };
             variants.push((format!("per-pixel hsr={hidden_surface} x{oversample}"), s));
         }
-        for algorithm in [Algorithm::PerVertex, Algorithm::PerPixel] {
+        for algorithm in [SirdsAlgorithm::PerVertex, SirdsAlgorithm::PerPixel] {
             let mut s = base.clone();
             s.sirds.algorithm = algorithm;
             s.sirds.geometry.model = DisparityModel::ViewAngle;
@@ -354,11 +352,11 @@ fn center_start_stays_sharper_than_left_start() {
     let text = format!("outputs = [\"sirds\"]\n{}{RAMP}", camera(960, 96));
     let mut s =
         Scene::from_toml(&text, Path::new("wide.toml"), Path::new("."), &[]).expect("scene");
-    s.sirds.per_vertex.filter = Filter::Bilinear;
+    s.sirds.per_vertex.filter = StripFilter::Bilinear;
     let w = s.width as usize;
     let f = frame(&s);
     let mut contrasts = Vec::new();
-    for start in [Start::Left, Start::Center] {
+    for start in [StripStart::Left, StripStart::Center] {
         s.sirds.per_vertex.start = start;
         let sirds = from_frame(&f, &s).expect("sirds");
         let bins: Vec<f64> = (0..6)
@@ -390,16 +388,16 @@ fn center_start_stays_sharper_than_left_start() {
 
 #[test]
 fn decoder_tells_sirds_from_noise() {
-    let d = Geometry::default().to_pixels().expect("valid");
-    let opts = DecodeOptions::for_disparity(&d);
+    let d = SirdsGeometry::default().to_pixels().expect("valid");
+    let opts = SirdsDecodeOptions::for_disparity(&d);
     let (w, h) = (320, 64);
     for noise in [
-        Pattern::BlackWhite { seed: 11 },
-        Pattern::Gray { seed: 12 },
-        Pattern::Color { seed: 13 },
+        SirdsPattern::BlackWhite { seed: 11 },
+        SirdsPattern::Gray { seed: 12 },
+        SirdsPattern::Color { seed: 13 },
     ] {
         let pixels = noise.fill(w, h);
-        let decoded = decode(&pixels, w, h, &opts).expect("decodes");
+        let decoded = decode_sirds(&pixels, w, h, &opts).expect("decodes");
         assert!(
             !decoded.is_autostereogram() && decoded.matched_share < 0.05,
             "noise {noise:?} matched {:.2}%",
@@ -412,7 +410,7 @@ fn decoder_tells_sirds_from_noise() {
             &PerPixelOptions::default(),
         )
         .expect("sirds");
-        let decoded = decode(&sirds, w, h, &opts).expect("decodes");
+        let decoded = decode_sirds(&sirds, w, h, &opts).expect("decodes");
         assert!(
             decoded.is_autostereogram(),
             "SIRDS on {noise:?} matched only {:.1}%",
@@ -423,7 +421,7 @@ fn decoder_tells_sirds_from_noise() {
 
 #[test]
 fn bad_inputs_get_clear_errors() {
-    let d = Geometry::default().to_pixels().expect("valid");
+    let d = SirdsGeometry::default().to_pixels().expect("valid");
     let msg = |r: Result<DepthMap, stereolab_core::Error>| r.expect_err("must fail").to_string();
     assert!(msg(DepthMap::new(0, 10, vec![])).contains("at least 1"));
     let mut z = vec![0.5; 12];
@@ -435,13 +433,13 @@ fn bad_inputs_get_clear_errors() {
     let r = per_pixel(
         &small,
         &d,
-        &Pattern::BlackWhite { seed: 1 },
+        &SirdsPattern::BlackWhite { seed: 1 },
         &Default::default(),
     );
     let m = r.expect_err("too narrow").to_string();
     assert!(m.contains("narrower than the image"), "{m}");
     // A pattern image narrower than the largest separation.
-    let narrow = Pattern::Image(std::sync::Arc::new(image::RgbaImage::new(40, 40)));
+    let narrow = SirdsPattern::Image(std::sync::Arc::new(image::RgbaImage::new(40, 40)));
     let depth = sphere_over_ramp(200, 8);
     let m = per_pixel(&depth, &d, &narrow, &Default::default())
         .expect_err("pattern too narrow")
@@ -454,9 +452,9 @@ fn bad_inputs_get_clear_errors() {
         .expect_err("k too small")
         .to_string();
     assert!(m.contains("sirds.iterations"), "{m}");
-    let bad = Geometry {
+    let bad = SirdsGeometry {
         depth_near_in: 13.0,
-        ..Geometry::default()
+        ..SirdsGeometry::default()
     };
     assert!(
         bad.to_pixels()

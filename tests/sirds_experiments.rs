@@ -5,8 +5,9 @@ use stereolab::output::sirds::{FIG5_BANDS, fig5_bands, from_frame, scene_depth};
 use stereolab::plan::Plan;
 use stereolab::render::render;
 use stereolab::scene::Scene;
-use stereolab_core::effects::sirds::decode::{DecodeOptions, decode, round_trip};
-use stereolab_core::effects::sirds::{DisparityModel, Filter};
+use stereolab_core::{
+    DisparityModel, SirdsDecodeOptions, StripFilter, decode_sirds, sirds_round_trip,
+};
 
 use crate::common::asset;
 
@@ -31,13 +32,13 @@ fn fig5_bands_follow_their_model_and_filter() {
         let mut g = s.sirds.geometry;
         g.model = model;
         let d = g.to_pixels().unwrap();
-        let opts = DecodeOptions::for_disparity(&d);
-        let decoded = decode(band, w as u32, rows.len() as u32, &opts).unwrap();
+        let opts = SirdsDecodeOptions::for_disparity(&d);
+        let decoded = decode_sirds(band, w as u32, rows.len() as u32, &opts).unwrap();
         let intended: Vec<f32> = depth.z[rows.start * w..rows.end * w]
             .iter()
             .map(|&z| d.separation(z))
             .collect();
-        let rt = round_trip(&decoded, &intended, &opts);
+        let rt = sirds_round_trip(&decoded, &intended, &opts);
         assert!(rt.within_one > 0.8, "band {k} {model:?} {filter:?}: {rt:?}");
         // The other model's separations fit worse: the bands really differ.
         let mut other = s.sirds.geometry;
@@ -50,7 +51,7 @@ fn fig5_bands_follow_their_model_and_filter() {
             .iter()
             .map(|&z| od.separation(z))
             .collect();
-        let rt_other = round_trip(&decoded, &wrong, &opts);
+        let rt_other = sirds_round_trip(&decoded, &wrong, &opts);
         assert!(
             rt_other.rms > rt.rms + 1.0,
             "band {k}: {rt:?} vs other model {rt_other:?}"
@@ -115,9 +116,9 @@ fn fig6_starts_in_the_centre_from_the_initialization_texture() {
     let (depth, _) = scene_depth(&f, &s).unwrap();
     let d = sirds.disparity;
     let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
-    let opts = DecodeOptions::for_disparity(&d);
-    let decoded = decode(&sirds.pixels, 512, 256, &opts).unwrap();
-    let rt = round_trip(&decoded, &intended, &opts);
+    let opts = SirdsDecodeOptions::for_disparity(&d);
+    let decoded = decode_sirds(&sirds.pixels, 512, 256, &opts).unwrap();
+    let rt = sirds_round_trip(&decoded, &intended, &opts);
     assert!(rt.within_one > 0.75, "{rt:?}");
 }
 
@@ -135,15 +136,15 @@ fn large_triangles_carry_the_piecewise_linear_error_small_ones_do_not() {
             "sirds_large_triangles",
             &[format!("mesh.0.detail={detail}")],
         );
-        assert_eq!(s.sirds.per_vertex.filter, Filter::Bilinear);
+        assert_eq!(s.sirds.per_vertex.filter, StripFilter::Bilinear);
         let f = render(&s, &Plan::new(&s.outputs)).unwrap();
         let sirds = from_frame(&f, &s).unwrap();
         let (depth, _) = scene_depth(&f, &s).unwrap();
         let d = sirds.disparity;
         let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
-        let opts = DecodeOptions::for_disparity(&d);
-        let decoded = decode(&sirds.pixels, s.width, s.height, &opts).unwrap();
-        let rt = round_trip(&decoded, &intended, &opts);
+        let opts = SirdsDecodeOptions::for_disparity(&d);
+        let decoded = decode_sirds(&sirds.pixels, s.width, s.height, &opts).unwrap();
+        let rt = sirds_round_trip(&decoded, &intended, &opts);
         table += &format!(
             "{detail:>6}  {:>9}  {:>12.3}  {:>12.3}\n",
             2 * detail * detail,

@@ -6,11 +6,10 @@ use std::path::Path;
 use std::process::Command;
 
 use stereolab::output::sirds::{from_frame, scene_depth};
-use stereolab_core::effects::sirds::decode::{AutoDecoded, decode_auto, round_trip};
-use stereolab_core::effects::sirds::pair::views;
-use stereolab_core::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
-use stereolab_core::effects::sirds::search::SearchOptions;
-use stereolab_core::effects::sirds::{Algorithm, DisparityModel, Geometry, Pattern};
+use stereolab_core::{
+    AutoDecodedSirds, DisparityModel, PerPixelOptions, SeparationSearchOptions, SirdsAlgorithm,
+    SirdsGeometry, SirdsPattern, decode_sirds_auto, per_pixel, sirds_round_trip, sirds_views,
+};
 
 use crate::common;
 use crate::sirds::{SPHERE, frame, sized_scene};
@@ -95,7 +94,8 @@ fn pamstereogram_outputs_decode_with_the_sphere_visible() {
         pamstereogram(&map, args, &path);
         let (pixels, iw, ih) = rgba(image::open(&path).expect("the image crate reads PAM"));
         assert_eq!((iw, ih), (w as u32, h as u32));
-        let auto = decode_auto(&pixels, iw, ih, &SearchOptions::default()).expect("decodes");
+        let auto = decode_sirds_auto(&pixels, iw, ih, &SeparationSearchOptions::default())
+            .expect("decodes");
         let (lo, hi) = auto.search.found.expect("a range found");
         let decoded = auto.decoded.as_ref().expect("decoded");
         let (r, n) = correlation(&decoded.separation, &depth);
@@ -134,9 +134,10 @@ fn check_own(
     intended: &[f32],
     floor: f64,
 ) -> String {
-    let auto: AutoDecoded = decode_auto(pixels, w, h, &SearchOptions::default()).expect("decodes");
+    let auto: AutoDecodedSirds =
+        decode_sirds_auto(pixels, w, h, &SeparationSearchOptions::default()).expect("decodes");
     let (lo, hi) = auto.search.found.expect("a range found");
-    let rt = round_trip(
+    let rt = sirds_round_trip(
         auto.decoded.as_ref().expect("decoded"),
         intended,
         &auto.options.expect("options"),
@@ -174,7 +175,7 @@ fn own_sirds_decode_without_being_told_the_setup() {
     let mut report = String::new();
     for model in [DisparityModel::EyeDistance, DisparityModel::ViewAngle] {
         for cross_eyed in [false, true] {
-            for algorithm in [Algorithm::PerVertex, Algorithm::PerPixel] {
+            for algorithm in [SirdsAlgorithm::PerVertex, SirdsAlgorithm::PerPixel] {
                 let mut s = sized_scene(SPHERE, 320, 96);
                 s.sirds.geometry.model = model;
                 s.sirds.cross_eyed = cross_eyed;
@@ -202,16 +203,16 @@ fn own_sirds_decode_without_being_told_the_setup() {
     }
     // A wide image: searched in 13 of its 17 strips of 7 rows (the work budget).
     let map = stereolab::fixtures::sphere_over_ramp(2100, 120);
-    let d = Geometry {
+    let d = SirdsGeometry {
         dpi: 144.0,
-        ..Geometry::default()
+        ..SirdsGeometry::default()
     }
     .to_pixels()
     .expect("valid");
     let pixels = per_pixel(
         &map,
         &d,
-        &Pattern::Color { seed: 5 },
+        &SirdsPattern::Color { seed: 5 },
         &PerPixelOptions::default(),
     )
     .expect("sirds");
@@ -233,12 +234,13 @@ fn own_sirds_decode_without_being_told_the_setup() {
 fn noise_over_the_full_range_is_still_noise() {
     for (w, h) in [(320, 64), (2100, 96)] {
         for noise in [
-            Pattern::BlackWhite { seed: 21 },
-            Pattern::Gray { seed: 22 },
-            Pattern::Color { seed: 23 },
+            SirdsPattern::BlackWhite { seed: 21 },
+            SirdsPattern::Gray { seed: 22 },
+            SirdsPattern::Color { seed: 23 },
         ] {
             let pixels = noise.fill(w, h);
-            let auto = decode_auto(&pixels, w, h, &SearchOptions::default()).expect("runs");
+            let auto = decode_sirds_auto(&pixels, w, h, &SeparationSearchOptions::default())
+                .expect("runs");
             assert!(
                 !auto.is_autostereogram() && auto.search.matched_share < 0.05,
                 "{w}x{h} {noise:?}: matched {:.2}% of cells, {} regions, found {:?}",
@@ -258,18 +260,19 @@ fn autostereogram_to_stereo_pair_puts_the_sphere_in_front() {
     for cross_eyed in [false, true] {
         let mut s = sized_scene(SPHERE, 320, 96);
         s.sirds.cross_eyed = cross_eyed;
-        s.sirds.algorithm = Algorithm::PerPixel;
+        s.sirds.algorithm = SirdsAlgorithm::PerPixel;
         let f = frame(&s);
         let sirds = from_frame(&f, &s).expect("sirds");
         let (depth, _) = scene_depth(&f, &s).expect("depth");
-        let auto = decode_auto(
+        let auto = decode_sirds_auto(
             &sirds.pixels,
             sirds.width,
             sirds.height,
-            &SearchOptions::default(),
+            &SeparationSearchOptions::default(),
         )
         .expect("decodes");
-        let v = views(&sirds.pixels, auto.decoded.as_ref().unwrap(), cross_eyed).expect("views");
+        let v =
+            sirds_views(&sirds.pixels, auto.decoded.as_ref().unwrap(), cross_eyed).expect("views");
         let w = sirds.width as usize;
         // Horizontal shift of right against left that matches best at (x, y): a 9×9 SAD.
         let parallax = |x: usize, y: usize| -> i32 {
@@ -322,7 +325,7 @@ fn pfm(channels: usize, w: usize, rows_top_first: &[Vec<f32>], little: bool) -> 
 /// Every format maps as docs/interop.md says, both ways round.
 #[test]
 fn depth_maps_from_any_format_map_as_documented() {
-    use stereolab_core::effects::sirds::depthfile::{DepthSamples, Near};
+    use stereolab_core::{DepthSamples, Near};
     let dir = common::out_dir("sirds_interop_depth");
     let z =
         |d: &DepthSamples| -> Vec<f32> { d.samples.iter().map(|&v| v as f32 / 65535.0).collect() };
@@ -480,7 +483,7 @@ fn cli_decodes_a_foreign_stereogram_into_a_pair() {
     }
     // Noise is refused with a clear word, and nothing is written.
     let noise = dir.join("noise.png");
-    let pixels = Pattern::BlackWhite { seed: 3 }.fill(400, 160);
+    let pixels = SirdsPattern::BlackWhite { seed: 3 }.fill(400, 160);
     image::RgbaImage::from_raw(400, 160, pixels.into_iter().flatten().collect())
         .unwrap()
         .save(&noise)

@@ -10,8 +10,7 @@ use stereolab::output::{Image, produce};
 use stereolab::plan::{Output, Plan};
 use stereolab::render::render;
 use stereolab::scene::Scene;
-use stereolab_core::effects::sirds::Pattern;
-use stereolab_core::effects::sirds::decode::{DecodeOptions, decode, round_trip};
+use stereolab_core::{SirdsDecodeOptions, SirdsPattern, decode_sirds, sirds_round_trip};
 
 use crate::common::{asset, out_dir};
 use crate::sirds::{SPHERE, frame, sized_scene};
@@ -203,8 +202,8 @@ fn a_cross_eyed_sirds_repeats_near_points_later() {
         let sirds = from_frame(&f, &s).expect("sirds");
         let (depth, _) = scene_depth(&f, &s).expect("depth");
         let d = sirds.disparity;
-        let opts = DecodeOptions::for_disparity(&d);
-        let decoded = decode(&sirds.pixels, 320, 96, &opts).expect("decodes");
+        let opts = SirdsDecodeOptions::for_disparity(&d);
+        let decoded = decode_sirds(&sirds.pixels, 320, 96, &opts).expect("decodes");
         let at = |x: usize, y: usize| decoded.separation[y * 320 + x];
         let (sphere, background) = (at(160, 48), at(160, 8));
         if cross_eyed {
@@ -244,7 +243,7 @@ fn a_pattern_image_fills_the_sirds_and_it_decodes() {
             320,
             96,
         );
-        s.sirds.pattern = Pattern::Image(Arc::new(pattern.clone()));
+        s.sirds.pattern = SirdsPattern::Image(Arc::new(pattern.clone()));
         let f = frame(&s);
         let sirds = from_frame(&f, &s).expect("sirds");
         let foreign = sirds
@@ -265,9 +264,9 @@ fn a_pattern_image_fills_the_sirds_and_it_decodes() {
         let (depth, _) = scene_depth(&f, &s).expect("depth");
         let d = sirds.disparity;
         let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
-        let opts = DecodeOptions::for_disparity(&d);
-        let decoded = decode(&sirds.pixels, 320, 96, &opts).expect("decodes");
-        let rt = round_trip(&decoded, &intended, &opts);
+        let opts = SirdsDecodeOptions::for_disparity(&d);
+        let decoded = decode_sirds(&sirds.pixels, 320, 96, &opts).expect("decodes");
+        let rt = sirds_round_trip(&decoded, &intended, &opts);
         assert!(rt.within_one > 0.7, "{algorithm}: {rt:?}");
     }
 }

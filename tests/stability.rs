@@ -5,9 +5,7 @@ use proptest::prelude::*;
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::render;
 use stereolab::scene::Scene;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::raster::{RasterOptions, rasterize};
-use stereolab_core::shade::{Fragment, Shader, Varyings};
+use stereolab_core::{Fragment, Framebuffer, RasterOptions, Shader, Varyings, rasterize};
 
 struct Clip(Vec<Vec4>);
 

@@ -4,8 +4,7 @@
 use glam::Vec3;
 use stereolab::info::{describe, horizontal_fov_degrees, scene_budget};
 use stereolab::scene::Scene;
-use stereolab_core::effects::parallax::PARALLAX_BUDGET_PERCENT;
-use stereolab_core::math::ZeroParallax;
+use stereolab_core::{PARALLAX_BUDGET_PERCENT, ZeroParallax};
 
 use crate::common::asset;
 

@@ -1,12 +1,10 @@
 //! Bad input to every finalize mode is a clear error, never a panic.
 
 use glam::Mat4;
-use stereolab_core::Framebuffer;
-use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
-use stereolab_core::effects::occlusion::occlusion_image;
-use stereolab_core::effects::parallax::{ParallaxRig, parallax_image};
-use stereolab_core::effects::remap::{Precision, remap_color, visibility_map};
-use stereolab_core::math::{Camera, StereoRig};
+use stereolab_core::{
+    AnaglyphKind, AnaglyphOptions, Camera, Framebuffer, ParallaxRig, Precision, StereoRig,
+    anaglyph, occlusion_image, parallax_image, remap_color, visibility_map,
+};
 
 fn fb(w: u32, h: u32) -> Framebuffer {
     Framebuffer::new(w, h, [90, 90, 90, 255]).expect("framebuffer")

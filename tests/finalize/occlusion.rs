@@ -2,13 +2,11 @@
 //! the strips the rig predicts; flat planes are never flagged; near/far ratios 10 to 1e5.
 
 use stereolab::plan::Output;
-use stereolab_core::Framebuffer;
-use stereolab_core::effects::occlusion::{OCCLUDED_COLOR, OUT_OF_VIEW_COLOR, occlusion_image};
-use stereolab_core::effects::remap::{
-    DEPTH_PRECISION, Precision, Remapper, Visibility, classify, depth_slope, tolerance,
-    visibility_map,
+use stereolab_core::{
+    DEPTH_PRECISION, EyeMatrices, Framebuffer, OCCLUSION_OCCLUDED_COLOR,
+    OCCLUSION_OUT_OF_VIEW_COLOR, Precision, Remapper, Visibility, classify_visibility, depth_slope,
+    occlusion_image, remap_tolerance, visibility_map,
 };
-use stereolab_core::math::EyeMatrices;
 
 use super::{Rig, eyes, plane, render_outputs, scene};
 
@@ -287,11 +285,11 @@ fn occlusion_image_shows_both_eyes_maps_side_by_side() {
         .expect("visibility");
         let red = (0..rig.height)
             .flat_map(|y| (0..rig.width).map(move |x| (x, y)))
-            .filter(|&(x, y)| img.get_pixel(k * rig.width + x, y).0 == OCCLUDED_COLOR)
+            .filter(|&(x, y)| img.get_pixel(k * rig.width + x, y).0 == OCCLUSION_OCCLUDED_COLOR)
             .count();
         let blue = (0..rig.height)
             .flat_map(|y| (0..rig.width).map(move |x| (x, y)))
-            .filter(|&(x, y)| img.get_pixel(k * rig.width + x, y).0 == OUT_OF_VIEW_COLOR)
+            .filter(|&(x, y)| img.get_pixel(k * rig.width + x, y).0 == OCCLUSION_OUT_OF_VIEW_COLOR)
             .count();
         assert_eq!(red, count(&map, Visibility::Occluded));
         assert_eq!(blue, count(&map, Visibility::OutOfView));
@@ -322,7 +320,7 @@ fn map_with_tolerance(
                 m.texel(w, h)
                     .map(|(tx, ty)| (m, other.depth()[other.index(tx, ty)]))
             });
-            classify(d, target, tol(this, x, y))
+            classify_visibility(d, target, tol(this, x, y))
         })
         .collect()
 }
@@ -342,7 +340,7 @@ fn tolerance_is_neither_too_tight_nor_too_loose() {
     let mvp = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     let tight = map_with_tolerance(left, right, mvp, &|_, _, _| DEPTH_PRECISION);
     let ours = map_with_tolerance(left, right, mvp, &|fb, x, y| {
-        tolerance(depth_slope(fb, x, y))
+        remap_tolerance(depth_slope(fb, x, y))
     });
     let flagged = |m: &[Visibility]| count(m, Visibility::Occluded) + count(m, Visibility::Farther);
     println!(
@@ -364,7 +362,7 @@ fn tolerance_is_neither_too_tight_nor_too_loose() {
     let mvp = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     let loose = map_with_tolerance(left, right, mvp, &|_, _, _| 1e-5);
     let ours = map_with_tolerance(left, right, mvp, &|fb, x, y| {
-        tolerance(depth_slope(fb, x, y))
+        remap_tolerance(depth_slope(fb, x, y))
     });
     println!(
         "occluder 0.5 in front of the wall, near/far 1/1e5: {} occluded px with tolerance 1e-5, {} with ours",

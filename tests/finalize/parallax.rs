@@ -4,9 +4,9 @@
 use stereolab::plan::{Output, Pass, Plan, Shading, View};
 use stereolab::scene::Scene;
 use stereolab::{info, output};
-use stereolab_core::effects::legend::LEGEND_HEIGHT;
-use stereolab_core::effects::parallax::{budget_of, parallax_color, parallax_image, parallax_map};
-use stereolab_core::math::project_ndc;
+use stereolab_core::{
+    LEGEND_HEIGHT, parallax_budget_of, parallax_color, parallax_image, parallax_map, project_ndc,
+};
 
 use super::{Rig, drawn_centroid, eyes, plane, render_outputs, scene};
 
@@ -145,7 +145,7 @@ fn budget_reports_share_beyond_three_percent_and_window_violations() {
     let s = scene(&rig, &meshes, &["parallax"]);
     let frame = render_outputs(&s, &[Output::Parallax]);
     let left = frame.view(View::Left).expect("left");
-    let b = budget_of(left, &s.parallax_rig().expect("rig")).expect("budget");
+    let b = parallax_budget_of(left, &s.parallax_rig().expect("rig")).expect("budget");
     print!("{}", b.report());
     let (wall, near) = (rig.parallax_px(30.0), rig.parallax_px(3.0));
     assert!(
@@ -236,7 +236,7 @@ fn finalize_outputs_run_only_the_passes_they_need() {
         ),
         (
             &[Output::Anaglyph(
-                stereolab_core::effects::anaglyph::AnaglyphKind::DuboisRedCyan,
+                stereolab_core::AnaglyphKind::DuboisRedCyan,
             )],
             vec![color(View::Left), color(View::Right)],
         ),

@@ -1,7 +1,7 @@
 //! Remapping (the exercise slides): identity at the zero-parallax plane, a shift of exactly p(z) behind it.
 
 use stereolab::plan::Output;
-use stereolab_core::effects::remap::{Precision, remap_color, remap_coordinates};
+use stereolab_core::{Precision, remap_color, remap_coordinates};
 
 use super::{Rig, eyes, plane, render_outputs, scene};
 

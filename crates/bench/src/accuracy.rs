@@ -15,14 +15,11 @@ use super::{Row, median_ms};
 use stereolab::plan::{Output, Plan, Shading, View};
 use stereolab::render::{render, render_view};
 use stereolab::scene::{Mesh, Scene};
-use stereolab_core::Eye;
-use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
-use stereolab_core::effects::sirds::decode::{DecodeOptions, decode, round_trip};
-use stereolab_core::effects::sirds::{
-    Algorithm, DisparityModel, Filter, PerVertexOptions, Start, per_pixel::PerPixelOptions,
+use stereolab_core::{
+    AnaglyphKind, AnaglyphOptions, CameraMode, DisparityModel, Error, Eye, PerPixelOptions,
+    PerVertexOptions, Result, Separation, SirdsAlgorithm, SirdsDecodeOptions, StripFilter,
+    StripStart, anaglyph, decode_sirds, sirds_round_trip,
 };
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::{CameraMode, Separation};
 use stereolab_figures::plot::{Knob, Point};
 use stereolab_figures::vertical_parallax_grid;
 
@@ -276,13 +273,13 @@ pub fn off_axis_mvp_f64(scene: &Scene, eye: Eye) -> Result<DMat4> {
     let c = &scene.camera;
     let aspect = f64::from(scene.width) / f64::from(scene.height);
     let tan = (f64::from(c.fov_y).to_radians() * 0.5).tan();
-    let z0 = stereolab_core::reference::zero_parallax(&scene.rig, c);
+    let z0 = stereolab_core::zero_parallax_f64(&scene.rig, c);
     let base = match scene.rig.separation {
         Separation::Absolute(d) => f64::from(d),
         Separation::Auto => 2.0 * (2.0 * z0 * tan * aspect) * 0.035,
     };
-    // The rig in f64 (`stereolab_core::reference::eye`), with the separation resolved in f64 as above.
-    Ok(stereolab_core::reference::eye(
+    // The rig in f64 (`stereolab_core::eye_matrices_f64`), with the separation resolved in f64 as above.
+    Ok(stereolab_core::eye_matrices_f64(
         &scene.rig,
         c,
         aspect,
@@ -388,7 +385,7 @@ fn rig_precision(scene: &Scene, offset: f32, iters: usize) -> Result<Knob> {
 /// from where the off-axis rig (the source documents' correct one) puts it, and the stereo
 /// pair's time.
 fn rig_mode(scene: &Scene, iters: usize) -> Result<Knob> {
-    use stereolab_core::math::{StereoRig, project_ndc};
+    use stereolab_core::{StereoRig, project_ndc};
     let plan = Plan::new(&[Output::Left, Output::Right]);
     let rig_of = |mode| StereoRig { mode, ..scene.rig };
     let reference = rig_of(CameraMode::OffAxis).eyes(&scene.camera, scene.aspect())?;
@@ -510,14 +507,14 @@ fn sirds_point(s: &Scene, intended_from: Option<&Scene>, iters: usize) -> Result
     let (depth, _) = scene_depth(&frame, s)?;
     let sirds = from_frame(&frame, s)?;
     let d = sirds.disparity;
-    let opts = DecodeOptions::for_disparity(&d);
-    let decoded = decode(&sirds.pixels, sirds.width, sirds.height, &opts)?;
+    let opts = SirdsDecodeOptions::for_disparity(&d);
+    let decoded = decode_sirds(&sirds.pixels, sirds.width, sirds.height, &opts)?;
     let want = match intended_from {
         Some(r) => r.sirds.geometry.to_pixels()?,
         None => d,
     };
     let intended: Vec<f32> = depth.z.iter().map(|&z| want.separation(z)).collect();
-    let rt = round_trip(&decoded, &intended, &opts);
+    let rt = sirds_round_trip(&decoded, &intended, &opts);
     let ms = median_ms(iters, || from_frame(&frame, s).is_ok());
     Ok((rt.rms, ms))
 }
@@ -541,13 +538,13 @@ fn sirds_knobs(scale: Scale) -> Result<Vec<Knob>> {
         negligible,
     };
     let mut out = Vec::new();
-    // Start strip and filter.
+    // StripStart strip and filter.
     let mut pts = Vec::new();
     for (start, filter) in [
-        (Start::Left, Filter::Nearest),
-        (Start::Left, Filter::Bilinear),
-        (Start::Center, Filter::Nearest),
-        (Start::Center, Filter::Bilinear),
+        (StripStart::Left, StripFilter::Nearest),
+        (StripStart::Left, StripFilter::Bilinear),
+        (StripStart::Center, StripFilter::Nearest),
+        (StripStart::Center, StripFilter::Bilinear),
     ] {
         let mut s = base.clone();
         s.sirds.per_vertex = PerVertexOptions {
@@ -656,7 +653,7 @@ fn sirds_knobs(scale: Scale) -> Result<Vec<Knob>> {
     // TIW: hidden-surface removal, and oversampling.
     let tiw = |hidden_surface, oversample| -> Result<(f64, f64)> {
         let mut s = base.clone();
-        s.sirds.algorithm = Algorithm::PerPixel;
+        s.sirds.algorithm = SirdsAlgorithm::PerPixel;
         s.sirds.per_pixel = PerPixelOptions {
             hidden_surface,
             oversample,

@@ -10,11 +10,10 @@ use stereolab::plan::Shading;
 use stereolab::render::chromadepth::{render_center_with, resolve_texgen, texgen_map};
 use stereolab::render::render_view;
 use stereolab::scene::{Scene, terrain};
-use stereolab_core::effects::chromadepth::glasses::glasses_pair;
-use stereolab_core::effects::chromadepth::ramp::{self, FAR_HUE_DEGREES, Ramp, RampKind, Sampling};
-use stereolab_core::effects::chromadepth::{ChromaDepthSettings, TexgenMode};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::StereoRig;
+use stereolab_core::{
+    ChromaDepthSettings, Error, FAR_HUE_DEGREES, Ramp, RampKind, RampSampling, Result, StereoRig,
+    TexgenMode, glasses_pair, hue_degrees, ramp_exact,
+};
 
 /// A 4×4 plane slanted 70° away from a camera at the origin looking down −Z, two triangles:
 /// the case where interpolation matters most.
@@ -145,14 +144,17 @@ pub(super) fn ramp_sampling(iters: usize, texel_counts: &[usize]) -> Vec<Row> {
         let Ok(r) = Ramp::new(RampKind::Hsv, texels) else {
             continue;
         };
-        for (name, sampling) in [("nearest", Sampling::Nearest), ("linear", Sampling::Linear)] {
+        for (name, sampling) in [
+            ("nearest", RampSampling::Nearest),
+            ("linear", RampSampling::Linear),
+        ] {
             let (mut hue_err, mut rgb_err) = (0.0f64, 0.0f32);
             for k in 0..=SAMPLES {
                 let s = k as f32 / SAMPLES as f32;
                 let got = r.sample(s, sampling);
-                let want = ramp::exact(RampKind::Hsv, s);
+                let want = ramp_exact(RampKind::Hsv, s);
                 rgb_err = rgb_err.max((got - want).abs().max_element());
-                if let Some(h) = ramp::hue_degrees(got) {
+                if let Some(h) = hue_degrees(got) {
                     hue_err = hue_err.max((h as f64 - (FAR_HUE_DEGREES * s) as f64).abs());
                 }
             }

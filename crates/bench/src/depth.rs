@@ -1,6 +1,6 @@
 //! `bench --only depth`: the `[raster] depth` knob (standard, reversed-Z with a finite or an
 //! infinite far plane, f64) across near/far ratios from 10 to 1e12, measured for z-fighting and
-//! lost fragments against the f64 reference (`stereolab_core::reference`), with its cost in time.
+//! lost fragments against the f64 reference (`stereolab_core::visible_f64`), with its cost in time.
 //!
 //! The scene: six pairs of fronto-parallel squares at eye depths 2 to 90 (far plane 100), the
 //! front square of each pair 1/10 000 of its depth in front of the back one (a decal, a
@@ -11,11 +11,10 @@
 use glam::{DVec3, Mat4, Vec3};
 
 use super::{Row, median_ms, row};
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::frustum;
-use stereolab_core::raster::{DepthMode, RasterOptions, rasterize};
-use stereolab_core::reference::{IdShader, compare, soup, visible};
+use stereolab_core::{
+    DepthMode, Framebuffer, IdShader, RasterOptions, Result, compare_with_reference, frustum,
+    rasterize, triangle_soup, visible_f64,
+};
 
 /// One measurement of the depth knob.
 #[derive(Clone, Debug, PartialEq)]
@@ -88,7 +87,7 @@ pub fn modes(near: f32) -> [DepthMode; 4] {
 /// A framebuffer of that size cannot be made.
 pub fn measure(width: u32, height: u32, iters: usize) -> Result<Vec<DepthRow>> {
     let (positions, triangles) = scene();
-    let soup_positions = soup(&positions, &triangles);
+    let soup_positions = triangle_soup(&positions, &triangles);
     let soup_triangles: Vec<[u32; 3]> = (0..triangles.len() as u32)
         .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
         .collect();
@@ -98,8 +97,8 @@ pub fn measure(width: u32, height: u32, iters: usize) -> Result<Vec<DepthRow>> {
     for ratio in RATIOS {
         let near = (f64::from(FAR) / ratio) as f32;
         let (n, f) = (f64::from(near), f64::from(FAR));
-        let mvp64 = stereolab_core::reference::frustum(-n * aspect, n * aspect, -n, n, n, f);
-        let reference = visible(&world, &triangles, &mvp64, width, height);
+        let mvp64 = stereolab_core::frustum_f64(-n * aspect, n * aspect, -n, n, n, f);
+        let reference = visible_f64(&world, &triangles, &mvp64, width, height);
         let a = near * aspect as f32;
         let shader = IdShader {
             positions: &soup_positions,
@@ -122,7 +121,7 @@ pub fn measure(width: u32, height: u32, iters: usize) -> Result<Vec<DepthRow>> {
                 Ok(fb)
             };
             let fb = draw()?;
-            let m = compare(&fb, &reference);
+            let m = compare_with_reference(&fb, &reference);
             let seconds = median_ms(iters, draw) * 1e-3;
             out.push(DepthRow {
                 setting: mode.name().to_string(),

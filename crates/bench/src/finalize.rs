@@ -8,17 +8,11 @@ use super::{Row, interleaved_medians, median_ms};
 use stereolab::plan::{Output, Plan, Shading, View};
 use stereolab::render::{render, render_view};
 use stereolab::scene::Scene;
-use stereolab_core::effects::anaglyph::{
-    AnaglyphKind, AnaglyphOptions, anaglyph, anaglyph_reference,
+use stereolab_core::{
+    AnaglyphKind, AnaglyphOptions, Framebuffer, Precision, Remapper, Result, Visibility, anaglyph,
+    anaglyph_reference, occlusion_image, parallax_image, parallax_image_reference, remap_color,
+    remap_color_reference, remap_coordinates, visibility_map,
 };
-use stereolab_core::effects::occlusion::occlusion_image;
-use stereolab_core::effects::parallax::{parallax_image, parallax_image_reference};
-use stereolab_core::effects::remap::{
-    Precision, Remapper, Visibility, remap_color, remap_color_reference, remap_coordinates,
-    visibility_map,
-};
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
 
 fn row(knob: &str, setting: impl Into<String>, error: Option<f64>, unit: &str, ms: f64) -> Row {
     Row {

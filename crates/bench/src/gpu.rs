@@ -7,11 +7,10 @@ use stereolab::compare::{compare, framebuffer_from_image};
 use stereolab::plan::View;
 use stereolab::render::Frame;
 use stereolab::scene::Scene;
-use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions, anaglyph};
-use stereolab_core::effects::occlusion::occlusion_image;
-use stereolab_core::effects::parallax::parallax_image;
-use stereolab_core::effects::remap::{Precision, remap_color};
-use stereolab_core::error::Result;
+use stereolab_core::{
+    AnaglyphKind, AnaglyphOptions, Precision, Result, anaglyph, occlusion_image, parallax_image,
+    remap_color,
+};
 
 use stereolab::output::{Image, produce};
 use stereolab::plan::{Output, Plan, Shading};
@@ -353,8 +352,7 @@ fn sirds_rows(r: &GpuRenderer, iters: usize) -> Result<Vec<Row>> {
     use stereolab::fixtures::{TABLE_1, table_scene};
     use stereolab::render::render_view;
     use stereolab::render::sirds_strips::per_vertex;
-    use stereolab_core::effects::sirds::depth_range;
-    use stereolab_core::math::StereoRig;
+    use stereolab_core::{StereoRig, depth_range};
 
     let (w, h, tris, k, paper_hz) = TABLE_1[0];
     let s = table_scene(w, h, tris, k)?;

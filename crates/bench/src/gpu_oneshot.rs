@@ -15,9 +15,7 @@ use wgpu::util::DeviceExt;
 
 use super::median_ms;
 use stereolab::scene::Scene;
-use stereolab_core::effects::anaglyph::AnaglyphKind;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::EyeMatrices;
+use stereolab_core::{AnaglyphKind, Error, EyeMatrices, Result};
 
 /// Blinn-Phong (the CPU's `BlinnPhong`) and the anaglyph pass, plain WGSL.
 const SHADER: &str = r#"
@@ -501,7 +499,7 @@ fn u32_bytes(v: &[u32]) -> Vec<u8> {
 }
 
 /// The goal-1 rows: the CPU stereo pair + Dubois anaglyph (on the loops
-/// [`kernels`](stereolab_core::simd::kernels) chose: the AVX2 fragment stage where the CPU has
+/// [`kernels`](stereolab_core::kernels) chose: the AVX2 fragment stage where the CPU has
 /// it, the scalar stage with `STEREOLAB_SCALAR=1`), beside [`OneShot`] on the same scene, timed
 /// in the same run. The CPU row's note carries the ratio `cpu / wgpu`; the wgpu row's error is the largest
 /// channel difference to the CPU's anaglyph (its arithmetic is not the parity path's).
@@ -563,9 +561,9 @@ pub(super) fn rows(scene: &Scene, iters: usize) -> Result<Vec<super::Row>> {
     if let Some(e) = failed {
         return Err(e);
     }
-    let simd = if stereolab_core::simd::kernels().avx2() {
+    let simd = if stereolab_core::kernels().avx2() {
         "AVX2 fragment stage"
-    } else if stereolab_core::simd::avx2_available() {
+    } else if stereolab_core::avx2_available() {
         "STEREOLAB_SCALAR: scalar"
     } else {
         "no AVX2 on this CPU: scalar"

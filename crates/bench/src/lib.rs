@@ -22,11 +22,9 @@ use glam::{Vec2, Vec3, Vec4};
 use stereolab::plan::{Output, Plan};
 use stereolab::render::{render, render_view};
 use stereolab::scene::{Mesh, Scene};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::perspective;
-use stereolab_core::raster::{RasterOptions, rasterize};
-use stereolab_core::shade::{Fragment, Shader, Varyings};
+use stereolab_core::{
+    Error, Fragment, Framebuffer, RasterOptions, Result, Shader, Varyings, perspective, rasterize,
+};
 
 /// One measurement.
 #[derive(Clone, Debug, PartialEq)]
@@ -286,7 +284,7 @@ impl Shader for UvShader<'_> {
     fn fragment(&self, f: &Fragment) -> Option<[u8; 4]> {
         // The color is only for looking at; the benchmark reads the exact floats through
         // `RecordUv`, which wraps this shader.
-        Some(stereolab_core::shade::to_rgba8(Vec3::new(
+        Some(stereolab_core::to_rgba8(Vec3::new(
             f.varyings[0],
             f.varyings[1],
             0.0,
@@ -463,5 +461,5 @@ pub fn write_csv(rows: &[Row], path: &Path) -> Result<()> {
             q(&r.note)
         );
     }
-    stereolab_core::files::write_bytes(path, s.as_bytes())
+    stereolab_core::write_bytes(path, s.as_bytes())
 }

@@ -15,8 +15,7 @@ use std::path::{Path, PathBuf};
 use super::BenchOptions;
 use super::accuracy::{Scale, knobs};
 use stereolab::scene::Scene;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::files::write_bytes;
+use stereolab_core::{Error, Result, write_bytes};
 use stereolab_figures::plot::{Knob, knob_plot, time_scale};
 
 /// The knobs whose plots the slides show (copied as `accuracy_<id>.png` into the slides'

@@ -18,9 +18,7 @@ use stereolab::plan::{Output, Plan, Shading};
 use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::render::{render, render_view};
 use stereolab::scene::Scene;
-use stereolab_core::effects::sirds::depth_range;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::StereoRig;
+use stereolab_core::{Error, Result, StereoRig, depth_range};
 
 fn row(knob: &str, setting: impl Into<String>, ms: f64, note: impl Into<String>) -> Row {
     Row {

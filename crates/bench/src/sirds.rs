@@ -10,13 +10,11 @@ use stereolab::plan::{Output, Plan, Shading};
 use stereolab::render::sirds_strips::{StripGeometry, per_vertex, per_vertex_reference};
 use stereolab::render::{render, render_view};
 use stereolab::scene::Scene;
-use stereolab_core::effects::sirds::decode::{DecodeOptions, RoundTrip, decode, round_trip};
-use stereolab_core::effects::sirds::per_pixel::{PerPixelOptions, per_pixel};
-use stereolab_core::effects::sirds::{
-    Algorithm, DepthRange, Disparity, Filter, Pattern, PerVertexOptions, Start, depth_range,
+use stereolab_core::{
+    DepthRange, Disparity, EyeMatrices, PerPixelOptions, PerVertexOptions, Result, SirdsAlgorithm,
+    SirdsDecodeOptions, SirdsPattern, SirdsRoundTrip, StereoRig, StripFilter, StripStart,
+    decode_sirds, depth_range, per_pixel, sirds_round_trip,
 };
-use stereolab_core::error::Result;
-use stereolab_core::math::{EyeMatrices, StereoRig};
 
 /// The SIRDS paper's Table 1, two rows per line of the table, each rate also as a multiple of
 /// the paper's:
@@ -82,7 +80,7 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     let loops = |simd: bool| {
         if !simd {
             ", scalar loops"
-        } else if stereolab_core::simd::kernels().avx2() {
+        } else if stereolab_core::kernels().avx2() {
             ", AVX2 loops"
         } else {
             ", scalar loops (no AVX2 here, or STEREOLAB_SCALAR set)"
@@ -143,7 +141,7 @@ detail = 16
 rotate = [0.0, 35.0, 0.0]
 "#,
     )?;
-    base.sirds.pattern = Pattern::BlackWhite { seed: 5 };
+    base.sirds.pattern = SirdsPattern::BlackWhite { seed: 5 };
     Ok(base)
 }
 
@@ -155,10 +153,10 @@ fn knobs(iters: usize) -> Result<Vec<Row>> {
     let (depth, _) = scene_depth(&frame, &base)?;
     let mut variants: Vec<(&str, String, Scene)> = Vec::new();
     for (start, filter) in [
-        (Start::Left, Filter::Nearest),
-        (Start::Left, Filter::Bilinear),
-        (Start::Center, Filter::Nearest),
-        (Start::Center, Filter::Bilinear),
+        (StripStart::Left, StripFilter::Nearest),
+        (StripStart::Left, StripFilter::Bilinear),
+        (StripStart::Center, StripFilter::Nearest),
+        (StripStart::Center, StripFilter::Bilinear),
     ] {
         let mut s = base.clone();
         s.sirds.per_vertex = PerVertexOptions {
@@ -170,7 +168,7 @@ fn knobs(iters: usize) -> Result<Vec<Row>> {
     }
     for (hidden_surface, oversample) in [(false, 1), (true, 1), (true, 2), (true, 4)] {
         let mut s = base.clone();
-        s.sirds.algorithm = Algorithm::PerPixel;
+        s.sirds.algorithm = SirdsAlgorithm::PerPixel;
         s.sirds.per_pixel = PerPixelOptions {
             hidden_surface,
             oversample,
@@ -185,10 +183,10 @@ fn knobs(iters: usize) -> Result<Vec<Row>> {
     for (knob, setting, s) in variants {
         let sirds = from_frame(&frame, &s)?;
         let d = sirds.disparity;
-        let opts = DecodeOptions::for_disparity(&d);
-        let decoded = decode(&sirds.pixels, sirds.width, sirds.height, &opts)?;
+        let opts = SirdsDecodeOptions::for_disparity(&d);
+        let decoded = decode_sirds(&sirds.pixels, sirds.width, sirds.height, &opts)?;
         let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
-        let rt = round_trip(&decoded, &intended, &opts);
+        let rt = sirds_round_trip(&decoded, &intended, &opts);
         let ms = median_ms(iters, || from_frame(&frame, &s).is_ok());
         rows.push(Row {
             area: "sirds".into(),
@@ -211,8 +209,8 @@ fn knobs(iters: usize) -> Result<Vec<Row>> {
 /// `pamstereogram` is done with hyperfine, see the issue note).
 fn large_depth_map(iters: usize) -> Result<Vec<Row>> {
     let depth = sphere_over_ramp(4096, 3072);
-    let d = stereolab_core::effects::sirds::Geometry::default().to_pixels()?;
-    let pattern = Pattern::BlackWhite { seed: 1 };
+    let d = stereolab_core::SirdsGeometry::default().to_pixels()?;
+    let pattern = SirdsPattern::BlackWhite { seed: 1 };
     let mut rows = Vec::new();
     for hidden_surface in [false, true] {
         let opts = PerPixelOptions {
@@ -244,30 +242,29 @@ fn large_depth_map(iters: usize) -> Result<Vec<Row>> {
 /// alone, and search + decode; error: RMS decoded separation; note: time against the known
 /// range, in this run.
 fn decode_search(iters: usize) -> Result<Vec<Row>> {
-    use stereolab_core::effects::sirds::decode::decode_auto;
-    use stereolab_core::effects::sirds::search::{SearchOptions, search};
+    use stereolab_core::{SeparationSearchOptions, decode_sirds_auto, search_separation};
     let (w, h) = (600, 300);
     let depth = sphere_over_ramp(w, h);
-    let d = stereolab_core::effects::sirds::Geometry::default().to_pixels()?;
+    let d = stereolab_core::SirdsGeometry::default().to_pixels()?;
     let pixels = per_pixel(
         &depth,
         &d,
-        &Pattern::BlackWhite { seed: 1 },
+        &SirdsPattern::BlackWhite { seed: 1 },
         &PerPixelOptions::default(),
     )?;
     let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
-    let known = DecodeOptions::for_disparity(&d);
-    let so = SearchOptions::default();
-    let rt_known = round_trip(&decode(&pixels, w, h, &known)?, &intended, &known);
-    let auto = decode_auto(&pixels, w, h, &so)?;
+    let known = SirdsDecodeOptions::for_disparity(&d);
+    let so = SeparationSearchOptions::default();
+    let rt_known = sirds_round_trip(&decode_sirds(&pixels, w, h, &known)?, &intended, &known);
+    let auto = decode_sirds_auto(&pixels, w, h, &so)?;
     let rt_auto = match (&auto.decoded, &auto.options) {
-        (Some(dec), Some(o)) => Some(round_trip(dec, &intended, o)),
+        (Some(dec), Some(o)) => Some(sirds_round_trip(dec, &intended, o)),
         _ => None,
     };
-    let t_known = median_ms(iters, || decode(&pixels, w, h, &known).is_ok());
-    let t_search = median_ms(iters, || search(&pixels, w, h, &so).is_ok());
-    let t_auto = median_ms(iters, || decode_auto(&pixels, w, h, &so).is_ok());
-    let row = |setting: String, rt: Option<RoundTrip>, ms: f64| Row {
+    let t_known = median_ms(iters, || decode_sirds(&pixels, w, h, &known).is_ok());
+    let t_search = median_ms(iters, || search_separation(&pixels, w, h, &so).is_ok());
+    let t_auto = median_ms(iters, || decode_sirds_auto(&pixels, w, h, &so).is_ok());
+    let row = |setting: String, rt: Option<SirdsRoundTrip>, ms: f64| Row {
         area: "sirds".into(),
         knob: "decode 600x300".into(),
         setting,
@@ -297,7 +294,7 @@ fn decode_search(iters: usize) -> Result<Vec<Row>> {
         ),
         row(
             format!(
-                "search + decode (found {:?})",
+                "search + decode_sirds (found {:?})",
                 auto.search.found.unwrap_or((0, 0))
             ),
             rt_auto,

@@ -3,9 +3,9 @@
 //! effects (anaglyphs, remapping and the visibility check, parallax, layouts, ChromaDepth,
 //! SIRDS), each a function of framebuffers, matrices and its own settings.
 //!
-//! A pass is [`raster::rasterize`] with a [`shade::Shader`] into a [`Framebuffer`], with the
-//! matrices of [`math::StereoRig::eyes`]; an effect reads the framebuffers, e.g.
-//! [`effects::anaglyph::anaglyph`]. Scene files, the plan and the outputs are the `stereolab`
+//! A pass is [`rasterize`] with a [`Shader`] into a [`Framebuffer`], with the
+//! matrices of [`StereoRig::eyes`]; an effect reads the framebuffers, e.g.
+//! [`anaglyph`]. Scene files, the plan and the outputs are the `stereolab`
 //! crate's; `examples/` in the repository has small complete programs.
 //!
 //! Its modules import lower ones only, in the order `tests/architecture.rs` holds.
@@ -13,18 +13,136 @@
 #![doc = include_str!("../../../docs/formulas.md")]
 #![warn(missing_docs)]
 
-pub mod effects;
-pub mod error;
-pub mod eye;
-pub mod files;
-pub mod framebuffer;
-pub mod math;
-pub mod raster;
-pub mod reference;
-pub mod shade;
-pub mod simd;
-pub mod text;
+mod effects;
+mod error;
+mod eye;
+mod files;
+mod framebuffer;
+mod math;
+mod raster;
+mod reference;
+mod shade;
+mod simd;
+mod text;
 
 pub use error::{Error, Result};
 pub use eye::Eye;
 pub use framebuffer::{EyePair, Framebuffer};
+
+pub use effects::anaglyph::{
+    AnaglyphKind, AnaglyphMatrices, AnaglyphOptions, ColorMatrix, anaglyph, anaglyph_pixel,
+    anaglyph_reference, linear_to_srgb, mix as anaglyph_mix, srgb_to_linear,
+};
+pub use effects::calibration::{
+    ARROW_COLOR as CALIBRATION_ARROW_COLOR, BLANK_COLOR as CALIBRATION_BLANK_COLOR,
+    CalibrationLayout, VIEW_COLOR as CALIBRATION_VIEW_COLOR, calibration_screen,
+};
+pub use effects::chromadepth::glasses::{
+    channel_weights, glasses_pair, glasses_view, pixel_shift, shift_map,
+};
+pub use effects::chromadepth::ramp::{
+    DEFAULT_TEXELS, FAR_HUE_DEGREES, Ramp, RampKind, Sampling as RampSampling, exact as ramp_exact,
+    hsv_to_rgb, hue_degrees,
+};
+pub use effects::chromadepth::texgen::{
+    Texgen, auto_range, bounding_sphere, eye_plane, eye_plane_specified_under,
+};
+pub use effects::chromadepth::{
+    ChromaDepthSettings, ChromaDepthView, TexgenMode, chromadepth_view,
+};
+pub use effects::eye_input::check_same_size;
+pub use effects::frame_sequential::{
+    Field as FrameField, FrameSequentialSettings, MAX_CYCLES, MAX_EYE_RATE_HZ,
+};
+pub use effects::ghosting::{
+    BRIGHT as GHOST_BRIGHT, DARK as GHOST_DARK, DEFAULT_LEAK as DEFAULT_GHOSTING_LEAK, GhostRisk,
+    GhostingSettings, contrast_warning, ghost_risk, ghosted,
+};
+pub use effects::layout::{above_below, above_below_squashed, interleave, side_by_side};
+pub use effects::legend::{LEGEND_HEIGHT, draw_legend, draw_legend_reference};
+pub use effects::occlusion::{
+    BACKGROUND_COLOR as OCCLUSION_BACKGROUND_COLOR, FARTHER_COLOR as OCCLUSION_FARTHER_COLOR,
+    OCCLUDED_COLOR as OCCLUSION_OCCLUDED_COLOR, OUT_OF_VIEW_COLOR as OCCLUSION_OUT_OF_VIEW_COLOR,
+    occlusion_image,
+};
+pub use effects::parallax::{
+    PARALLAX_BACKGROUND, PARALLAX_BUDGET_PERCENT, ParallaxBudget, ParallaxRig,
+    VIOLATION_COLOR as PARALLAX_VIOLATION_COLOR, budget as parallax_budget,
+    budget_of as parallax_budget_of, color_scale as parallax_color_scale, parallax_color,
+    parallax_image, parallax_image_reference, parallax_map, violation_band, window_violation_marks,
+};
+pub use effects::rds::{
+    MAX_DOT_SIZE, RdsSettings, as_framebuffer as rds_framebuffer, dot as rds_dot, rds_left,
+    rds_right, right_only_seed, source_texel,
+};
+pub use effects::remap::{
+    DEPTH_PRECISION, Precision, Remapped, Remapper, Visibility, classify as classify_visibility,
+    depth_slope, remap_color, remap_color_pixel, remap_color_reference, remap_coordinates,
+    tolerance as remap_tolerance, visibility_map,
+};
+pub use effects::shear_rotate::{
+    Difference as ShearRotateDifference, difference as shear_rotate_difference,
+    max_abs as max_abs_vertical_parallax, vertical_parallax_image, vertical_parallax_map,
+};
+pub use effects::sirds::decode::{
+    AUTOSTEREOGRAM_SHARE, AutoDecoded as AutoDecodedSirds, DecodeOptions as SirdsDecodeOptions,
+    Decoded as DecodedSirds, RoundTrip as SirdsRoundTrip, decode as decode_sirds,
+    decode_auto as decode_sirds_auto, depth_from_separation, matched_share_where_all_fit,
+    nearness_linear, round_trip as sirds_round_trip,
+};
+pub use effects::sirds::depthfile::{DepthSamples, Near, PgmRows};
+pub use effects::sirds::depthmap::DepthMapping;
+pub use effects::sirds::disparity::{
+    separation_eye_distance, separation_view_angle, tan_phi_eye_distance,
+};
+pub use effects::sirds::pair::{Views as SirdsViews, views as sirds_views};
+pub use effects::sirds::pattern::draw_guide_dots;
+pub use effects::sirds::per_pixel::{
+    MAX_OVERSAMPLE, PerPixelOptions, RowLinker, SampleTable, check_inputs as check_sirds_inputs,
+    left_of_pair, per_pixel, per_pixel_samples, per_pixel_streamed,
+};
+pub use effects::sirds::search::{
+    Region as SearchRegion, Search as SeparationSearch, SearchOptions as SeparationSearchOptions,
+    search as search_separation,
+};
+pub use effects::sirds::settings::DotKind;
+pub use effects::sirds::{
+    Algorithm as SirdsAlgorithm, DepthMap, DepthRange, Disparity, DisparityModel,
+    Filter as StripFilter, Geometry as SirdsGeometry, Pattern as SirdsPattern, PerVertexOptions,
+    Settings as SirdsSettings, Sirds, SirdsSpec, Start as StripStart, depth_range, from_depth_map,
+};
+pub use files::{
+    EXCERPT_CHARS, InputRoot, check_input, check_output_path, excerpt, image_error,
+    open_image as open_image_within, read_input, read_text, without_bom, write_atomic, write_bytes,
+    write_png,
+};
+pub use framebuffer::{
+    BACK_LEFT, BACK_RIGHT, DrawBuffer, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_size, open_image,
+};
+pub use math::stereo::{
+    auto_eye_separation, cyclopic_projection, eye_translation, frustum_asymmetry,
+    image_shift_translation, off_axis_frustum, toe_in_view, view_width_at,
+    zero_parallax_at_fraction,
+};
+pub use math::{
+    Camera, CameraMode, EyeMatrices, ImageShift, Lighting, ResolvedRig, Separation, StereoRig,
+    Viewer, ZeroParallax, fit_zero_parallax, frustum, look_at, perspective, project_ndc,
+};
+pub use raster::avx2::{
+    columns as avx2_columns, covered_vectors as avx2_covered_vectors, depth_at as avx2_depth_at,
+    floor_i32 as avx2_floor_i32, load as avx2_load, opaque as avx2_opaque,
+    plane_at as avx2_plane_at, store as avx2_store, tail_mask as avx2_tail_mask,
+};
+pub use raster::{
+    Band as RasterBand, DepthMode, DepthPlane, Plane, RasterOptions, RasterStats,
+    Setup as TriangleSetup, SetupTriangle, Setups, SmallBox, WindowVertex, bin_rows, rasterize,
+    rasterize_blinn_phong, setup_triangle, setup_triangles, traverse,
+};
+pub use reference::{
+    IdShader, Mismatch, Visible, compare as compare_with_reference, eye as eye_matrices_f64,
+    frustum as frustum_f64, look_at as look_at_f64, soup as triangle_soup, visible as visible_f64,
+    zero_parallax as zero_parallax_f64,
+};
+pub use shade::{BlinnPhong, DepthOnly, Fragment, Light, MAX_VARYINGS, Shader, Varyings, to_rgba8};
+pub use simd::{Kernels, avx2_available, kernels};
+pub use text::{Align as TextAlign, caption, draw_rgba as draw_text_rgba, width as text_width};

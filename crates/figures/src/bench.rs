@@ -4,8 +4,7 @@
 
 use super::Context;
 use super::canvas::{Axes, Canvas, GRAY, INK, LABEL, SMALL};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::text::Align;
+use stereolab_core::{Error, Result, TextAlign};
 
 /// One row of `stereolab bench --csv`.
 #[derive(Clone, Debug, PartialEq)]
@@ -129,7 +128,7 @@ pub fn accuracy_time(ctx: &Context) -> Result<Canvas> {
             y: (0.0, max_err),
         };
         a.draw(&mut c, "median time (ms)", &rows[0].error_unit, (5.0, 4.0));
-        c.text(x0 + 165.0, y0 - 26.0, LABEL, title, INK, Align::Center);
+        c.text(x0 + 165.0, y0 - 26.0, LABEL, title, INK, TextAlign::Center);
         for r in &rows {
             c.dot(a.px(r.ms, r.error.unwrap_or(0.0)), 4.5, (30, 30, 160));
         }
@@ -147,7 +146,11 @@ pub fn accuracy_time(ctx: &Context) -> Result<Canvas> {
                 SMALL,
                 &label,
                 INK,
-                if right { Align::Right } else { Align::Left },
+                if right {
+                    TextAlign::Right
+                } else {
+                    TextAlign::Left
+                },
             );
         }
     }
@@ -157,7 +160,7 @@ pub fn accuracy_time(ctx: &Context) -> Result<Canvas> {
         SMALL,
         "stereolab bench --csv (slides/data/bench.csv): median of 15 runs, 1024×768 unless noted; shared 2-core machine",
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }

@@ -1,12 +1,11 @@
 //! The drawing kit every figure uses: a white tiny-skia page with lines, arrows, dots, filled
-//! shapes, pasted images, and text in the shipped font ([`stereolab_core::text`]); and [`Axes`], a plot
-//! frame with tick values, axis labels with units and a legend.
+//! shapes, pasted images, and text in the shipped font ([`draw_text_rgba`]); and [`Axes`], a
+//! plot frame with tick values, axis labels with units and a legend.
 
 use image::RgbaImage;
 use tiny_skia::{FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform};
 
-use stereolab_core::error::{Error, Result};
-use stereolab_core::text::{self, Align};
+use stereolab_core::{Error, Result, TextAlign, draw_text_rgba, text_width};
 
 /// An RGB color.
 pub type Rgb = (u8, u8, u8);
@@ -207,15 +206,15 @@ impl Canvas {
     }
 
     /// A label: `(x, y)` is the top of the text, aligned by `align`.
-    pub fn text(&mut self, x: f32, y: f32, size: f32, s: &str, rgb: Rgb, align: Align) {
-        let w = text::width(s, size);
+    pub fn text(&mut self, x: f32, y: f32, size: f32, s: &str, rgb: Rgb, align: TextAlign) {
+        let w = text_width(s, size);
         let x = match align {
-            Align::Left => x,
-            Align::Center => x - w / 2.0,
-            Align::Right => x - w,
+            TextAlign::Left => x,
+            TextAlign::Center => x - w / 2.0,
+            TextAlign::Right => x - w,
         };
         let (pw, ph) = (self.pm.width(), self.pm.height());
-        text::draw_rgba(
+        draw_text_rgba(
             self.pm.data_mut(),
             pw,
             ph,
@@ -229,12 +228,12 @@ impl Canvas {
     }
 
     /// A label on a white box (readable over lines and images).
-    pub fn boxed_text(&mut self, x: f32, y: f32, size: f32, s: &str, rgb: Rgb, align: Align) {
-        let w = text::width(s, size);
+    pub fn boxed_text(&mut self, x: f32, y: f32, size: f32, s: &str, rgb: Rgb, align: TextAlign) {
+        let w = text_width(s, size);
         let x0 = match align {
-            Align::Left => x,
-            Align::Center => x - w / 2.0,
-            Align::Right => x - w,
+            TextAlign::Left => x,
+            TextAlign::Center => x - w / 2.0,
+            TextAlign::Right => x - w,
         };
         self.fill_rect(
             (x0 - 3.0, y - 1.0),
@@ -242,14 +241,14 @@ impl Canvas {
             (255, 255, 255),
             235,
         );
-        self.text(x0, y, size, s, rgb, Align::Left);
+        self.text(x0, y, size, s, rgb, TextAlign::Left);
     }
 
     /// A label reading bottom to top, centered vertically on `y`, its left edge at `x`.
     pub fn vertical_text(&mut self, x: f32, y: f32, size: f32, s: &str, rgb: Rgb) {
-        let w = text::width(s, size);
+        let w = text_width(s, size);
         let (pw, ph) = (self.pm.width(), self.pm.height());
-        text::draw_rgba(
+        draw_text_rgba(
             self.pm.data_mut(),
             pw,
             ph,
@@ -357,7 +356,14 @@ impl Axes {
             let (px, _) = self.px(v, self.y.0);
             c.line((px, t), (px, b), (232, 232, 232), 1.0);
             c.line((px, b), (px, b + 5.0), INK, 1.0);
-            c.text(px, b + 7.0, SMALL, &tick_label(v, xs), INK, Align::Center);
+            c.text(
+                px,
+                b + 7.0,
+                SMALL,
+                &tick_label(v, xs),
+                INK,
+                TextAlign::Center,
+            );
             v += xs;
         }
         let mut v = (self.y.0 / ys).ceil() * ys;
@@ -371,15 +377,22 @@ impl Axes {
                 SMALL,
                 &tick_label(v, ys),
                 INK,
-                Align::Right,
+                TextAlign::Right,
             );
             v += ys;
         }
         c.rect((l, t), (r, b), INK, 1.0);
-        c.text((l + r) / 2.0, b + 26.0, LABEL, x_label, INK, Align::Center);
+        c.text(
+            (l + r) / 2.0,
+            b + 26.0,
+            LABEL,
+            x_label,
+            INK,
+            TextAlign::Center,
+        );
         let widest_tick = [self.y.0, self.y.1]
             .iter()
-            .map(|v| text::width(&tick_label(*v, ys), SMALL))
+            .map(|v| text_width(&tick_label(*v, ys), SMALL))
             .fold(0.0, f32::max);
         c.vertical_text(
             l - 14.0 - widest_tick - LABEL * 1.2,
@@ -405,7 +418,7 @@ impl Axes {
         let (l, t, r, _) = self.frame;
         let w = entries
             .iter()
-            .map(|(s, _)| text::width(s, SMALL))
+            .map(|(s, _)| text_width(s, SMALL))
             .fold(0.0, f32::max)
             + 40.0;
         let h = entries.len() as f32 * (SMALL + 6.0) + 8.0;
@@ -421,7 +434,7 @@ impl Axes {
                 *rgb,
                 2.5,
             );
-            c.text(x0 + 34.0, y, SMALL, s, INK, Align::Left);
+            c.text(x0 + 34.0, y, SMALL, s, INK, TextAlign::Left);
         }
     }
 }

@@ -9,12 +9,9 @@ use super::thumbs::{grid, image_of, rendered};
 use stereolab::plan::Output;
 use stereolab::render::chromadepth::resolve_texgen;
 use stereolab::scene::Scene;
-use stereolab_core::effects::chromadepth::glasses::pixel_shift;
-use stereolab_core::effects::chromadepth::ramp::{Ramp, RampKind};
-use stereolab_core::effects::chromadepth::texgen::{Texgen, bounding_sphere};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::StereoRig;
-use stereolab_core::text::Align;
+use stereolab_core::{
+    Error, Ramp, RampKind, Result, StereoRig, Texgen, TextAlign, bounding_sphere, pixel_shift,
+};
 
 fn to_rgb(v: Vec3) -> (u8, u8, u8) {
     let c = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -87,7 +84,7 @@ pub fn texgen_top_view(ctx: &Context) -> Result<Canvas> {
             SMALL,
             &format!("{name} = {d:.2}  (s = {sval})"),
             INK,
-            Align::Left,
+            TextAlign::Left,
         );
     }
     c.text(
@@ -96,7 +93,7 @@ pub fn texgen_top_view(ctx: &Context) -> Result<Canvas> {
         SMALL,
         &format!("bounding sphere, r = {radius:.2}"),
         INK,
-        Align::Left,
+        TextAlign::Left,
     );
     let [pa, pb, pc, pd] = tg.plane.to_array();
     c.text(
@@ -105,7 +102,7 @@ pub fn texgen_top_view(ctx: &Context) -> Result<Canvas> {
         SMALL,
         &format!("eye plane (A, B, C, D) = ({pa:.0}, {pb:.0}, {pc:.4}, {pd:.4}); s = C·z + D"),
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
@@ -160,7 +157,7 @@ pub fn ramp_against_distance(ctx: &Context) -> Result<Canvas> {
             SMALL,
             &format!("{name} = {d:.2}"),
             INK,
-            Align::Left,
+            TextAlign::Left,
         );
     }
     let kind = match ramp.kind() {
@@ -176,7 +173,7 @@ pub fn ramp_against_distance(ctx: &Context) -> Result<Canvas> {
             ramp.texels().len()
         ),
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
@@ -231,7 +228,7 @@ pub fn glasses_shift(ctx: &Context) -> Result<Canvas> {
             s.width
         ),
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }

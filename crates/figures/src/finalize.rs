@@ -8,13 +8,11 @@ use super::Context;
 use super::canvas::{Axes, Canvas, GRAY, INK, LABEL, LEFT, RIGHT, SMALL};
 use super::thumbs::{grid, image_of, rendered};
 use stereolab::plan::{Output, View};
-use stereolab_core::effects::anaglyph::{
-    AnaglyphKind, ColorMatrix, linear_to_srgb, srgb_to_linear,
+use stereolab_core::{
+    AnaglyphKind, ColorMatrix, Error, OCCLUSION_FARTHER_COLOR, OCCLUSION_OCCLUDED_COLOR,
+    OCCLUSION_OUT_OF_VIEW_COLOR, Precision, Remapper, Result, TextAlign, linear_to_srgb,
+    srgb_to_linear,
 };
-use stereolab_core::effects::occlusion::{FARTHER_COLOR, OCCLUDED_COLOR, OUT_OF_VIEW_COLOR};
-use stereolab_core::effects::remap::{Precision, Remapper};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::text::Align;
 
 /// The two eye framebuffers of one frame: color and depth each.
 ///
@@ -103,7 +101,7 @@ fn matrix(c: &mut Canvas, x: f32, y: f32, m: &ColorMatrix, rgb: (u8, u8, u8)) {
                 SMALL,
                 &s,
                 if *v == 0.0 { GRAY } else { rgb },
-                Align::Right,
+                TextAlign::Right,
             );
         }
     }
@@ -116,18 +114,46 @@ fn anaglyph_table(ctx: &Context, kinds: &[AnaglyphKind]) -> Result<Canvas> {
     let (s, frame) = rendered(ctx.scene, 120, 90, &outs, |_| {})?;
     let row_h = 100.0;
     let mut c = Canvas::new(720, (40.0 + row_h * kinds.len() as f32) as u32)?;
-    c.text(235.0, 8.0, LABEL, "M_L (left eye)", LEFT, Align::Center);
-    c.text(445.0, 8.0, LABEL, "M_R (right eye)", RIGHT, Align::Center);
+    c.text(235.0, 8.0, LABEL, "M_L (left eye)", LEFT, TextAlign::Center);
+    c.text(
+        445.0,
+        8.0,
+        LABEL,
+        "M_R (right eye)",
+        RIGHT,
+        TextAlign::Center,
+    );
     for (i, kind) in kinds.iter().enumerate() {
         let y = 34.0 + i as f32 * row_h;
         let img = image_of(Output::Anaglyph(*kind), &frame, &s)?;
         c.image(&img, 8, y as u32, 1);
         let m = kind.matrices();
-        c.text(140.0, y + 2.0, LABEL, kind.output_name(), INK, Align::Left);
+        c.text(
+            140.0,
+            y + 2.0,
+            LABEL,
+            kind.output_name(),
+            INK,
+            TextAlign::Left,
+        );
         matrix(&mut c, 140.0, y + 28.0, &m.left, LEFT);
         matrix(&mut c, 350.0, y + 28.0, &m.right, RIGHT);
-        c.text(560.0, y + 46.0, SMALL, "out = clamp(", GRAY, Align::Left);
-        c.text(560.0, y + 62.0, SMALL, " M_L·l + M_R·r)", GRAY, Align::Left);
+        c.text(
+            560.0,
+            y + 46.0,
+            SMALL,
+            "out = clamp(",
+            GRAY,
+            TextAlign::Left,
+        );
+        c.text(
+            560.0,
+            y + 62.0,
+            SMALL,
+            " M_L·l + M_R·r)",
+            GRAY,
+            TextAlign::Left,
+        );
     }
     Ok(c)
 }
@@ -195,7 +221,14 @@ pub fn linear_light(ctx: &Context) -> Result<Canvas> {
     );
     let img0 = image_of(out[0], &f0, &s0)?;
     let img1 = image_of(out[0], &f1, &s1)?;
-    c.text(460.0, 14.0, SMALL, "mixed as stored", INK, Align::Center);
+    c.text(
+        460.0,
+        14.0,
+        SMALL,
+        "mixed as stored",
+        INK,
+        TextAlign::Center,
+    );
     c.image(&img0, 380, 34, 1);
     c.text(
         640.0,
@@ -203,7 +236,7 @@ pub fn linear_light(ctx: &Context) -> Result<Canvas> {
         SMALL,
         "mixed in linear light",
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     c.image(&img1, 560, 34, 1);
     c.text(
@@ -212,7 +245,7 @@ pub fn linear_light(ctx: &Context) -> Result<Canvas> {
         SMALL,
         "anaglyph_dubois, [finalize] linear_light",
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
@@ -293,8 +326,8 @@ pub fn remap_one_pixel(ctx: &Context) -> Result<Canvas> {
     let mut c = Canvas::new(540, 200 + 26 * lines.len() as u32 + 10)?;
     let li = image_of(Output::Left, &frame, &s)?;
     let ri = image_of(Output::Right, &frame, &s)?;
-    c.text(130.0, 6.0, LABEL, "left eye", LEFT, Align::Center);
-    c.text(400.0, 6.0, LABEL, "right eye", RIGHT, Align::Center);
+    c.text(130.0, 6.0, LABEL, "left eye", LEFT, TextAlign::Center);
+    c.text(400.0, 6.0, LABEL, "right eye", RIGHT, TextAlign::Center);
     c.image(&li, 10, 26, 1);
     c.image(&ri, 280, 26, 1);
     let pl = (10.0 + x as f32 + 0.5, 26.0 + y as f32 + 0.5);
@@ -303,7 +336,14 @@ pub fn remap_one_pixel(ctx: &Context) -> Result<Canvas> {
     c.circle(pr, 6.0, (255, 220, 0), 2.0);
     c.arrow((pl.0 + 8.0, pl.1), (pr.0 - 8.0, pr.1), (255, 220, 0), 1.5);
     for (i, l) in lines.iter().enumerate() {
-        c.text(10.0, 214.0 + 26.0 * i as f32, SMALL, l, INK, Align::Left);
+        c.text(
+            10.0,
+            214.0 + 26.0 * i as f32,
+            SMALL,
+            l,
+            INK,
+            TextAlign::Left,
+        );
     }
     Ok(c)
 }
@@ -340,11 +380,14 @@ pub fn remap_occlusion(ctx: &Context) -> Result<Canvas> {
             "seen by both eyes (gray: nearer is lighter)",
             (170, 170, 170),
         ),
-        ("occluded in the other eye", rgb(OCCLUDED_COLOR)),
-        ("outside the other eye's view", rgb(OUT_OF_VIEW_COLOR)),
+        ("occluded in the other eye", rgb(OCCLUSION_OCCLUDED_COLOR)),
+        (
+            "outside the other eye's view",
+            rgb(OCCLUSION_OUT_OF_VIEW_COLOR),
+        ),
         (
             "farther there: a silhouette sampling artifact",
-            rgb(FARTHER_COLOR),
+            rgb(OCCLUSION_FARTHER_COLOR),
         ),
     ]
     .into_iter()
@@ -352,7 +395,7 @@ pub fn remap_occlusion(ctx: &Context) -> Result<Canvas> {
     {
         let y = y0 + i as f32 * 20.0;
         c.fill_rect((14.0, y + 2.0), (28.0, y + 16.0), color, 255);
-        c.text(36.0, y, SMALL, label, INK, Align::Left);
+        c.text(36.0, y, SMALL, label, INK, TextAlign::Left);
     }
     Ok(c)
 }

@@ -2,13 +2,13 @@
 //! renderer uses — the rig's matrices and frusta, [`ParallaxRig::parallax`], the anaglyph
 //! matrices, the remapper, the ChromaDepth texgen, ramp and glasses, the SIRDS disparity
 //! models and strip renderer, the rasterizer's fixed-point setup — never a copy of a formula.
-//! Labels, tick values, units and legends are drawn in the shipped font ([`stereolab_core::text`]).
+//! Labels, tick values, units and legends are drawn in the shipped font ([`caption`](stereolab_core::caption), [`draw_text_rgba`](stereolab_core::draw_text_rgba)).
 //!
 //! `stereolab figures SCENE --out slides/figures` writes them all; `tests/figures.rs` checks
 //! that the committed PNGs are byte for byte what this code draws, and that plotted curves
 //! agree with what the renderer measures.
 //!
-//! [`ParallaxRig::parallax`]: stereolab_core::effects::parallax::ParallaxRig::parallax
+//! [`ParallaxRig::parallax`]: stereolab_core::ParallaxRig::parallax
 
 pub mod bench;
 pub mod canvas;
@@ -28,7 +28,7 @@ pub use perception::{parallax_curve, parallax_types_geometry};
 pub use rig::vertical_parallax_grid;
 
 use stereolab::scene::Scene;
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 
 /// What a figure is drawn from: the course scene, and measured benchmark rows for the
 /// accuracy-against-time plot.
@@ -139,7 +139,7 @@ pub fn write_all(ctx: &Context, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut paths = Vec::new();
     for (name, png) in draw_all(ctx)? {
         let path = dir.join(name);
-        stereolab_core::files::write_bytes(&path, &png)?;
+        stereolab_core::write_bytes(&path, &png)?;
         paths.push(path);
     }
     Ok(paths)

@@ -7,10 +7,10 @@ use super::canvas::{Axes, Canvas, GRAY, INK, LABEL, LEFT, RIGHT, SMALL};
 use super::thumbs::{image_of, rendered};
 use stereolab::plan::{Output, View};
 use stereolab::scene::Scene;
-use stereolab_core::effects::parallax::{PARALLAX_BUDGET_PERCENT, ParallaxRig, budget_of};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::{CameraMode, StereoRig};
-use stereolab_core::text::Align;
+use stereolab_core::{
+    CameraMode, Error, PARALLAX_BUDGET_PERCENT, ParallaxRig, Result, StereoRig, TextAlign,
+    parallax_budget_of,
+};
 
 /// The curve of the `parallax_vs_depth` figure: `steps + 1` points `(z, p)` from near to far, `p` the
 /// screen parallax of a point at eye distance z in percent of the image width. It is the
@@ -70,7 +70,7 @@ fn eyes_and_point(c: &mut Canvas, frame: (f32, f32, f32, f32), z: f64, xl: f64, 
     let (l, _, r, _) = frame;
     let (_, sy) = a.px(0.0, z0);
     c.line((l, sy), (r, sy), INK, 2.5);
-    c.text(l + 2.0, sy + 3.0, SMALL, "screen", INK, Align::Left);
+    c.text(l + 2.0, sy + 3.0, SMALL, "screen", INK, TextAlign::Left);
     for (ex, sx, rgb) in [(-d / 2.0, xl, LEFT), (d / 2.0, xr, RIGHT)] {
         // The ray from the eye through its image point on the screen, on to the point.
         // The ray runs on to the point, or to the screen when the point is in front of it.
@@ -86,7 +86,7 @@ fn eyes_and_point(c: &mut Canvas, frame: (f32, f32, f32, f32), z: f64, xl: f64, 
         SMALL,
         "L",
         LEFT,
-        Align::Center,
+        TextAlign::Center,
     );
     c.text(
         a.px(d / 2.0, 0.0).0,
@@ -94,7 +94,7 @@ fn eyes_and_point(c: &mut Canvas, frame: (f32, f32, f32, f32), z: f64, xl: f64, 
         SMALL,
         "R",
         RIGHT,
-        Align::Center,
+        TextAlign::Center,
     );
     c.dot(a.px(0.0, z), 5.0, INK);
 }
@@ -119,7 +119,7 @@ pub fn parallax_types(_: &Context) -> Result<Canvas> {
         let x0 = 10.0 + i as f32 * 258.0;
         let frame = (x0, 40.0, x0 + 240.0, 340.0);
         eyes_and_point(&mut c, frame, z, xl, xr);
-        c.text(x0 + 120.0, 10.0, LABEL, title, INK, Align::Center);
+        c.text(x0 + 120.0, 10.0, LABEL, title, INK, TextAlign::Center);
         let p = xr - xl;
         c.text(
             x0 + 120.0,
@@ -131,7 +131,7 @@ pub fn parallax_types(_: &Context) -> Result<Canvas> {
             )
             .replace('-', "−"),
             INK,
-            Align::Center,
+            TextAlign::Center,
         );
     }
     c.text(
@@ -140,7 +140,7 @@ pub fn parallax_types(_: &Context) -> Result<Canvas> {
         SMALL,
         "p(z) = d (1 − z0/z) from ParallaxRig::parallax; schematic rig: d = 1, z0 = 4, points at z = 7, 4, 2.5",
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
@@ -179,7 +179,7 @@ pub fn vergence_accommodation(_: &Context) -> Result<Canvas> {
         SMALL,
         &format!("eyes converge here: z = {z}"),
         INK,
-        Align::Left,
+        TextAlign::Left,
     );
     c.text(
         a.px(0.0, z0).0,
@@ -187,7 +187,7 @@ pub fn vergence_accommodation(_: &Context) -> Result<Canvas> {
         SMALL,
         &format!("eyes focus here: the screen, z0 = {z0}"),
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     c.text(
         280.0,
@@ -195,7 +195,7 @@ pub fn vergence_accommodation(_: &Context) -> Result<Canvas> {
         SMALL,
         "negative parallax: the two distances differ (the conflict grows with |p|)",
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
@@ -264,7 +264,7 @@ pub fn parallax_vs_depth(ctx: &Context) -> Result<Canvas> {
         SMALL,
         &format!("z0 = {z0:.2}"),
         GRAY,
-        Align::Left,
+        TextAlign::Left,
     );
     c.boxed_text(
         a.px(far, budget).0 - 6.0,
@@ -272,7 +272,7 @@ pub fn parallax_vs_depth(ctx: &Context) -> Result<Canvas> {
         SMALL,
         "±3% budget",
         (40, 120, 40),
-        Align::Right,
+        TextAlign::Right,
     );
     for (_, pts, rgb) in &curves {
         a.curve(&mut c, pts, *rgb, 2.0);
@@ -291,7 +291,7 @@ pub fn parallax_vs_depth(ctx: &Context) -> Result<Canvas> {
             r.eye_separation, scene.width, scene.height
         ),
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
@@ -307,7 +307,7 @@ pub fn parallax_map(ctx: &Context) -> Result<Canvas> {
     let fb = frame
         .view(View::Left)
         .ok_or_else(|| Error::internal("figures", "no left pass"))?;
-    let b = budget_of(fb, &s.parallax_rig()?)?;
+    let b = parallax_budget_of(fb, &s.parallax_rig()?)?;
     let caption = format!(
         "measured: {:+.2}% … {:+.2}% of the width; {:.1}% of pixels beyond ±3%",
         b.percent(b.min_pixels),
@@ -316,7 +316,7 @@ pub fn parallax_map(ctx: &Context) -> Result<Canvas> {
     )
     .replace('-', "−");
     let width =
-        (stereolab_core::text::width(&caption, SMALL).ceil() as u32 + 24).max(img.width() + 20);
+        (stereolab_core::text_width(&caption, SMALL).ceil() as u32 + 24).max(img.width() + 20);
     let mut c = Canvas::new(width, img.height() + 40)?;
     c.image(&img, (width - img.width()) / 2, 10, 1);
     c.text(
@@ -325,7 +325,7 @@ pub fn parallax_map(ctx: &Context) -> Result<Canvas> {
         SMALL,
         &caption,
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }

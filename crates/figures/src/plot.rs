@@ -5,8 +5,7 @@
 //! error and time, and [`knob_plot`] draws it with this module's [`Canvas`].
 
 use super::canvas::{Canvas, GRAY, INK, LABEL, Rgb, SMALL, nice_step, tick_label};
-use stereolab_core::error::Result;
-use stereolab_core::text::{self, Align};
+use stereolab_core::{Result, TextAlign, text_width};
 
 /// One measured setting of a knob.
 #[derive(Clone, Debug, PartialEq)]
@@ -154,7 +153,14 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
         let x = l + (v / x_max) as f32 * (r - l);
         c.line((x, t), (x, b), (232, 232, 232), 1.0);
         c.line((x, b), (x, b + 5.0), INK, 1.0);
-        c.text(x, b + 7.0, SMALL, &tick_label(v, xs), INK, Align::Center);
+        c.text(
+            x,
+            b + 7.0,
+            SMALL,
+            &tick_label(v, xs),
+            INK,
+            TextAlign::Center,
+        );
         v += xs;
     }
     let mut y_ticks: Vec<(f32, String)> = Vec::new();
@@ -185,8 +191,8 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
     for (y, s) in &y_ticks {
         c.line((l, *y), (r, *y), (232, 232, 232), 1.0);
         c.line((l - 5.0, *y), (l, *y), INK, 1.0);
-        c.text(l - 8.0, y - SMALL * 0.6, SMALL, s, INK, Align::Right);
-        widest = widest.max(text::width(s, SMALL));
+        c.text(l - 8.0, y - SMALL * 0.6, SMALL, s, INK, TextAlign::Right);
+        widest = widest.max(text_width(s, SMALL));
     }
     c.rect((l, t), (r, b), INK, 1.0);
     c.text(
@@ -195,7 +201,7 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
         LABEL,
         &format!("median time ({unit}), {}", knob.time_unit),
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     let y_label = if matches!(ys, YScale::Log { .. }) {
         format!("{} (log scale)", knob.error_unit)
@@ -209,7 +215,7 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
         &y_label,
         INK,
     );
-    c.text(l, 14.0, LABEL + 2.0, &knob.title, INK, Align::Left);
+    c.text(l, 14.0, LABEL + 2.0, &knob.title, INK, TextAlign::Left);
     // The front as a staircase (fastest first: each step is more accurate and slower).
     let front = knob.front();
     let mut on: Vec<usize> = valid.iter().copied().filter(|&i| front[i]).collect();
@@ -249,7 +255,14 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
         }
         placed.push(at);
         let color = if front[i] { FRONT } else { INK };
-        c.boxed_text(at.0, at.1, SMALL, &(n + 1).to_string(), color, Align::Left);
+        c.boxed_text(
+            at.0,
+            at.1,
+            SMALL,
+            &(n + 1).to_string(),
+            color,
+            TextAlign::Left,
+        );
     }
     // The key: number, setting, on the front or not.
     let kx = r + 24.0;
@@ -259,7 +272,7 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
         SMALL,
         "settings (filled: Pareto front)",
         INK,
-        Align::Left,
+        TextAlign::Left,
     );
     for (n, &i) in valid.iter().enumerate() {
         let y = t + 16.0 + n as f32 * (SMALL + 5.0);
@@ -269,21 +282,21 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
             (GRAY, "○")
         };
         let label = &knob.points[i].label;
-        let label = if text::width(label, SMALL) > 300.0 {
+        let label = if text_width(label, SMALL) > 300.0 {
             let mut s: String = label.chars().take(40).collect();
             s.push('…');
             s
         } else {
             label.clone()
         };
-        c.text(kx, y, SMALL, mark, color, Align::Left);
+        c.text(kx, y, SMALL, mark, color, TextAlign::Left);
         c.text(
             kx + 16.0,
             y,
             SMALL,
             &format!("{}  {label}", n + 1),
             INK,
-            Align::Left,
+            TextAlign::Left,
         );
     }
     let skipped = knob.points.len() - valid.len();
@@ -295,7 +308,7 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
             SMALL,
             &format!("{skipped} setting(s) not measured"),
             GRAY,
-            Align::Left,
+            TextAlign::Left,
         );
     }
     c.text(
@@ -304,7 +317,7 @@ pub fn knob_plot(knob: &Knob) -> Result<Canvas> {
         SMALL,
         "Pareto front: no other setting is both at least as fast and at least as accurate",
         GRAY,
-        Align::Left,
+        TextAlign::Left,
     );
     Ok(c)
 }

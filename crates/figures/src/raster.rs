@@ -3,10 +3,10 @@
 
 use super::Context;
 use super::canvas::{Canvas, GRAY, INK, LABEL, LEFT, RIGHT, SMALL};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::raster::{RasterOptions, Setup, SetupTriangle, WindowVertex, setup_triangle};
-use stereolab_core::shade::{MAX_VARYINGS, Varyings};
-use stereolab_core::text::Align;
+use stereolab_core::{
+    Error, MAX_VARYINGS, RasterOptions, Result, SetupTriangle, TextAlign, TriangleSetup, Varyings,
+    WindowVertex, setup_triangle,
+};
 
 /// The grid the figure draws: `W`×`H` pixels.
 pub const GRID: (u32, u32) = (10, 8);
@@ -41,7 +41,7 @@ pub fn setup(tri: [(f32, f32); 3]) -> Result<SetupTriangle> {
         GRID.1,
         &RasterOptions::default(),
     ) {
-        Setup::Triangle(t) => Ok(t),
+        TriangleSetup::Triangle(t) => Ok(t),
         _ => Err(Error::internal(
             "figures",
             "the figure's triangle set up empty",
@@ -103,7 +103,7 @@ pub fn top_left(_: &Context) -> Result<Canvas> {
         LABEL,
         "A",
         LEFT,
-        Align::Left,
+        TextAlign::Left,
     );
     c.text(
         px(6.7, 2.65).0,
@@ -111,7 +111,7 @@ pub fn top_left(_: &Context) -> Result<Canvas> {
         LABEL,
         "B",
         RIGHT,
-        Align::Left,
+        TextAlign::Left,
     );
     c.text(
         ox,
@@ -119,7 +119,7 @@ pub fn top_left(_: &Context) -> Result<Canvas> {
         LABEL,
         "pixel centers at +0.5; window y down",
         INK,
-        Align::Left,
+        TextAlign::Left,
     );
     let x = ox + GRID.0 as f32 * cell + 20.0;
     // Who gets the pixel centers on each edge, read back from the coverage test.
@@ -157,7 +157,7 @@ pub fn top_left(_: &Context) -> Result<Canvas> {
         ("64-bit integer edge tests".to_string(), GRAY),
     ];
     for (i, (s, rgb)) in lines.iter().enumerate() {
-        c.text(x, 44.0 + 21.0 * i as f32, SMALL, s, *rgb, Align::Left);
+        c.text(x, 44.0 + 21.0 * i as f32, SMALL, s, *rgb, TextAlign::Left);
     }
     Ok(c)
 }

@@ -7,9 +7,7 @@ use glam::Vec3;
 use super::Context;
 use super::canvas::{Axes, Canvas, GRAY, INK, LABEL, LEFT, RIGHT, SMALL};
 use stereolab::scene::Scene;
-use stereolab_core::error::Result;
-use stereolab_core::math::{CameraMode, StereoRig, project_ndc};
-use stereolab_core::text::Align;
+use stereolab_core::{CameraMode, Result, StereoRig, TextAlign, project_ndc};
 
 /// Draws the top view of `mode`'s frusta into the page box `frame`: eye space of the cyclopean
 /// camera, x right, −z up the page, out to twice z0.
@@ -60,9 +58,9 @@ fn top_view(
         c.dashed(p(origin.x, origin.z), p(end.x, end.z), rgb, 1.0);
         c.dot(p(origin.x, origin.z), 4.0, rgb);
         let (label, align, dx) = if i == 0 {
-            ("left eye", Align::Right, -4.0)
+            ("left eye", TextAlign::Right, -4.0)
         } else {
-            ("right eye", Align::Left, 4.0)
+            ("right eye", TextAlign::Left, 4.0)
         };
         c.text(
             p(origin.x, origin.z).0 + dx,
@@ -79,7 +77,7 @@ fn top_view(
         SMALL,
         &format!("near n = {n}"),
         GRAY,
-        Align::Right,
+        TextAlign::Right,
     );
     c.boxed_text(
         rr - 4.0,
@@ -87,7 +85,7 @@ fn top_view(
         SMALL,
         &format!("zero parallax z0 = {z0:.2}"),
         INK,
-        Align::Right,
+        TextAlign::Right,
     );
     let (el, er) = (eyes[0].eye_world, eyes[1].eye_world);
     let iod = (er - el).length();
@@ -97,7 +95,7 @@ fn top_view(
         SMALL,
         &format!("d (IOD) = {iod:.3}"),
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     c.rect((l, t), (rr, b + 42.0), (200, 200, 200), 1.0);
     Ok(())
@@ -105,7 +103,7 @@ fn top_view(
 
 fn single(ctx: &Context, mode: CameraMode, title: &str) -> Result<Canvas> {
     let mut c = Canvas::new(480, 540)?;
-    c.text(240.0, 8.0, LABEL, title, INK, Align::Center);
+    c.text(240.0, 8.0, LABEL, title, INK, TextAlign::Center);
     top_view(&mut c, (10.0, 34.0, 470.0, 494.0), ctx.scene, mode)?;
     Ok(c)
 }
@@ -152,8 +150,15 @@ pub fn parallel(ctx: &Context) -> Result<Canvas> {
 /// Invalid rig.
 pub fn shear_vs_rotate(ctx: &Context) -> Result<Canvas> {
     let mut c = Canvas::new(900, 540)?;
-    c.text(225.0, 8.0, LABEL, "shear (off-axis)", INK, Align::Center);
-    c.text(675.0, 8.0, LABEL, "rotate (toe-in)", INK, Align::Center);
+    c.text(
+        225.0,
+        8.0,
+        LABEL,
+        "shear (off-axis)",
+        INK,
+        TextAlign::Center,
+    );
+    c.text(675.0, 8.0, LABEL, "rotate (toe-in)", INK, TextAlign::Center);
     top_view(
         &mut c,
         (10.0, 34.0, 440.0, 494.0),
@@ -249,14 +254,14 @@ pub fn toe_in_vertical_parallax(ctx: &Context) -> Result<Canvas> {
             1.0,
         );
         let worst = map.iter().fold(0.0f32, |m, v| m.max(v.abs()));
-        c.text(x0 + 160.0, 8.0, LABEL, name, INK, Align::Center);
+        c.text(x0 + 160.0, 8.0, LABEL, name, INK, TextAlign::Center);
         c.text(
             x0 + 160.0,
             y0 + rows as f32 * cell + 6.0,
             SMALL,
             &format!("max |y_R − y_L| = {worst:.2} px"),
             INK,
-            Align::Center,
+            TextAlign::Center,
         );
     }
     // Color bar.
@@ -276,7 +281,7 @@ pub fn toe_in_vertical_parallax(ctx: &Context) -> Result<Canvas> {
         SMALL,
         &format!("+{scale:.1}"),
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     c.text(
         bx + 7.0,
@@ -284,7 +289,7 @@ pub fn toe_in_vertical_parallax(ctx: &Context) -> Result<Canvas> {
         SMALL,
         &format!("−{scale:.1}"),
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     c.text(
         370.0,
@@ -295,7 +300,7 @@ pub fn toe_in_vertical_parallax(ctx: &Context) -> Result<Canvas> {
             ctx.scene.width, ctx.scene.height
         ),
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     c.text(
         370.0,
@@ -303,7 +308,7 @@ pub fn toe_in_vertical_parallax(ctx: &Context) -> Result<Canvas> {
         SMALL,
         "projected through both eyes' MVP matrices (StereoRig::eyes); red: the right eye's image is higher",
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }

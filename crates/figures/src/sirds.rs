@@ -7,17 +7,15 @@ use super::thumbs::{grid, rendered};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::Output;
 use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
-use stereolab_core::effects::sirds::{DisparityModel, Filter, Geometry, Start};
-use stereolab_core::error::Result;
-use stereolab_core::text::Align;
+use stereolab_core::{DisparityModel, Result, SirdsGeometry, StripFilter, StripStart, TextAlign};
 
 /// The SIRDS paper's Fig. 1–3 with TIW's set-up: two surface points, the rays to both eyes,
-/// and the two linked pixels on the image plane, `d` apart ([`stereolab_core::effects::sirds::Disparity::separation`]).
+/// and the two linked pixels on the image plane, `d` apart ([`stereolab_core::Disparity::separation`]).
 ///
 /// # Errors
 /// Invalid geometry.
 pub fn linked_pixels(_: &Context) -> Result<Canvas> {
-    let g = Geometry::default();
+    let g = SirdsGeometry::default();
     let d = g.to_pixels()?;
     let (a, f) = (f64::from(d.eye_separation), f64::from(d.viewing_distance));
     let mut c = Canvas::new(760, 440)?;
@@ -31,7 +29,14 @@ pub fn linked_pixels(_: &Context) -> Result<Canvas> {
     let plane = ax.px(0.0, 0.0).1;
     let back = ax.px(0.0, -f64::from(d.t_far)).1;
     c.line((l, plane), (r, plane), INK, 2.5);
-    c.text(r + 6.0, plane - 8.0, SMALL, "image plane", INK, Align::Left);
+    c.text(
+        r + 6.0,
+        plane - 8.0,
+        SMALL,
+        "image plane",
+        INK,
+        TextAlign::Left,
+    );
     c.dashed((l, back), (r, back), GRAY, 1.0);
     c.text(
         r + 6.0,
@@ -39,7 +44,7 @@ pub fn linked_pixels(_: &Context) -> Result<Canvas> {
         SMALL,
         "background z = 0",
         GRAY,
-        Align::Left,
+        TextAlign::Left,
     );
     let front = ax.px(0.0, -f64::from(d.t_near)).1;
     c.dashed((l, front), (r, front), GRAY, 1.0);
@@ -49,7 +54,7 @@ pub fn linked_pixels(_: &Context) -> Result<Canvas> {
         SMALL,
         "front z = 1",
         GRAY,
-        Align::Left,
+        TextAlign::Left,
     );
     let eyes = [(-a / 2.0, LEFT, "L"), (a / 2.0, RIGHT, "R")];
     for (ex, rgb, name) in eyes {
@@ -60,7 +65,7 @@ pub fn linked_pixels(_: &Context) -> Result<Canvas> {
             SMALL,
             name,
             rgb,
-            Align::Center,
+            TextAlign::Center,
         );
     }
     for (z, x) in [(0.3f32, -60.0f64), (0.9, 70.0)] {
@@ -81,7 +86,7 @@ pub fn linked_pixels(_: &Context) -> Result<Canvas> {
             SMALL,
             &format!("z = {z}"),
             INK,
-            Align::Left,
+            TextAlign::Left,
         );
         let y = plane - 26.0;
         c.dimension(
@@ -95,7 +100,7 @@ pub fn linked_pixels(_: &Context) -> Result<Canvas> {
             SMALL,
             &format!("d = {sep:.1} px"),
             INK,
-            Align::Center,
+            TextAlign::Center,
         );
     }
     let x_dim = l - 40.0;
@@ -124,7 +129,7 @@ pub fn linked_pixels(_: &Context) -> Result<Canvas> {
             g.viewing_distance_in, g.dpi
         ),
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
@@ -135,7 +140,7 @@ pub fn linked_pixels(_: &Context) -> Result<Canvas> {
 /// # Errors
 /// Invalid geometry.
 pub fn disparity_models(_: &Context) -> Result<Canvas> {
-    let g = Geometry::default();
+    let g = SirdsGeometry::default();
     let models = [
         (
             DisparityModel::EyeDistance,
@@ -150,7 +155,7 @@ pub fn disparity_models(_: &Context) -> Result<Canvas> {
     ];
     let mut curves = Vec::new();
     for (model, name, rgb) in models {
-        let d = Geometry { model, ..g }.to_pixels()?;
+        let d = SirdsGeometry { model, ..g }.to_pixels()?;
         let pts: Vec<(f64, f64)> = (0..=100)
             .map(|i| {
                 let z = i as f32 / 100.0;
@@ -193,7 +198,7 @@ pub fn disparity_models(_: &Context) -> Result<Canvas> {
             g.eye_separation_in, g.viewing_distance_in, g.depth_near_in, g.depth_far_in, g.dpi
         ),
         GRAY,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
@@ -205,7 +210,7 @@ pub fn disparity_models(_: &Context) -> Result<Canvas> {
 /// A render error.
 pub fn passes(ctx: &Context) -> Result<Canvas> {
     let (s, frame) = rendered(ctx.scene, 400, 200, &[Output::Sirds], |s| {
-        s.sirds.per_vertex.start = Start::Left;
+        s.sirds.per_vertex.start = StripStart::Left;
     })?;
     let (depth, range) = scene_depth(&frame, &s)?;
     let d = s.sirds.geometry.to_pixels()?;
@@ -236,7 +241,7 @@ pub fn passes(ctx: &Context) -> Result<Canvas> {
         LABEL,
         "nearness z (depth pass)",
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     c.text(
         24.0 + s.width as f32 * 1.5,
@@ -244,7 +249,7 @@ pub fn passes(ctx: &Context) -> Result<Canvas> {
         LABEL,
         &format!("SIRDS: k = {} strips of {} px", r.iterations, r.strip_width),
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     c.image(&depth_img, 12, 30, 1);
     let x0 = 24 + s.width;
@@ -259,7 +264,7 @@ pub fn passes(ctx: &Context) -> Result<Canvas> {
             SMALL,
             &format!("{}", i + 1),
             INK,
-            Align::Center,
+            TextAlign::Center,
         );
     }
     c.text(
@@ -268,7 +273,7 @@ pub fn passes(ctx: &Context) -> Result<Canvas> {
         SMALL,
         "strip 1 is the random pattern; pass i renders the scene shifted by d/2 (vertex right, texture",
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     c.text(
         c.width() / 2.0,
@@ -279,14 +284,14 @@ pub fn passes(ctx: &Context) -> Result<Canvas> {
             d.min_separation()
         ),
         INK,
-        Align::Center,
+        TextAlign::Center,
     );
     Ok(c)
 }
 
 fn sirds_variants(
     ctx: &Context,
-    variants: &[(&str, Start, Filter)],
+    variants: &[(&str, StripStart, StripFilter)],
     crop: Option<(u32, u32, u32, u32)>,
     scale: u32,
 ) -> Result<Canvas> {
@@ -315,8 +320,12 @@ pub fn start(ctx: &Context) -> Result<Canvas> {
     sirds_variants(
         ctx,
         &[
-            ("start = \"left\"", Start::Left, Filter::Bilinear),
-            ("start = \"center\"", Start::Center, Filter::Bilinear),
+            ("start = \"left\"", StripStart::Left, StripFilter::Bilinear),
+            (
+                "start = \"center\"",
+                StripStart::Center,
+                StripFilter::Bilinear,
+            ),
         ],
         None,
         1,
@@ -331,8 +340,16 @@ pub fn filter(ctx: &Context) -> Result<Canvas> {
     sirds_variants(
         ctx,
         &[
-            ("filter = \"nearest\" (3×)", Start::Left, Filter::Nearest),
-            ("filter = \"bilinear\" (3×)", Start::Left, Filter::Bilinear),
+            (
+                "filter = \"nearest\" (3×)",
+                StripStart::Left,
+                StripFilter::Nearest,
+            ),
+            (
+                "filter = \"bilinear\" (3×)",
+                StripStart::Left,
+                StripFilter::Bilinear,
+            ),
         ],
         Some((200, 60, 80, 60)),
         3,

@@ -8,8 +8,7 @@ use stereolab::output::produce;
 use stereolab::plan::{Output, Plan};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
-use stereolab_core::error::Result;
-use stereolab_core::text::Align;
+use stereolab_core::{Result, TextAlign};
 
 /// The course scene at `width`×`height`, edited by `edit`, rendered for `outputs`.
 ///
@@ -61,7 +60,7 @@ pub fn grid(cells: &[(String, RgbaImage)], cols: usize, scale: u32) -> Result<Ca
             LABEL,
             caption,
             INK,
-            Align::Center,
+            TextAlign::Center,
         );
         c.image(img, x, y + cap, scale);
     }

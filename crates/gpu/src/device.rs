@@ -3,14 +3,14 @@
 use std::collections::HashMap;
 use std::sync::Mutex;
 
-use stereolab_core::error::Result;
+use stereolab_core::Result;
 
 use super::gpu_error;
 use super::readback::Target;
 use super::resources::{fragment_texture_entry, fragment_uniform_entry};
 
 /// Which pipeline a scene pass needs: its shading and the rasterizer options that change
-/// fixed-function state or the shader (see [`stereolab_core::raster::RasterOptions`]).
+/// fixed-function state or the shader (see [`stereolab_core::RasterOptions`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct PipelineKey {
     /// A color stage (Blinn-Phong or ChromaDepth: true) or depth only.

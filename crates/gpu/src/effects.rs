@@ -10,15 +10,11 @@
 use glam::{DMat4, Mat4};
 use image::RgbaImage;
 
-use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions};
-use stereolab_core::effects::eye_input::check_same_size;
-use stereolab_core::effects::occlusion::{
-    BACKGROUND_COLOR, FARTHER_COLOR, OCCLUDED_COLOR, OUT_OF_VIEW_COLOR,
+use stereolab_core::{
+    AnaglyphKind, AnaglyphOptions, DEPTH_PRECISION, Error, Framebuffer, OCCLUSION_BACKGROUND_COLOR,
+    OCCLUSION_FARTHER_COLOR, OCCLUSION_OCCLUDED_COLOR, OCCLUSION_OUT_OF_VIEW_COLOR,
+    PARALLAX_BACKGROUND, ParallaxRig, Result, check_same_size,
 };
-use stereolab_core::effects::parallax::{PARALLAX_BACKGROUND, ParallaxRig};
-use stereolab_core::effects::remap::DEPTH_PRECISION;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::framebuffer::Framebuffer;
 
 use super::device::GpuRenderer;
 use super::fullscreen::FullscreenPass;
@@ -73,7 +69,7 @@ impl GpuFinalize {
         })
     }
 
-    /// The anaglyph of two eyes, as [`anaglyph::anaglyph`](stereolab_core::effects::anaglyph::anaglyph):
+    /// The anaglyph of two eyes, as [`anaglyph::anaglyph`](stereolab_core::anaglyph):
     /// `clamp(ML · left + MR · right)` on stored values or in linear light, eyes swapped on
     /// request (the host swaps the inputs, as the CPU function does).
     ///
@@ -102,7 +98,7 @@ impl GpuFinalize {
     /// Parallax in pixels per pixel of `fb` on the GPU (NaN on the background), and the image
     /// area of the parallax color image (without the legend bar, which tiny-skia draws on the
     /// CPU). The color scale is the largest |p| of the GPU's own values (at least ½ pixel,
-    /// as [`color_scale`](stereolab_core::effects::parallax::color_scale)): a reduction done on the host
+    /// as [`color_scale`](stereolab_core::parallax_color_scale)): a reduction done on the host
     /// between two runs of the pass.
     ///
     /// # Errors
@@ -136,8 +132,8 @@ impl GpuFinalize {
         Ok((first.values, colored.to_rgba_image()))
     }
 
-    /// `this` eye recolored from `other`, as [`remap_color`](stereolab_core::effects::remap::remap_color)
-    /// with [`Precision::F32Composed`](stereolab_core::effects::remap::Precision::F32Composed).
+    /// `this` eye recolored from `other`, as [`remap_color`](stereolab_core::remap_color)
+    /// with [`Precision::F32Composed`](stereolab_core::Precision::F32Composed).
     ///
     /// # Errors
     /// Different sizes, a missing or bad depth buffer, a singular MVP, or a GPU failure.
@@ -155,7 +151,7 @@ impl GpuFinalize {
     }
 
     /// Both eyes' occlusion maps side by side, as
-    /// [`occlusion_image`](stereolab_core::effects::occlusion::occlusion_image) with
+    /// [`occlusion_image`](stereolab_core::occlusion_image) with
     /// `Precision::F32Composed`. The depth extremes that scale the gray are a host reduction.
     ///
     /// # Errors
@@ -250,8 +246,8 @@ pub fn produce_wgsl(
             let (values, area) = fin.parallax(r, left, &scene.parallax_rig()?)?;
             // The same scale the pass used.
             let scale = f64::from(parallax_scale(&values));
-            let legend = stereolab_core::effects::legend::draw_legend(left.width(), scale, &|p| {
-                stereolab_core::effects::parallax::parallax_color(p, scale)
+            let legend = stereolab_core::draw_legend(left.width(), scale, &|p| {
+                stereolab_core::parallax_color(p, scale)
             })?;
             let mut bytes = area.into_raw();
             // The window violations, marked on the host from the GPU's own values.
@@ -259,14 +255,9 @@ pub fn produce_wgsl(
                 .iter()
                 .map(|v| (!v.is_nan()).then_some(f64::from(*v)))
                 .collect();
-            let marks = stereolab_core::effects::parallax::window_violation_marks(
-                &map,
-                left.width(),
-                left.height(),
-            );
+            let marks = stereolab_core::window_violation_marks(&map, left.width(), left.height());
             for i in marks {
-                bytes[4 * i..4 * i + 4]
-                    .copy_from_slice(&stereolab_core::effects::parallax::VIOLATION_COLOR);
+                bytes[4 * i..4 * i + 4].copy_from_slice(&stereolab_core::PARALLAX_VIOLATION_COLOR);
             }
             bytes.extend_from_slice(legend.data());
             RgbaImage::from_raw(left.width(), left.height() + legend.height(), bytes)
@@ -278,7 +269,7 @@ pub fn produce_wgsl(
 
 /// The parallax color scale from the GPU's own parallax values (NaN on the background): the
 /// largest |p|, at least half a pixel, as
-/// [`color_scale`](stereolab_core::effects::parallax::color_scale) on the CPU.
+/// [`color_scale`](stereolab_core::parallax_color_scale) on the CPU.
 fn parallax_scale(values: &[f32]) -> f32 {
     values
         .iter()
@@ -310,10 +301,10 @@ pub(super) fn remap_params(
     let mut p: Vec<f32> = composed.as_mat4().to_cols_array().to_vec();
     p.extend([mode, DEPTH_PRECISION as f32, near, far]);
     for c in [
-        BACKGROUND_COLOR,
-        OUT_OF_VIEW_COLOR,
-        OCCLUDED_COLOR,
-        FARTHER_COLOR,
+        OCCLUSION_BACKGROUND_COLOR,
+        OCCLUSION_OUT_OF_VIEW_COLOR,
+        OCCLUSION_OCCLUDED_COLOR,
+        OCCLUSION_FARTHER_COLOR,
     ] {
         p.extend(unit_color(c));
     }

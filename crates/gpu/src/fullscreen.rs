@@ -5,8 +5,7 @@
 
 use std::fmt::Write as _;
 
-use stereolab_core::error::{Error, Result};
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::{Error, Framebuffer, Result};
 
 use super::device::GpuRenderer;
 use super::gpu_error;

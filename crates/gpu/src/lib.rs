@@ -9,7 +9,7 @@
 //! - wgpu's NDC has y = +1 at the top row (wgpu itself gives Vulkan a negative viewport height),
 //!   exactly as the CPU viewport `y_win = (y/w)·(−H/2) + H/2`: nothing is flipped here;
 //! - color targets are `Rgba8Unorm` without sRGB; shaders quantize like
-//!   [`to_rgba8`](stereolab_core::shade::to_rgba8) so the unorm store is exact;
+//!   [`to_rgba8`](stereolab_core::to_rgba8) so the unorm store is exact;
 //! - depth is `Depth32Float`, read back bit for bit.
 //!
 //! Layout: [`device`] (adapter, device, pipeline cache), [`raster`] (scene passes),
@@ -77,7 +77,7 @@ mod tests {
 
     #[test]
     fn depth_remap_keeps_x_y_w_of_a_projection_bit_for_bit() {
-        let p = stereolab_core::math::frustum(-0.7, 0.55, -0.4, 0.45, 1.3, 17.0);
+        let p = stereolab_core::frustum(-0.7, 0.55, -0.4, 0.45, 1.3, 17.0);
         let q = GL_TO_WGPU_DEPTH * p;
         for c in 0..4 {
             for r in [0, 1, 3] {

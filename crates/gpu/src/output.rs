@@ -7,7 +7,7 @@ use stereolab::output::{Image, produce, write_all_with};
 use stereolab::plan::Output;
 use stereolab::render::Frame;
 use stereolab::scene::Scene;
-use stereolab_core::error::Result;
+use stereolab_core::Result;
 
 use super::device::GpuRenderer;
 use super::sirds::GpuStrips;

@@ -10,11 +10,7 @@ use stereolab::output::{Image, produce};
 use stereolab::plan::{Output, Plan, View};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
-use stereolab_core::effects::anaglyph;
-use stereolab_core::effects::occlusion::occlusion_image;
-use stereolab_core::effects::parallax::parallax_image;
-use stereolab_core::effects::remap::{Precision, remap_color};
-use stereolab_core::error::Result;
+use stereolab_core::{Precision, Result, anaglyph, occlusion_image, parallax_image, remap_color};
 
 use super::device::GpuRenderer;
 use super::effects::GpuFinalize;
@@ -86,7 +82,7 @@ pub fn compare_finalize(
     for &o in &frame.plan.outputs {
         let (cpu, gpu) = match o {
             Output::Anaglyph(kind) => (
-                anaglyph::anaglyph(left, right, kind, scene.finalize)?,
+                anaglyph(left, right, kind, scene.finalize)?,
                 fin.anaglyph(r, left, right, kind, scene.finalize)?,
             ),
             Output::RemapLeft | Output::RemapRight => {

@@ -9,20 +9,16 @@ use stereolab::plan::{Pass, Plan, Shading};
 use stereolab::render::chromadepth::resolve_texgen;
 use stereolab::render::{Frame, PassResult, ViewMatrices};
 use stereolab::scene::{Object, Scene};
-use stereolab_core::effects::chromadepth::TexgenMode;
-use stereolab_core::effects::chromadepth::ramp::{Ramp, Sampling};
-use stereolab_core::effects::chromadepth::texgen::Texgen;
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::EyeMatrices;
-use stereolab_core::raster::{RasterOptions, RasterStats};
-use stereolab_core::shade::BlinnPhong;
+use stereolab_core::{
+    BlinnPhong, EyeMatrices, Framebuffer, Ramp, RampSampling, RasterOptions, RasterStats, Result,
+    Texgen, TexgenMode,
+};
 
 use super::device::{FusedEye, GpuRenderer, PipelineKey};
 use super::readback::{COLOR_FORMAT, DepthKind, Readback, Target, submit_and_read};
 use super::resources::{buffer_with, clear_color};
 
-/// The mirror of [`BlinnPhong`](stereolab_core::shade::BlinnPhong).
+/// The mirror of [`BlinnPhong`](stereolab_core::BlinnPhong).
 const BLINN_PHONG_WGSL: &str = concat!(
     include_str!("shaders/common.wgsl"),
     include_str!("shaders/blinn_phong.wgsl")
@@ -50,7 +46,7 @@ pub(crate) struct Fused<'a> {
     pub clear: wgpu::Color,
 }
 
-/// The mirror of [`DepthOnly`](stereolab_core::shade::DepthOnly).
+/// The mirror of [`DepthOnly`](stereolab_core::DepthOnly).
 const DEPTH_ONLY_WGSL: &str = include_str!("shaders/depth_only.wgsl");
 
 /// Interleaved position + normal, 6 × f32.
@@ -87,7 +83,7 @@ impl<'a> GpuScene<'a> {
                 "the GPU snaps to its own fixed 8 subpixel bits",
             ));
         }
-        if scene.raster.depth != stereolab_core::raster::DepthMode::Standard {
+        if scene.raster.depth != stereolab_core::DepthMode::Standard {
             return Err(stereolab_core::Error::invalid(
                 "raster.depth",
                 scene.raster.depth.name(),
@@ -470,7 +466,7 @@ fn chromadepth_uniforms(o: &Object, m: &EyeMatrices, texgen: Texgen, s: &Scene) 
     f.extend(light_eye.to_array());
     f.push(s.light.ambient);
     f.extend(texgen.plane.to_array());
-    let flags = u32::from(settings.sampling == Sampling::Linear)
+    let flags = u32::from(settings.sampling == RampSampling::Linear)
         | (u32::from(settings.texgen == TexgenMode::PerPixel) << 1)
         | (u32::from(settings.lit) << 2);
     f.extend([

@@ -6,8 +6,7 @@ use std::sync::mpsc;
 use image::RgbaImage;
 use rayon::prelude::*;
 
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::{Framebuffer, Result};
 
 use super::device::GpuRenderer;
 use super::gpu_error;

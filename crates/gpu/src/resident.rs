@@ -13,9 +13,7 @@ use image::RgbaImage;
 
 use stereolab::plan::{Output, Plan, Shading, View};
 use stereolab::scene::Scene;
-use stereolab_core::effects::anaglyph::{AnaglyphKind, AnaglyphOptions};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::EyeMatrices;
+use stereolab_core::{AnaglyphKind, AnaglyphOptions, Error, EyeMatrices, Result};
 
 use super::device::GpuRenderer;
 use super::effects::{GpuFinalize, anaglyph_params, remap_params};

@@ -27,10 +27,9 @@ use std::sync::mpsc;
 use glam::Vec4;
 
 use stereolab::render::sirds_strips::{StripGeometry, StripResult, plan_strips};
-use stereolab_core::effects::sirds::per_pixel::check_inputs;
-use stereolab_core::effects::sirds::{Disparity, Pattern};
-use stereolab_core::effects::sirds::{Filter, PerVertexOptions};
-use stereolab_core::error::Result;
+use stereolab_core::{
+    Disparity, PerVertexOptions, Result, SirdsPattern, StripFilter, check_sirds_inputs,
+};
 
 use super::device::GpuRenderer;
 use super::readback::{COLOR_FORMAT, padded_row_bytes};
@@ -186,10 +185,10 @@ impl GpuStrips {
         width: u32,
         height: u32,
         d: &Disparity,
-        pattern: &Pattern,
+        pattern: &SirdsPattern,
         opts: &PerVertexOptions,
     ) -> Result<StripResult> {
-        check_inputs(width, d, pattern)?;
+        check_sirds_inputs(width, d, pattern)?;
         let strips = plan_strips(width, d, opts)?;
         r.check_target_size(width, height)?;
         let wf = width as f32;
@@ -248,7 +247,7 @@ impl GpuStrips {
         let mut uniforms = vec![0u8; slot as usize * strips.len()];
         for (k, s) in strips.iter().enumerate() {
             let at = k * slot as usize;
-            let bilinear = u32::from(opts.filter == Filter::Bilinear);
+            let bilinear = u32::from(opts.filter == StripFilter::Bilinear);
             uniforms[at..at + 4].copy_from_slice(&s.toward.to_ne_bytes());
             uniforms[at + 4..at + 8].copy_from_slice(&(s.lo as i32).to_ne_bytes());
             uniforms[at + 8..at + 12].copy_from_slice(&(s.hi as i32).to_ne_bytes());

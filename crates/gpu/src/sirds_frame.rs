@@ -8,8 +8,7 @@ use stereolab::output::sirds;
 use stereolab::plan::Output;
 use stereolab::render::Frame;
 use stereolab::scene::Scene;
-use stereolab_core::effects::sirds::{Algorithm, Sirds};
-use stereolab_core::error::Result;
+use stereolab_core::{Result, Sirds, SirdsAlgorithm};
 
 use super::device::GpuRenderer;
 use super::sirds::GpuStrips;
@@ -53,7 +52,8 @@ pub fn compare_strips(
     scene: &Scene,
     out: Option<&Path>,
 ) -> Result<Vec<Comparison>> {
-    if !frame.plan.outputs.contains(&Output::Sirds) || scene.sirds.algorithm != Algorithm::PerVertex
+    if !frame.plan.outputs.contains(&Output::Sirds)
+        || scene.sirds.algorithm != SirdsAlgorithm::PerVertex
     {
         return Ok(Vec::new());
     }

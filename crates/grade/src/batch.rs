@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use super::report::Report;
 use super::{Exercise, GradeOptions, Limits, grade, stubs_path};
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 
 /// How to grade a batch.
 #[derive(Clone, Debug)]
@@ -176,10 +176,7 @@ pub fn grade_batch(
     let mut entries = results.into_inner().unwrap_or_else(|e| e.into_inner());
     entries.sort_by(|a, b| a.name.cmp(&b.name));
     let csv_path = opts.out.join("scores.csv");
-    stereolab_core::files::write_bytes(
-        &csv_path,
-        scores_csv(&opts.exercises, &entries).as_bytes(),
-    )?;
+    stereolab_core::write_bytes(&csv_path, scores_csv(&opts.exercises, &entries).as_bytes())?;
     super::similarity::write_batch_report(
         &subs,
         &opts.exercises,
@@ -235,8 +232,8 @@ fn write_entry(out: &Path, entry: &BatchEntry, took: std::time::Duration) -> Res
     json["execution_time"] = took.as_secs().into();
     let json = serde_json::to_string_pretty(&json)
         .map_err(|e| Error::io(&dir, std::io::Error::other(e)))?;
-    stereolab_core::files::write_bytes(&dir.join("results.json"), json.as_bytes())?;
-    stereolab_core::files::write_bytes(&dir.join("report.txt"), text.as_bytes())
+    stereolab_core::write_bytes(&dir.join("results.json"), json.as_bytes())?;
+    stereolab_core::write_bytes(&dir.join("report.txt"), text.as_bytes())
 }
 
 /// A CSV field: quoted when it holds a comma, quote or line break; a field a spreadsheet would

@@ -11,7 +11,7 @@
 use std::path::Path;
 
 use super::Exercise;
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 
 /// The largest file the bundle takes from the sources (the models and scenes are far smaller).
 const MAX_FILE_BYTES: u64 = 16 << 20;
@@ -44,7 +44,7 @@ fn add_tree(root: &Path, rel: &str, files: &mut Files) -> Result<()> {
 
 fn add_file(root: &Path, rel: &str, files: &mut Files) -> Result<()> {
     let path = root.join(rel);
-    let bytes = stereolab_core::files::read_input(&path, MAX_FILE_BYTES)?;
+    let bytes = stereolab_core::read_input(&path, MAX_FILE_BYTES)?;
     files.push((format!("stereolab/{rel}"), bytes, false));
     Ok(())
 }
@@ -301,7 +301,7 @@ fn write_zip(files: &Files, out: &Path) -> Result<()> {
         zip.write_all(bytes).map_err(io(out))?;
     }
     let bytes = zip.finish().map_err(zerr)?.into_inner();
-    stereolab_core::files::write_bytes(out, &bytes)
+    stereolab_core::write_bytes(out, &bytes)
 }
 
 /// Writes `.github/workflows/classroom.yml` under `dir`.
@@ -313,7 +313,7 @@ pub fn write_classroom(dir: &Path) -> Result<std::path::PathBuf> {
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent).map_err(io(parent))?;
     }
-    stereolab_core::files::write_bytes(&path, CLASSROOM_YML.as_bytes())?;
+    stereolab_core::write_bytes(&path, CLASSROOM_YML.as_bytes())?;
     Ok(path)
 }
 

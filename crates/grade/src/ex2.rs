@@ -12,13 +12,10 @@ use super::fixture::Fixture;
 use super::spec::{Case, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use stereolab::render::chromadepth::ChromaDepthShader;
 use stereolab::scene::Scene;
-use stereolab_core::effects::chromadepth::ChromaDepthSettings;
-use stereolab_core::effects::chromadepth::ramp::{Ramp, RampKind, exact, hsv_to_rgb};
-use stereolab_core::effects::chromadepth::texgen::{Texgen, auto_range};
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::EyeMatrices;
-use stereolab_core::raster::rasterize;
-use stereolab_core::shade::to_rgba8;
+use stereolab_core::{
+    ChromaDepthSettings, EyeMatrices, Framebuffer, Ramp, RampKind, Texgen, auto_range, hsv_to_rgb,
+    ramp_exact, rasterize, to_rgba8,
+};
 
 /// Every task of exercise 2.
 pub(crate) fn tasks(fx: &Fixture) -> Vec<TaskSpec> {
@@ -32,7 +29,7 @@ fn hue_to_rgb(hue: f32) -> [f32; 3] {
 
 /// The ChromaDepth article's ramp as stereolab computes it: hue 240° · clamp(t), red near, blue far.
 pub(crate) fn reference_ramp(t: f32) -> [f32; 3] {
-    exact(RampKind::Hsv, t).to_array()
+    ramp_exact(RampKind::Hsv, t).to_array()
 }
 
 /// The ChromaDepth article's texgen plane `[A, B, C, D]` as stereolab's `Texgen::from_range` computes it; for

@@ -11,10 +11,10 @@ use super::ex1::flat;
 use super::fixture::{Fixture, unproject};
 use super::spec::{Case, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
 use crate::exercise::{SirdsGeometry, SirdsSetup};
-use stereolab_core::effects::sirds::disparity::{separation_eye_distance, separation_view_angle};
-use stereolab_core::effects::sirds::per_pixel::RowLinker;
-use stereolab_core::effects::sirds::{Disparity, DisparityModel};
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::{
+    Disparity, DisparityModel, Framebuffer, RowLinker, separation_eye_distance,
+    separation_view_angle,
+};
 
 /// Every task of exercise 3.
 pub(crate) fn tasks(fx: &Fixture) -> Vec<TaskSpec> {

@@ -10,20 +10,20 @@ pub use exercise_api::{
     SirdsSetup, StereoSetup, decode_reply, protocol,
 };
 
-use stereolab_core::effects::anaglyph;
+use stereolab_core::{AnaglyphKind as ReferenceKind, AnaglyphMatrices as ReferenceMatrices};
 
 /// The same anaglyph kind in stereolab's anaglyph module (the reference).
-pub(crate) fn reference_kind(kind: AnaglyphKind) -> anaglyph::AnaglyphKind {
+pub(crate) fn reference_kind(kind: AnaglyphKind) -> ReferenceKind {
     match kind {
-        AnaglyphKind::True => anaglyph::AnaglyphKind::True,
-        AnaglyphKind::Gray => anaglyph::AnaglyphKind::Gray,
-        AnaglyphKind::Color => anaglyph::AnaglyphKind::Color,
-        AnaglyphKind::HalfColor => anaglyph::AnaglyphKind::HalfColor,
+        AnaglyphKind::True => ReferenceKind::True,
+        AnaglyphKind::Gray => ReferenceKind::Gray,
+        AnaglyphKind::Color => ReferenceKind::Color,
+        AnaglyphKind::HalfColor => ReferenceKind::HalfColor,
     }
 }
 
 /// stereolab's matrices as the exercise's type (the same numbers, row-major).
-pub(crate) fn exercise_matrices(m: anaglyph::AnaglyphMatrices) -> AnaglyphMatrices {
+pub(crate) fn exercise_matrices(m: ReferenceMatrices) -> AnaglyphMatrices {
     AnaglyphMatrices {
         left: m.left,
         right: m.right,
@@ -31,8 +31,8 @@ pub(crate) fn exercise_matrices(m: anaglyph::AnaglyphMatrices) -> AnaglyphMatric
 }
 
 /// The exercise's matrices as stereolab's type.
-pub(crate) fn reference_matrices(m: AnaglyphMatrices) -> anaglyph::AnaglyphMatrices {
-    anaglyph::AnaglyphMatrices {
+pub(crate) fn reference_matrices(m: AnaglyphMatrices) -> ReferenceMatrices {
+    ReferenceMatrices {
         left: m.left,
         right: m.right,
     }

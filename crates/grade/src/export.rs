@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 use stereolab_grade_core::build::{HANDOUT_PROFILE, strip_solution};
 use stereolab_grade_core::data::{exercise_data, task_to_data};
 use stereolab_grade_core::{
@@ -127,7 +127,7 @@ fn write_task_data(root: &Path, data: &Path) -> Result<()> {
         let text = serde_json::to_string(&exercise_data(ex, tasks))
             .map_err(|e| Error::internal("task data", e.to_string()))?;
         let path = data.join(format!("{}.json", ex.id()));
-        stereolab_core::files::write_bytes(&path, text.as_bytes())?;
+        stereolab_core::write_bytes(&path, text.as_bytes())?;
     }
     Ok(())
 }

@@ -8,9 +8,9 @@ use crate::exercise::StereoSetup;
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab::scene::Scene;
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::{EyeMatrices, Lighting, Separation, StereoRig, ZeroParallax};
+use stereolab_core::{
+    EyeMatrices, Framebuffer, Lighting, Result, Separation, StereoRig, ZeroParallax,
+};
 
 /// The built-in grading scene: small (fast, ASCII maps fit a terminal), with depth in front of
 /// and behind the screen (parallax of both signs), occluders in front of a backdrop (remapping,

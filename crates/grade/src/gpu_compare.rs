@@ -16,7 +16,7 @@ use stereolab::compare::{Comparison, compare, write_diff_strip};
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab::scene::Scene;
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 use stereolab_gpu::{GpuRenderer, GpuScene};
 
 /// The task whose answers are compared.

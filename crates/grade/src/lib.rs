@@ -24,7 +24,7 @@ use fixture::Fixture;
 use report::Report;
 use spec::TaskSpec;
 use stereolab::scene::Scene;
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 pub use stereolab_grade_core::{
     Binary, BuildMode, Exercise, GradeOptions, Limits, NotBuilt, Policy, build, check_sandbox,
     child, default_work_dir, exercises_dir, report, sandbox, score, stubs_candidates, stubs_path,

@@ -8,7 +8,7 @@ use std::rc::Rc;
 
 use serde_json::Value;
 use stereolab::compare::{ascii_map, compare, coverage, write_diff_strip};
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::Framebuffer;
 use stereolab_grade_core::spec::ImageCheck;
 
 /// One image compared: the reference's and the one built from the student's answers.
@@ -72,8 +72,8 @@ fn write_references(pictures: &[Picture], out: &Path) -> Vec<String> {
             );
             let name = format!("{}.png", p.name);
             match std::fs::create_dir_all(out)
-                .map_err(|e| stereolab_core::error::Error::io(out, e))
-                .and_then(|()| stereolab_core::files::write_png(&out.join(&name), &big))
+                .map_err(|e| stereolab_core::Error::io(out, e))
+                .and_then(|()| stereolab_core::write_png(&out.join(&name), &big))
             {
                 Ok(()) => name,
                 Err(e) => format!("error: {e}"),

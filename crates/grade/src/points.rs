@@ -3,7 +3,7 @@
 pub use stereolab_grade_core::points::*;
 
 use super::fixture::{Fixture, grading_scene};
-use stereolab_core::error::Result;
+use stereolab_core::Result;
 
 /// Every task of every exercise, in course order.
 ///

@@ -35,7 +35,7 @@ use std::path::{Path, PathBuf};
 
 use super::Exercise;
 use super::batch::{csv_field, submission_root};
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 
 /// The default threshold of `--similarity-threshold`: pairs at or above it are flagged. At 0.8
 /// four fifths of the smaller function's fingerprints (each one a run of [`K`] tokens) occur in
@@ -705,7 +705,7 @@ pub fn check_threshold(threshold: f64) -> Result<f64> {
 /// A file's text, `None` when it is missing or unreadable (the grading report says why); bytes
 /// that are not UTF-8 become U+FFFD.
 fn read_source(path: &Path) -> Option<String> {
-    let bytes = stereolab_core::files::read_input(path, MAX_SOURCE_BYTES).ok()?;
+    let bytes = stereolab_core::read_input(path, MAX_SOURCE_BYTES).ok()?;
     Some(String::from_utf8_lossy(&bytes).into_owned())
 }
 
@@ -787,7 +787,7 @@ pub fn write_batch_report(
     out: &Path,
 ) -> Result<Report> {
     let report = batch_report(subs, exercises, &repository_exercises(), threshold)?;
-    stereolab_core::files::write_bytes(&out.join(FILE_NAME), report.csv().as_bytes())?;
+    stereolab_core::write_bytes(&out.join(FILE_NAME), report.csv().as_bytes())?;
     Ok(report)
 }
 

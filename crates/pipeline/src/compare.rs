@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 
 use image::{Rgba, RgbaImage};
 
-use stereolab_core::error::{Error, Result};
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::{Error, Framebuffer, Result};
 
 /// How two framebuffers differ.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -177,7 +176,7 @@ pub fn write_diff_strip(
     let mut strip = RgbaImage::from_pixel(sw, sh, Rgba([48, 48, 48, 255]));
     for (i, (img, label)) in panels.iter().enumerate() {
         let x0 = i as u32 * (w * k + PANEL_GAP);
-        let band = stereolab_core::text::caption(w * k, CAPTION_HEIGHT, label, 14.0, [32, 32, 32]);
+        let band = stereolab_core::caption(w * k, CAPTION_HEIGHT, label, 14.0, [32, 32, 32]);
         image::imageops::replace(&mut strip, &band, i64::from(x0), 0);
         for y in 0..h * k {
             for x in 0..w * k {
@@ -187,7 +186,7 @@ pub fn write_diff_strip(
     }
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let path = dir.join(format!("{name}.png"));
-    stereolab_core::files::write_png(&path, &strip)?;
+    stereolab_core::write_png(&path, &strip)?;
     Ok(path)
 }
 
@@ -369,7 +368,7 @@ pub fn framebuffer_from_image(img: &RgbaImage, background: [u8; 4]) -> Result<Fr
 /// # Errors
 /// The file cannot be read or decoded.
 pub fn load_image(path: &Path) -> Result<RgbaImage> {
-    let img = stereolab_core::framebuffer::open_image(path, "image")?;
+    let img = stereolab_core::open_image(path, "image")?;
     Ok(img.to_rgba8())
 }
 
@@ -386,8 +385,8 @@ pub fn compare_images(
     out: Option<&Path>,
 ) -> Result<Comparison> {
     let (de, da) = (
-        stereolab_core::framebuffer::open_image(expected, "image")?,
-        stereolab_core::framebuffer::open_image(actual, "image")?,
+        stereolab_core::open_image(expected, "image")?,
+        stereolab_core::open_image(actual, "image")?,
     );
     let to_fb = |img: &image::DynamicImage| -> Result<Framebuffer> {
         let img = img.to_rgba8();

@@ -4,8 +4,7 @@
 use std::path::Path;
 
 use crate::scene::Scene;
-use stereolab_core::effects::sirds::DepthMap;
-use stereolab_core::error::Result;
+use stereolab_core::{DepthMap, Result};
 
 /// The SIRDS paper's Table 1: (width, height, triangles, k, frame rate in Hz on a GeForce4 Ti 4600).
 pub const TABLE_1: [(u32, u32, u32, u32, f64); 6] = [

@@ -5,11 +5,11 @@ use std::fmt::Write as _;
 use crate::plan::{Shading, View};
 use crate::render::{Frame, render_view};
 use crate::scene::Scene;
-use stereolab_core::effects::parallax::{ParallaxBudget, budget_of};
-use stereolab_core::error::Result;
-use stereolab_core::math::{CameraMode, StereoRig, Viewer, project_ndc};
+use stereolab_core::{
+    CameraMode, ParallaxBudget, Result, StereoRig, Viewer, parallax_budget_of, project_ndc,
+};
 
-use stereolab_core::effects::parallax::PARALLAX_BUDGET_PERCENT;
+use stereolab_core::PARALLAX_BUDGET_PERCENT;
 
 /// Horizontal and vertical parallax range over the scene's vertices, in percent of image width
 /// (horizontal) and height (vertical): `(x_right − x_left)` in NDC / 2 · 100.
@@ -234,19 +234,19 @@ pub fn scene_budget(scene: &Scene) -> Result<ParallaxBudget> {
         .rig
         .eyes_for_image(&scene.camera, scene.width, scene.height)?;
     let (fb, _) = render_view(scene, &eyes[0], Shading::DepthOnly)?;
-    budget_of(&fb, &scene.parallax_rig()?)
+    parallax_budget_of(&fb, &scene.parallax_rig()?)
 }
 
 /// The budget lines of the render report, from the frame's left eye depth (or the right eye's
 /// when only that one was rendered); `None` when no eye pass ran.
 ///
 /// # Errors
-/// As [`budget_of`].
+/// As [`parallax_budget_of`].
 pub fn frame_budget_report(frame: &Frame, scene: &Scene) -> Result<Option<String>> {
     let rig = scene.parallax_rig()?;
     for (view, name) in [(View::Left, "left"), (View::Right, "right")] {
         if let Some(fb) = frame.view(view) {
-            let b = budget_of(fb, &rig)?;
+            let b = parallax_budget_of(fb, &rig)?;
             let shift = image_shift_line(scene)?.unwrap_or_default();
             let step = depth_step_parallax(fb, &rig);
             let uncertain = if step > DEPTH_STEP_PARALLAX_WARN {
@@ -277,7 +277,7 @@ pub const DEPTH_STEP_PARALLAX_WARN: f64 = 0.1;
 /// depth buffer can be off. 0 when nothing is drawn.
 pub fn depth_step_parallax(
     fb: &stereolab_core::Framebuffer,
-    rig: &stereolab_core::effects::parallax::ParallaxRig,
+    rig: &stereolab_core::ParallaxRig,
 ) -> f64 {
     let drawn = fb.depth().iter().copied().filter(|d| *d < 1.0);
     let (lo, hi) = drawn.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| {

@@ -3,9 +3,7 @@
 
 use std::fmt::Write as _;
 
-use stereolab_core::Eye;
-use stereolab_core::effects::anaglyph::AnaglyphKind;
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{AnaglyphKind, Error, Eye, Result};
 
 /// Everything a scene can ask `stereolab render` to write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

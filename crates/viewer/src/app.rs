@@ -16,11 +16,10 @@ use super::session::{
 };
 use stereolab::plan::Output;
 use stereolab::scene::Scene;
-use stereolab_core::effects::parallax::PARALLAX_BUDGET_PERCENT;
-use stereolab_core::effects::sirds::Algorithm;
-use stereolab_core::effects::sirds::settings::{Filter, Start};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::{Lighting, Separation, ZeroParallax};
+use stereolab_core::{
+    Error, Lighting, PARALLAX_BUDGET_PERCENT, Result, Separation, SirdsAlgorithm, StripFilter,
+    StripStart, ZeroParallax,
+};
 
 /// The keys, as the help overlay lists them.
 const KEYS: &[(&str, &str)] = &[
@@ -554,7 +553,7 @@ impl App {
             .ok_or_else(|| Error::invalid("screenshot", dir.display(), "10 000 shots already"))?;
         let (png, toml) = (base.with_extension("png"), base.with_extension("toml"));
         let text = self.session.scene_toml(&shown.params, &dir)?;
-        stereolab_core::files::write_bytes(&toml, text.as_bytes())?;
+        stereolab_core::write_bytes(&toml, text.as_bytes())?;
         shown.image.save_png(&png)?;
         self.shots.push(png.clone());
         let outside = text.contains("path = \"/") || text.contains("pattern_image = \"/");
@@ -677,7 +676,7 @@ impl App {
             v["image_size"] = serde_json::json!([s.image_width(), s.image_height()]);
         }
         let text = v.to_string();
-        if let Err(e) = stereolab_core::files::write_bytes(path, text.as_bytes()) {
+        if let Err(e) = stereolab_core::write_bytes(path, text.as_bytes()) {
             eprintln!("state file: {e}");
         }
     }
@@ -799,20 +798,32 @@ impl App {
         ui.horizontal(|ui| {
             ui.radio_value(
                 &mut self.params.sirds_algorithm,
-                Algorithm::PerVertex,
+                SirdsAlgorithm::PerVertex,
                 "per-vertex",
             );
-            ui.radio_value(&mut self.params.sirds_algorithm, Algorithm::PerPixel, "TIW");
+            ui.radio_value(
+                &mut self.params.sirds_algorithm,
+                SirdsAlgorithm::PerPixel,
+                "TIW",
+            );
         });
         ui.horizontal(|ui| {
             ui.label("start");
-            ui.radio_value(&mut self.params.sirds_start, Start::Left, "left");
-            ui.radio_value(&mut self.params.sirds_start, Start::Center, "center");
+            ui.radio_value(&mut self.params.sirds_start, StripStart::Left, "left");
+            ui.radio_value(&mut self.params.sirds_start, StripStart::Center, "center");
         });
         ui.horizontal(|ui| {
             ui.label("filter");
-            ui.radio_value(&mut self.params.sirds_filter, Filter::Nearest, "nearest");
-            ui.radio_value(&mut self.params.sirds_filter, Filter::Bilinear, "bilinear");
+            ui.radio_value(
+                &mut self.params.sirds_filter,
+                StripFilter::Nearest,
+                "nearest",
+            );
+            ui.radio_value(
+                &mut self.params.sirds_filter,
+                StripFilter::Bilinear,
+                "bilinear",
+            );
         });
         ui.checkbox(&mut self.turning, "turn the model (T)");
         ui.checkbox(&mut self.new_dots, "new dots every frame (N)");

@@ -13,9 +13,7 @@ use stereolab::plan::{Output, Plan, Shading, View};
 use stereolab::render::chromadepth::resolve_texgen;
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
-use stereolab_core::effects::parallax::ParallaxRig;
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::{Framebuffer, ParallaxRig, Result};
 
 use super::session::{Params, point_parallax_pixels, unproject};
 
@@ -113,7 +111,7 @@ pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Res
 /// The StereoGraphics guide's window violations of one eye's framebuffer: border pixels with
 /// negative parallax (in front of the screen, cut by the window's edge), per side (left, right,
 /// top, bottom). The same count as
-/// [`budget_of`](stereolab_core::effects::parallax::budget_of)`(fb, rig).window_violations`, which maps
+/// [`parallax_budget_of`](stereolab_core::parallax_budget_of)`(fb, rig).window_violations`, which maps
 /// every pixel's parallax; this looks at the border pixels only, as only they can violate
 /// (a unit test holds the two equal).
 pub fn window_violations(fb: &Framebuffer, rig: &ParallaxRig) -> [usize; 4] {
@@ -231,8 +229,7 @@ impl Shown {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stereolab_core::effects::parallax::budget_of;
-    use stereolab_core::math::{Camera, StereoRig, ZeroParallax};
+    use stereolab_core::{Camera, StereoRig, ZeroParallax, parallax_budget_of};
 
     /// The border-only count is the per-pixel budget's count, on framebuffers whose depths are
     /// scattered over the whole range (background included), for several zero-parallax planes.
@@ -268,7 +265,7 @@ mod tests {
                 ..StereoRig::default()
             };
             let prig = ParallaxRig::new(&rig, &camera, w, h).unwrap();
-            let expected = budget_of(&fb, &prig).unwrap().window_violations;
+            let expected = parallax_budget_of(&fb, &prig).unwrap().window_violations;
             assert_eq!(window_violations(&fb, &prig), expected, "{w}x{h} z0 {z0}");
             if z0 > 5.0 && w > 2 {
                 assert!(

@@ -14,7 +14,7 @@ use stereolab::compare::{Metrics, compare, depth_bits_identical, framebuffer_fro
 use stereolab::output::{Image, produce};
 use stereolab::plan::Output;
 use stereolab::scene::Scene;
-use stereolab_core::error::Result;
+use stereolab_core::Result;
 use stereolab_gpu::sirds::GpuStrips;
 use stereolab_gpu::{GpuFinalize, GpuRenderer, GpuScene};
 

@@ -29,7 +29,7 @@ pub use frame::{Shown, display_image, render_shown};
 pub use session::{Params, Session};
 
 use stereolab::scene::Scene;
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 
 /// What `stereolab view` was asked besides the scene.
 #[derive(Clone, Debug, Default)]

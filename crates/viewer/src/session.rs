@@ -14,12 +14,9 @@ use glam::{Mat4, Vec3};
 
 use stereolab::plan::Output;
 use stereolab::scene::{Scene, model_matrix};
-use stereolab_core::effects::sirds::Algorithm;
-use stereolab_core::effects::sirds::pattern::Pattern;
-use stereolab_core::effects::sirds::settings::{Filter, Start};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::{
-    Camera, CameraMode, Lighting, Separation, StereoRig, ZeroParallax, project_ndc,
+use stereolab_core::{
+    Camera, CameraMode, Error, Lighting, Result, Separation, SirdsAlgorithm, SirdsPattern,
+    StereoRig, StripFilter, StripStart, ZeroParallax, project_ndc,
 };
 
 /// The StereoGraphics guide's §7 keypad step: `UserOffsetAdjustment *= 1.1` per press ("based on
@@ -48,11 +45,11 @@ pub struct Params {
     /// `[finalize] swap_eyes`.
     pub swap_eyes: bool,
     /// `[sirds] algorithm`.
-    pub sirds_algorithm: Algorithm,
+    pub sirds_algorithm: SirdsAlgorithm,
     /// `[sirds] start`.
-    pub sirds_start: Start,
+    pub sirds_start: StripStart,
     /// `[sirds] filter`.
-    pub sirds_filter: Filter,
+    pub sirds_filter: StripFilter,
     /// `[sirds] seed` (ignored for a pattern image).
     pub sirds_seed: u64,
     /// Degrees every mesh is turned about its Y axis, added to its `rotate[1]` (the SIRDS
@@ -87,7 +84,7 @@ impl Session {
     /// # Errors
     /// The file cannot be read again, or a `--set` does not apply.
     pub fn new(scene: &Scene, path: &Path, sets: &[String]) -> Result<Session> {
-        let text = stereolab_core::files::read_text(path, 16 * 1024 * 1024)?;
+        let text = stereolab_core::read_text(path, 16 * 1024 * 1024)?;
         let mut table: toml::Table =
             toml::from_str(&text).map_err(|e| Error::parse(path, None, e.message().to_string()))?;
         stereolab::scene::apply_sets(&mut table, sets)?;
@@ -125,10 +122,10 @@ impl Session {
             sirds_start: s.per_vertex.start,
             sirds_filter: s.per_vertex.filter,
             sirds_seed: match s.pattern {
-                Pattern::BlackWhite { seed } | Pattern::Gray { seed } | Pattern::Color { seed } => {
-                    seed
-                }
-                Pattern::Image(_) => 1,
+                SirdsPattern::BlackWhite { seed }
+                | SirdsPattern::Gray { seed }
+                | SirdsPattern::Color { seed } => seed,
+                SirdsPattern::Image(_) => 1,
             },
             turn_degrees: 0.0,
         };
@@ -153,8 +150,9 @@ impl Session {
         scene.sirds.algorithm = p.sirds_algorithm;
         scene.sirds.per_vertex.start = p.sirds_start;
         scene.sirds.per_vertex.filter = p.sirds_filter;
-        if let Pattern::BlackWhite { seed } | Pattern::Gray { seed } | Pattern::Color { seed } =
-            &mut scene.sirds.pattern
+        if let SirdsPattern::BlackWhite { seed }
+        | SirdsPattern::Gray { seed }
+        | SirdsPattern::Color { seed } = &mut scene.sirds.pattern
         {
             *seed = p.sirds_seed;
         }
@@ -222,18 +220,18 @@ impl Session {
         );
         set("finalize", "swap_eyes", Some(Value::Boolean(p.swap_eyes)));
         let algorithm = match p.sirds_algorithm {
-            Algorithm::PerVertex => "per-vertex",
-            Algorithm::PerPixel => "per-pixel",
+            SirdsAlgorithm::PerVertex => "per-vertex",
+            SirdsAlgorithm::PerPixel => "per-pixel",
         };
         set("sirds", "algorithm", Some(word(algorithm)));
         let start = match p.sirds_start {
-            Start::Left => "left",
-            Start::Center => "center",
+            StripStart::Left => "left",
+            StripStart::Center => "center",
         };
         set("sirds", "start", Some(word(start)));
         let filter = match p.sirds_filter {
-            Filter::Nearest => "nearest",
-            Filter::Bilinear => "bilinear",
+            StripFilter::Nearest => "nearest",
+            StripFilter::Bilinear => "bilinear",
         };
         set("sirds", "filter", Some(word(filter)));
         let seed = i64::try_from(p.sirds_seed)
@@ -514,7 +512,7 @@ impl Params {
 /// the right eye sees it minus where the left eye does, `(x_r − x_l)/2 · W` in NDC; `None`
 /// behind either eye.
 pub fn point_parallax_pixels(
-    eyes: &[stereolab_core::math::EyeMatrices; 2],
+    eyes: &[stereolab_core::EyeMatrices; 2],
     p: Vec3,
     width: u32,
 ) -> Option<f32> {
@@ -540,7 +538,7 @@ mod tests {
     use crate::render_shown;
     use stereolab::output::Image;
     use stereolab::scene::LoadOptions;
-    use stereolab_core::effects::anaglyph::AnaglyphKind;
+    use stereolab_core::AnaglyphKind;
 
     fn raw(i: &Image) -> Vec<u8> {
         match i {
@@ -571,7 +569,7 @@ mod tests {
         p.rig.lighting = Lighting::Cyclopic;
         p.turn_degrees = 33.3;
         p.sirds_seed = 7;
-        p.sirds_start = Start::Left;
+        p.sirds_start = StripStart::Left;
         p.chromadepth_d = [Some(3.0), None];
         let elsewhere = std::env::temp_dir().join(format!("stereolab-view-{}", std::process::id()));
         std::fs::create_dir_all(&elsewhere).unwrap();
@@ -637,9 +635,9 @@ mod tests {
             chromadepth_d: [None, None],
             linear_light: false,
             swap_eyes: false,
-            sirds_algorithm: Algorithm::PerVertex,
-            sirds_start: Start::Center,
-            sirds_filter: Filter::Bilinear,
+            sirds_algorithm: SirdsAlgorithm::PerVertex,
+            sirds_start: StripStart::Center,
+            sirds_filter: StripFilter::Bilinear,
             sirds_seed: 1,
             turn_degrees: 0.0,
         };

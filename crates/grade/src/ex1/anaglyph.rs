@@ -9,9 +9,7 @@ use crate::exercise::{
 };
 use crate::fixture::Fixture;
 use crate::spec::{Case, Mistake, Picture, TaskSpec, Tolerance};
-use stereolab_core::effects::anaglyph::AnaglyphKind::DuboisRedCyan;
-use stereolab_core::effects::anaglyph::anaglyph_pixel;
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::{AnaglyphKind::DuboisRedCyan, Framebuffer, anaglyph_pixel};
 
 /// The exercise slides' anaglyph matrices from stereolab's anaglyph module.
 pub(crate) fn reference_anaglyph(kind: AnaglyphKind) -> AnaglyphMatrices {

@@ -12,10 +12,7 @@ use crate::exercise::{
 };
 use crate::fixture::Fixture;
 use crate::spec::{Case, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
-use stereolab_core::effects::anaglyph::AnaglyphKind::DuboisRedCyan;
-use stereolab_core::effects::anaglyph::anaglyph_pixel;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::shade::to_rgba8;
+use stereolab_core::{AnaglyphKind::DuboisRedCyan, Framebuffer, anaglyph_pixel, to_rgba8};
 
 /// The known slips as switches.
 #[derive(Clone, Copy, Default)]
@@ -278,7 +275,7 @@ pub(super) fn finalize_task(fx: &Fixture) -> TaskSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stereolab_core::effects::anaglyph::mix;
+    use stereolab_core::anaglyph_mix;
 
     #[test]
     fn the_reference_pixel_is_stereolabs_mix_and_each_slip_shows_on_the_public_cases() {
@@ -289,7 +286,7 @@ mod tests {
         ];
         for (l, r, m) in cases {
             let ours = finalize_reference(l, r, &m, FinalizeVariant::default());
-            let module = mix(&reference_matrices(m), l, r);
+            let module = anaglyph_mix(&reference_matrices(m), l, r);
             for (a, b) in ours.iter().zip(module) {
                 assert!((a - f64::from(b)).abs() < 1e-6, "{ours:?} vs {module:?}");
             }

@@ -6,7 +6,7 @@ use serde_json::json;
 use super::{HIDDEN_SETUPS, MATRIX_TOLERANCE, eyes, flat, random_setup, setups};
 use crate::fixture::Fixture;
 use crate::spec::{Case, Mistake, TaskSpec, Tolerance, hidden_cases};
-use stereolab_core::math::{CameraMode, Lighting, frustum};
+use stereolab_core::{CameraMode, Lighting, frustum};
 
 pub(super) fn frustum_task(fx: &Fixture) -> TaskSpec {
     let e = fx.eyes[0].frustum;

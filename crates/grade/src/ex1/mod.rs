@@ -20,8 +20,7 @@ mod visible;
 use super::fixture::{Fixture, reference_rig};
 use super::spec::{SplitMix64, TaskSpec, Tolerance};
 use crate::exercise::{Answer, StereoSetup};
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::{Camera, CameraMode, EyeMatrices, Lighting};
+use stereolab_core::{Camera, CameraMode, EyeMatrices, Framebuffer, Lighting};
 
 #[cfg(feature = "gpu")]
 pub(crate) use rig::{eye_matrices_from_answer, eye_view_input};

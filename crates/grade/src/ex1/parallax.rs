@@ -6,7 +6,7 @@ use serde_json::json;
 use super::{flat, left_samples};
 use crate::fixture::Fixture;
 use crate::spec::{Case, Mistake, Picture, TaskSpec, Tolerance, hidden_cases};
-use stereolab_core::shade::to_rgba8;
+use stereolab_core::to_rgba8;
 
 pub(super) fn parallax_task() -> TaskSpec {
     let inputs: [[f32; 3]; 7] = [

@@ -1,6 +1,6 @@
 //! Exercise 1's `rds_right` task: the right image of Julesz's random-dot stereo pair (the SIRDS
 //! paper (Petz et al.), §1), built by the student from their own `remap_right_to_left` and
-//! `visible`. The library's version is [`stereolab_core::effects::rds`].
+//! `visible`. The library's version is [`rds_right`](stereolab_core::rds_right).
 //!
 //! A case is a whole pair: both eyes' depth buffers rendered by stereolab, their MVPs, the left
 //! random dots and the fresh dots, and the depth tolerance. The answer is the right image's dots
@@ -21,9 +21,9 @@ use crate::spec::{Case, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidde
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab::scene::Scene;
-use stereolab_core::effects::rds::{dot, right_only_seed};
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::{Camera, CameraMode, EyeMatrices, Lighting};
+use stereolab_core::{
+    Camera, CameraMode, EyeMatrices, Framebuffer, Lighting, rds_dot, right_only_seed,
+};
 
 /// The visibility check's depth tolerance (as the `visible` task's fixture uses: a few times the
 /// depth change across one pixel on the grading scene's slanted faces at 64×48).
@@ -62,7 +62,7 @@ struct RdsCase {
 /// Random dots of `seed` (dot size 1, `true` white), the library's texture.
 fn dots(seed: u64, width: u32, height: u32) -> Vec<bool> {
     (0..height)
-        .flat_map(|y| (0..width).map(move |x| dot(seed, 1, x, y)[0] == 255))
+        .flat_map(|y| (0..width).map(move |x| rds_dot(seed, 1, x, y)[0] == 255))
         .collect()
 }
 
@@ -505,12 +505,12 @@ mod tests {
         let fx = Fixture::new(grading_scene().unwrap()).unwrap();
         let c = &public_cases(&fx)[0];
         let right = reference(c, Variant::default());
-        let lib = stereolab_core::effects::rds::rds_right(
+        let lib = stereolab_core::rds_right(
             &fx.views[0],
             &fx.views[1],
             &fx.eyes[0].mvp,
             &fx.eyes[1].mvp,
-            &stereolab_core::effects::rds::RdsSettings {
+            &stereolab_core::RdsSettings {
                 seed: 1,
                 dot_size: 1,
             },

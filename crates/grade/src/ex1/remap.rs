@@ -8,8 +8,7 @@ use super::view_samples;
 use super::{HIDDEN_SETUPS, eyes, random_setup};
 use crate::fixture::Fixture;
 use crate::spec::{Case, Mistake, Picture, SplitMix64, TaskSpec, Tolerance, hidden_cases};
-use stereolab_core::effects::remap::{Precision, Remapped, Remapper};
-use stereolab_core::math::{CameraMode, Lighting};
+use stereolab_core::{CameraMode, Lighting, Precision, Remapped, Remapper};
 
 /// The known remapping mistakes as switches.
 #[derive(Clone, Copy, Default)]

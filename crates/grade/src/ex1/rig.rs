@@ -10,8 +10,7 @@ use crate::fixture::Fixture;
 use crate::spec::{Case, Mistake, Picture, TaskSpec, hidden_cases};
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::{Camera, CameraMode, EyeMatrices, Lighting};
+use stereolab_core::{Camera, CameraMode, EyeMatrices, Framebuffer, Lighting};
 
 /// The `stereo_matrices` task's input for one eye: setup, cyclopean modelview, eye index
 /// (0 = left), lighting.

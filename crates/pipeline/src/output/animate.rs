@@ -11,9 +11,7 @@ use super::sirds::from_frame;
 use crate::plan::{Output, Plan};
 use crate::render::render;
 use crate::scene::Scene;
-use stereolab_core::effects::sirds::Pattern;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::files;
+use stereolab_core::{Error, Result, SirdsPattern, image_error, write_atomic};
 
 /// The most frames an animation may have: every frame is a full render and a GIF frame, and the
 /// count is a number on the command line (a typo of 100000 would run for hours and fill a disk).
@@ -88,8 +86,8 @@ pub fn animate(
     let seed_pattern = scene.sirds.pattern.clone();
     // The frames stream into a temporary file renamed onto `path` only once the last one is in:
     // a failed or killed run never leaves a truncated GIF.
-    files::write_atomic(path, |w| {
-        let gif_error = |e| files::image_error(path, e);
+    write_atomic(path, |w| {
+        let gif_error = |e| image_error(path, e);
         let mut gif = GifEncoder::new_with_speed(w, 10);
         gif.set_repeat(Repeat::Infinite).map_err(gif_error)?;
         let mut frame_of = |i: u32| -> Result<Frame> {
@@ -102,10 +100,10 @@ pub fn animate(
             }
             if !opts.fixed_seed {
                 let seed = match &seed_pattern {
-                    Pattern::BlackWhite { seed }
-                    | Pattern::Gray { seed }
-                    | Pattern::Color { seed } => seed.wrapping_add(i as u64),
-                    Pattern::Image(_) => 0,
+                    SirdsPattern::BlackWhite { seed }
+                    | SirdsPattern::Gray { seed }
+                    | SirdsPattern::Color { seed } => seed.wrapping_add(i as u64),
+                    SirdsPattern::Image(_) => 0,
                 };
                 s.sirds.pattern = seed_pattern.reseeded(seed);
             }

@@ -2,11 +2,9 @@
 
 use crate::plan::Output;
 use crate::render::Frame;
-use stereolab_core::effects::chromadepth::{
-    ChromaDepthSettings, ChromaDepthView, chromadepth_view,
+use stereolab_core::{
+    ChromaDepthSettings, ChromaDepthView, Error, Framebuffer, Result, chromadepth_view,
 };
-use stereolab_core::error::{Error, Result};
-use stereolab_core::framebuffer::Framebuffer;
 
 /// Produces a ChromaDepth output from the frame's ChromaDepth pass: the image itself, one eye's
 /// view through the glasses, or both views as an anaglyph (`chromadepth.anaglyph`, default gray).

@@ -1,6 +1,6 @@
 //! The `frame_sequential` output: the two eye back buffers (`BACK_LEFT`, `BACK_RIGHT`) as an
 //! animated PNG (APNG) that alternates them at the scene's rate, what a shutter-glasses display
-//! shows ([`stereolab_core::effects::frame_sequential`] is the schedule).
+//! shows ([`FrameSequentialSettings::fields`](stereolab_core::FrameSequentialSettings::fields) is the schedule).
 //!
 //! APNG stores each frame's duration as a fraction `delay_num / delay_den` seconds (`fcTL`), so
 //! 1/120 s is exact (GIF's centiseconds could not say it). The file loops forever
@@ -10,9 +10,7 @@
 use image::RgbaImage;
 
 use crate::render::Frame;
-use stereolab_core::effects::frame_sequential::{Field, FrameSequentialSettings};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::framebuffer::DrawBuffer;
+use stereolab_core::{DrawBuffer, Error, FrameField, FrameSequentialSettings, Result};
 
 /// Both eyes and the order and durations they are shown in.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,7 +20,7 @@ pub struct FrameSequence {
     /// `BACK_RIGHT`: the right eye's image (same size).
     pub right: RgbaImage,
     /// The fields in display order.
-    pub fields: Vec<Field>,
+    pub fields: Vec<FrameField>,
 }
 
 impl FrameSequence {
@@ -50,7 +48,7 @@ impl FrameSequence {
     }
 
     /// The image shown in `field`.
-    pub fn image(&self, field: &Field) -> &RgbaImage {
+    pub fn image(&self, field: &FrameField) -> &RgbaImage {
         match field.buffer {
             DrawBuffer::BackLeft => &self.left,
             DrawBuffer::BackRight => &self.right,

@@ -14,12 +14,12 @@ use crate::plan::{Output, View};
 use crate::render::Frame;
 use crate::scene::Scene;
 use stereo_photo::{PhotoFormat, RigMetadata, StereoPhoto};
-use stereolab_core::effects::parallax::parallax_image;
-use stereolab_core::effects::remap::{Precision, remap_color};
-use stereolab_core::effects::{anaglyph, calibration, ghosting, layout, occlusion, rds};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::files;
-use stereolab_core::framebuffer::Framebuffer;
+use stereolab_core::{
+    AnaglyphKind, Error, Framebuffer, Precision, Result, above_below, above_below_squashed,
+    anaglyph, calibration_screen, check_output_path, ghosted, interleave, occlusion_image,
+    parallax_image, rds_framebuffer, rds_left, rds_right, remap_color, side_by_side, write_bytes,
+    write_png,
+};
 
 /// One finished output image.
 pub enum Image {
@@ -35,16 +35,16 @@ pub enum Image {
 
 impl Image {
     /// Writes the image as PNG (a stereo photo in its own format), all or nothing
-    /// ([`files::write_atomic`]).
+    /// ([`write_atomic`](stereolab_core::write_atomic)).
     ///
     /// # Errors
     /// The file cannot be written, or its name is a link or a special file.
     pub fn save_png(&self, path: &Path) -> Result<()> {
         match self {
-            Image::Rgba(i) => files::write_png(path, i),
-            Image::Gray16(i) => files::write_png(path, i),
-            Image::Stereo(photo) => files::write_bytes(path, &photo.encode()?),
-            Image::Sequence(seq) => files::write_bytes(path, &seq.encode()?),
+            Image::Rgba(i) => write_png(path, i),
+            Image::Gray16(i) => write_png(path, i),
+            Image::Stereo(photo) => write_bytes(path, &photo.encode()?),
+            Image::Sequence(seq) => write_bytes(path, &seq.encode()?),
         }
     }
 
@@ -107,42 +107,36 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
         Output::Right => Image::Rgba(eye(View::Right)?.to_rgba_image()),
         Output::LeftDepth => Image::Gray16(eye(View::Left)?.depth_image()),
         Output::RightDepth => Image::Gray16(eye(View::Right)?.depth_image()),
-        Output::SideBySide => {
-            Image::Rgba(layout::side_by_side(eye(View::Left)?, eye(View::Right)?)?)
-        }
-        Output::CrossEyed => {
-            Image::Rgba(layout::side_by_side(eye(View::Right)?, eye(View::Left)?)?)
-        }
-        Output::AboveBelow => {
-            Image::Rgba(layout::above_below(eye(View::Left)?, eye(View::Right)?)?)
-        }
-        Output::AboveBelowSquashed => Image::Rgba(layout::above_below_squashed(
+        Output::SideBySide => Image::Rgba(side_by_side(eye(View::Left)?, eye(View::Right)?)?),
+        Output::CrossEyed => Image::Rgba(side_by_side(eye(View::Right)?, eye(View::Left)?)?),
+        Output::AboveBelow => Image::Rgba(above_below(eye(View::Left)?, eye(View::Right)?)?),
+        Output::AboveBelowSquashed => Image::Rgba(above_below_squashed(
             eye(View::Left)?,
             eye(View::Right)?,
             scene.blank_interval,
         )?),
-        Output::InterlacedRows => Image::Rgba(layout::interleave(
-            eye(View::Left)?,
-            eye(View::Right)?,
-            |_, y| y % 2 == 0,
-        )?),
-        Output::InterlacedColumns => Image::Rgba(layout::interleave(
-            eye(View::Left)?,
-            eye(View::Right)?,
-            |x, _| x % 2 == 0,
-        )?),
-        Output::Checkerboard => Image::Rgba(layout::interleave(
-            eye(View::Left)?,
-            eye(View::Right)?,
-            |x, y| (x + y) % 2 == 0,
-        )?),
+        Output::InterlacedRows => {
+            Image::Rgba(interleave(eye(View::Left)?, eye(View::Right)?, |_, y| {
+                y % 2 == 0
+            })?)
+        }
+        Output::InterlacedColumns => {
+            Image::Rgba(interleave(eye(View::Left)?, eye(View::Right)?, |x, _| {
+                x % 2 == 0
+            })?)
+        }
+        Output::Checkerboard => {
+            Image::Rgba(interleave(eye(View::Left)?, eye(View::Right)?, |x, y| {
+                (x + y) % 2 == 0
+            })?)
+        }
         Output::ChromaDepth
         | Output::ChromaDepthLeft
         | Output::ChromaDepthRight
         | Output::ChromaDepthAnaglyph => {
             Image::Rgba(chromadepth::produce(output, frame, &scene.chromadepth)?.to_rgba_image())
         }
-        Output::Anaglyph(kind) => Image::Rgba(anaglyph::anaglyph(
+        Output::Anaglyph(kind) => Image::Rgba(anaglyph(
             eye(View::Left)?,
             eye(View::Right)?,
             kind,
@@ -162,40 +156,35 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             &frame.views.eyes[0].mvp,
             Precision::default(),
         )?),
-        Output::Occlusion => Image::Rgba(occlusion::occlusion_image(
+        Output::Occlusion => Image::Rgba(occlusion_image(
             eye(View::Left)?,
             eye(View::Right)?,
             [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp],
             Precision::default(),
         )?),
         Output::Parallax => Image::Rgba(parallax_image(eye(View::Left)?, &scene.parallax_rig()?)?),
-        Output::RdsLeft => Image::Rgba(rds::rds_left(scene.width, scene.height, &scene.rds)),
-        Output::RdsRight => Image::Rgba(rds_right(frame, scene, output)?),
+        Output::RdsLeft => Image::Rgba(rds_left(scene.width, scene.height, &scene.rds)),
+        Output::RdsRight => Image::Rgba(rds_right_of(frame, scene, output)?),
         Output::RdsAnaglyph => {
-            let left = rds::as_framebuffer(&rds::rds_left(scene.width, scene.height, &scene.rds));
-            let right = rds::as_framebuffer(&rds_right(frame, scene, output)?);
-            Image::Rgba(anaglyph::anaglyph(
-                &left,
-                &right,
-                anaglyph::AnaglyphKind::Gray,
-                scene.finalize,
-            )?)
+            let left = rds_framebuffer(&rds_left(scene.width, scene.height, &scene.rds));
+            let right = rds_framebuffer(&rds_right_of(frame, scene, output)?);
+            Image::Rgba(anaglyph(&left, &right, AnaglyphKind::Gray, scene.finalize)?)
         }
         Output::FrameSequential => Image::Sequence(frame_sequential::FrameSequence::from_frame(
             frame,
             &scene.frame_sequential,
         )?),
-        Output::GhostingLeft => Image::Rgba(ghosting::ghosted(
+        Output::GhostingLeft => Image::Rgba(ghosted(
             eye(View::Left)?,
             eye(View::Right)?,
             &scene.ghosting,
         )?),
-        Output::GhostingRight => Image::Rgba(ghosting::ghosted(
+        Output::GhostingRight => Image::Rgba(ghosted(
             eye(View::Right)?,
             eye(View::Left)?,
             &scene.ghosting,
         )?),
-        Output::AboveBelowCalibration => Image::Rgba(calibration::calibration_screen(
+        Output::AboveBelowCalibration => Image::Rgba(calibration_screen(
             scene.width,
             scene.height,
             scene.blank_interval,
@@ -221,8 +210,8 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
 }
 
 /// The right image of the random-dot pair from the frame's two depth passes.
-fn rds_right(frame: &Frame, scene: &Scene, output: Output) -> Result<image::RgbaImage> {
-    rds::rds_right(
+fn rds_right_of(frame: &Frame, scene: &Scene, output: Output) -> Result<image::RgbaImage> {
+    rds_right(
         need(frame, View::Left, output)?,
         need(frame, View::Right, output)?,
         &frame.views.eyes[0].mvp,
@@ -237,9 +226,9 @@ fn rds_right(frame: &Frame, scene: &Scene, output: Output) -> Result<image::Rgba
 /// (parallel axes).
 ///
 /// # Errors
-/// As [`StereoRig::resolve`](stereolab_core::math::StereoRig::resolve).
+/// As [`StereoRig::resolve`](stereolab_core::StereoRig::resolve).
 pub fn rig_metadata(scene: &Scene) -> Result<RigMetadata> {
-    use stereolab_core::math::CameraMode;
+    use stereolab_core::CameraMode;
     let r = scene.rig.resolve(&scene.camera, scene.aspect())?;
     let convergence_deg = match scene.rig.mode {
         CameraMode::ToeIn => {
@@ -283,7 +272,7 @@ pub fn write_all_with(
         .iter()
         .map(|&o| {
             let path = dir.join(o.file_name());
-            files::check_output_path(&path)?;
+            check_output_path(&path)?;
             Ok((path, make(o)?))
         })
         .collect::<Result<Vec<_>>>()?;

@@ -6,8 +6,7 @@ use crate::plan::{Output, View};
 use crate::render::Frame;
 use crate::render::chromadepth::resolve_texgen;
 use crate::scene::Scene;
-use stereolab_core::effects::ghosting::{contrast_warning, ghost_risk};
-use stereolab_core::error::Result;
+use stereolab_core::{Result, contrast_warning, ghost_risk};
 
 /// The report lines for `frame` (each without indentation or newline):
 ///

@@ -1,5 +1,6 @@
 //! `shear_vs_rotate`: the SGI course notes' §4.1.3 "Rotate vs. Shear" as one picture and a
-//! few measured numbers (the pure pieces are in [`stereolab_core::effects::shear_rotate`]).
+//! few measured numbers (the pure pieces are [`vertical_parallax_map`] and
+//! [`shear_rotate_difference`]).
 //!
 //! The picture is a 2 × 2 grid of `W×H` panels, each captioned:
 //!
@@ -14,12 +15,10 @@ use image::{RgbaImage, imageops};
 
 use crate::plan::{Output, View};
 use crate::render::Frame;
-use stereolab_core::effects::shear_rotate::{
-    Difference, difference, max_abs, vertical_parallax_image, vertical_parallax_map,
+use stereolab_core::{
+    Error, Framebuffer, Result, ShearRotateDifference, caption, max_abs_vertical_parallax,
+    shear_rotate_difference, vertical_parallax_image, vertical_parallax_map,
 };
-use stereolab_core::error::{Error, Result};
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::text;
 
 /// The measured numbers of a shear-vs-rotate comparison.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,9 +28,9 @@ pub struct ShearVsRotate {
     /// The same for the off-axis pair: zero up to rounding (parallel axes).
     pub shear_max_vertical: f64,
     /// Off-axis vs toe-in, left eye.
-    pub left: Difference,
+    pub left: ShearRotateDifference,
     /// Off-axis vs toe-in, right eye.
-    pub right: Difference,
+    pub right: ShearRotateDifference,
     /// Image height (for the percentages).
     pub height: u32,
 }
@@ -110,11 +109,11 @@ pub fn shear_vs_rotate(frame: &Frame) -> Result<(RgbaImage, ShearVsRotate)> {
         &mvp(frame, View::ShearLeft)?,
         &mvp(frame, View::ShearRight)?,
     )?;
-    let (diff_left, left) = difference(shear[0], rotate[0])?;
-    let (_, right) = difference(shear[1], rotate[1])?;
+    let (diff_left, left) = shear_rotate_difference(shear[0], rotate[0])?;
+    let (_, right) = shear_rotate_difference(shear[1], rotate[1])?;
     let numbers = ShearVsRotate {
-        rotate_max_vertical: max_abs(&rotate_map),
-        shear_max_vertical: max_abs(&shear_map),
+        rotate_max_vertical: max_abs_vertical_parallax(&rotate_map),
+        shear_max_vertical: max_abs_vertical_parallax(&shear_map),
         left,
         right,
         height: h,
@@ -148,7 +147,7 @@ pub fn shear_vs_rotate(frame: &Frame) -> Result<(RgbaImage, ShearVsRotate)> {
     let mut out = RgbaImage::new(2 * w, 2 * (h + caption_h));
     for (i, (img, label)) in panels.iter().enumerate() {
         let (x, y) = ((i as u32 % 2) * w, (i as u32 / 2) * (h + caption_h));
-        let band = text::caption(w, caption_h, label, size, [255, 255, 255]);
+        let band = caption(w, caption_h, label, size, [255, 255, 255]);
         imageops::replace(&mut out, &band, i64::from(x), i64::from(y));
         imageops::replace(&mut out, img, i64::from(x), i64::from(y + caption_h));
     }

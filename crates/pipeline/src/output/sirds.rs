@@ -8,14 +8,11 @@ use crate::plan::View;
 use crate::render::Frame;
 use crate::render::sirds_strips::{self, StripGeometry, StripResult};
 use crate::scene::Scene;
-use stereolab_core::effects::sirds::depthfile::{DepthMapping, DepthSamples, Near, PgmRows};
-use stereolab_core::effects::sirds::{
-    Algorithm, DepthMap, DepthRange, Disparity, DisparityModel, Filter, Settings, Sirds,
-    depth_range, pattern, per_pixel,
+use stereolab_core::{
+    DepthMap, DepthMapping, DepthRange, DepthSamples, Disparity, DisparityModel, Error,
+    Framebuffer, Near, PgmRows, Result, Sirds, SirdsAlgorithm, SirdsSettings, StripFilter,
+    depth_range, draw_guide_dots, per_pixel, write_atomic, write_png,
 };
-use stereolab_core::error::{Error, Result};
-use stereolab_core::files;
-use stereolab_core::framebuffer::Framebuffer;
 
 /// The cyclopean depth pass of `frame`.
 fn depth_pass(frame: &Frame) -> Result<&Framebuffer> {
@@ -42,7 +39,7 @@ pub fn scene_depth(frame: &Frame, scene: &Scene) -> Result<(DepthMap, DepthRange
 /// chose; adds guide dots if asked.
 ///
 /// # Errors
-/// As [`scene_depth`], [`per_pixel::per_pixel`] and [`sirds_strips::per_vertex`].
+/// As [`scene_depth`], [`per_pixel`] and [`sirds_strips::per_vertex`].
 pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
     let s = &scene.sirds;
     from_frame_with(frame, scene, |g, d| {
@@ -61,10 +58,10 @@ pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
 /// The three variants of the SIRDS paper's Fig. 5, top to bottom: eq. 3 (constant eye
 /// distance) with bilinear filtering, eq. 1 (constant viewing direction) bilinear, eq. 3 with
 /// nearest filtering ("without texture interpolation, discrete depth layers are visible").
-pub const FIG5_BANDS: [(DisparityModel, Filter); 3] = [
-    (DisparityModel::EyeDistance, Filter::Bilinear),
-    (DisparityModel::ViewAngle, Filter::Bilinear),
-    (DisparityModel::EyeDistance, Filter::Nearest),
+pub const FIG5_BANDS: [(DisparityModel, StripFilter); 3] = [
+    (DisparityModel::EyeDistance, StripFilter::Bilinear),
+    (DisparityModel::ViewAngle, StripFilter::Bilinear),
+    (DisparityModel::EyeDistance, StripFilter::Nearest),
 ];
 
 /// Output `sirds_fig5`: the scene's per-vertex SIRDS made three times from the one depth pass,
@@ -79,7 +76,7 @@ pub fn fig5_bands(frame: &Frame, scene: &Scene) -> Result<Sirds> {
     let mut bands = Vec::with_capacity(3);
     for (model, filter) in FIG5_BANDS {
         let mut s = scene.clone();
-        s.sirds.algorithm = Algorithm::PerVertex;
+        s.sirds.algorithm = SirdsAlgorithm::PerVertex;
         s.sirds.geometry.model = model;
         s.sirds.per_vertex.filter = filter;
         bands.push(from_frame(frame, &s)?);
@@ -109,25 +106,22 @@ pub fn from_frame_with(
     let (depth, range) = scene_depth(frame, scene)?;
     let d = s.geometry.to_pixels()?;
     let (mut pixels, iterations) = match s.algorithm {
-        Algorithm::PerPixel => {
+        SirdsAlgorithm::PerPixel => {
             let encoded = if s.cross_eyed {
                 depth.inverted()
             } else {
                 depth.clone()
             };
-            (
-                per_pixel::per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?,
-                None,
-            )
+            (per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?, None)
         }
-        Algorithm::PerVertex => {
+        SirdsAlgorithm::PerVertex => {
             let g = StripGeometry::new(scene, &frame.views.center, &range, &d, s.cross_eyed);
             let r = strips(&g, &d)?;
             (r.pixels, Some(r.iterations))
         }
     };
     if s.guide_dots {
-        pattern::draw_guide_dots(&mut pixels, scene.width, scene.height, d.max_separation());
+        draw_guide_dots(&mut pixels, scene.width, scene.height, d.max_separation());
     }
     Ok(Sirds {
         pixels,
@@ -206,14 +200,14 @@ impl Netpbm {
 }
 
 /// Writes RGBA pixels as PNG, or uncompressed as binary PPM (`.ppm`/`.pnm`) or PGM (`.pgm`,
-/// gray SIRDS only, see [`Netpbm`]), all or nothing ([`files::write_atomic`]).
+/// gray SIRDS only, see [`Netpbm`]), all or nothing ([`write_atomic`]).
 ///
 /// # Errors
 /// The file cannot be written, or its name is a link or a special file; a `.pgm` of a color
 /// SIRDS.
 pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<()> {
     if let Some(kind) = Netpbm::of(path) {
-        files::write_atomic(path, |w| {
+        write_atomic(path, |w| {
             w.write_all(kind.header(width, height).as_bytes())
                 .map_err(|e| Error::io(path, e))?;
             let mut row = Vec::with_capacity(width as usize * 3);
@@ -231,7 +225,7 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
                 format!("{} pixels for {width}x{height}", pixels.len()),
             )
         })?;
-        files::write_png(path, &img)
+        write_png(path, &img)
     }
 }
 
@@ -245,7 +239,7 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
 pub fn stream_depth_map(
     depth: &Path,
     near: Near,
-    settings: &Settings,
+    settings: &SirdsSettings,
     out: &Path,
 ) -> Result<(u32, u32, DepthMapping)> {
     // A binary PGM is read as it is used; anything else whole first.
@@ -274,13 +268,13 @@ pub fn stream_depth_map(
     let d = settings.geometry.to_pixels()?;
     // The rows stream into a temporary file: a failure in TIW or in the writing leaves `out`
     // as it was.
-    files::write_atomic(out, |writer| {
+    write_atomic(out, |writer| {
         let kind = Netpbm::of(out).unwrap_or(Netpbm::Ppm);
         writer
             .write_all(kind.header(width, height).as_bytes())
             .map_err(|e| Error::io(out, e))?;
         let mut bytes = Vec::new();
-        stereolab_core::effects::sirds::per_pixel::per_pixel_samples(
+        stereolab_core::per_pixel_samples(
             width,
             height,
             read,

@@ -36,7 +36,7 @@ use std::path::Path;
 
 use image::RgbaImage;
 
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 
 /// Which stereo photo format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -406,12 +406,12 @@ pub fn mpo_images<'a>(path: &Path, bytes: &'a [u8]) -> Result<Vec<&'a [u8]>> {
 /// `Io`/`Parse` naming the file: unreadable, not the format its name says, an odd width, or
 /// a JPS layout other than side by side.
 pub fn read_stereo(path: &Path) -> Result<(RgbaImage, RgbaImage)> {
-    use stereolab_core::framebuffer::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
+    use stereolab_core::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
     let format = PhotoFormat::from_path(path).ok_or_else(|| {
         Error::invalid("stereo photo", path.display(), "name it .mpo, .jps or .pns")
     })?;
     // A JPEG of the largest accepted image stays well under 4 bytes a pixel.
-    let bytes = stereolab_core::files::read_input(path, MAX_IMAGE_PIXELS * 4)?;
+    let bytes = stereolab_core::read_input(path, MAX_IMAGE_PIXELS * 4)?;
     let decode = |data: &[u8], fmt: image::ImageFormat| -> Result<RgbaImage> {
         let mut r = image::ImageReader::with_format(Cursor::new(data), fmt);
         let mut limits = image::Limits::default();

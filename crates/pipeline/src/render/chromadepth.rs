@@ -4,14 +4,10 @@
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use crate::scene::{Object, Scene};
-use stereolab_core::effects::chromadepth::ramp::{Ramp, Sampling};
-use stereolab_core::effects::chromadepth::texgen::{Texgen, auto_range};
-use stereolab_core::effects::chromadepth::{ChromaDepthSettings, TexgenMode};
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::EyeMatrices;
-use stereolab_core::raster::{RasterStats, rasterize};
-use stereolab_core::shade::{Fragment, Shader, Varyings, to_rgba8};
+use stereolab_core::{
+    ChromaDepthSettings, EyeMatrices, Fragment, Framebuffer, Ramp, RampSampling, RasterStats,
+    Result, Shader, Texgen, TexgenMode, Varyings, auto_range, rasterize, to_rgba8,
+};
 
 /// The fragment program of one object in the ChromaDepth pass.
 ///
@@ -32,7 +28,7 @@ pub struct ChromaDepthShader<'a> {
     projection: Mat4,
     texgen: Texgen,
     ramp: &'a Ramp,
-    sampling: Sampling,
+    sampling: RampSampling,
     mode: TexgenMode,
     /// `(light position in eye space, ambient)` for lit ChromaDepth.
     lighting: Option<(Vec3, f32)>,

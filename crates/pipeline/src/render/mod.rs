@@ -13,12 +13,10 @@ use rayon::prelude::*;
 
 use crate::plan::{Pass, Plan, Shading, View};
 use crate::scene::Scene;
-use stereolab_core::Eye;
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::math::{CameraMode, EyeMatrices, StereoRig};
-use stereolab_core::raster::{RasterStats, rasterize, rasterize_blinn_phong};
-use stereolab_core::shade::{BlinnPhong, DepthOnly};
+use stereolab_core::{
+    BlinnPhong, CameraMode, DepthOnly, Eye, EyeMatrices, Framebuffer, RasterStats, Result,
+    StereoRig, rasterize, rasterize_blinn_phong,
+};
 
 /// What one pass produced.
 #[derive(Clone, Debug)]
@@ -128,10 +126,7 @@ impl Frame {
 
     /// The eye framebuffer behind an OpenGL stereo draw buffer (`BACK_LEFT` is the left eye's,
     /// `BACK_RIGHT` the right eye's), if the plan rendered that eye.
-    pub fn draw_buffer(
-        &self,
-        buffer: stereolab_core::framebuffer::DrawBuffer,
-    ) -> Option<&Framebuffer> {
+    pub fn draw_buffer(&self, buffer: stereolab_core::DrawBuffer) -> Option<&Framebuffer> {
         self.view(buffer.eye().into())
     }
 

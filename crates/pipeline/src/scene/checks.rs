@@ -17,10 +17,7 @@ use glam::DVec3;
 
 use super::{Object, Scene, file::LightSpec, file::RasterSpec};
 use crate::plan::Output;
-use stereolab_core::effects::sirds::settings::{Algorithm, Settings};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::math::Camera;
-use stereolab_core::raster::DepthMode;
+use stereolab_core::{Camera, DepthMode, Error, Result, SirdsAlgorithm, SirdsSettings};
 
 /// Warn when two surfaces must be further apart in depth than this fraction of the smallest
 /// object's size to be told apart: a cube 1 unit wide z-fights where its faces come within
@@ -88,8 +85,8 @@ pub(super) fn depth_mode(spec: &RasterSpec, camera: &Camera) -> Result<DepthMode
 /// Per-vertex SIRDS renders the background plane at `sirds.back` and maps `sirds.front` to the
 /// nearest depth: both must lie inside the camera's clip range, or the plane is clipped away
 /// and the image is no autostereogram.
-pub(super) fn check_sirds_clip(s: &Settings, camera: &Camera) -> Result<()> {
-    if s.algorithm != Algorithm::PerVertex {
+pub(super) fn check_sirds_clip(s: &SirdsSettings, camera: &Camera) -> Result<()> {
+    if s.algorithm != SirdsAlgorithm::PerVertex {
         return Ok(());
     }
     for (name, v) in [("sirds.front", s.front), ("sirds.back", s.back)] {

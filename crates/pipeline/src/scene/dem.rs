@@ -13,7 +13,7 @@ use std::path::Path;
 
 use super::terrain::{Terrain, TerrainPoint, triangulate};
 use super::terrain_data::SplitMix64;
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 
 /// The largest DEM image side accepted (read from the header, before decoding).
 pub const MAX_DEM_SIDE: u32 = 8192;
@@ -69,7 +69,7 @@ impl DemGrid {
 /// Unreadable or oversized file; `Parse` for a color image or one smaller than 2×2.
 pub fn load_grid(path: &Path) -> Result<DemGrid> {
     let img =
-        stereolab_core::files::open_image(path, "elevation image", MAX_DEM_SIDE, MAX_DEM_PIXELS)?;
+        stereolab_core::open_image_within(path, "elevation image", MAX_DEM_SIDE, MAX_DEM_PIXELS)?;
     if img.color().has_color() {
         return Err(Error::parse(
             path,

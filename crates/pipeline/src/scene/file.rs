@@ -2,8 +2,7 @@
 
 use serde::Deserialize;
 
-use stereolab_core::effects::chromadepth::ChromaDepthSettings;
-use stereolab_core::math::{Camera, CameraMode, Lighting, Viewer};
+use stereolab_core::{Camera, CameraMode, ChromaDepthSettings, Lighting, Viewer};
 
 /// A scene file as written.
 #[derive(Debug, Deserialize)]
@@ -33,16 +32,16 @@ pub(crate) struct SceneFile {
     pub finalize: FinalizeSpec,
     /// Autostereogram options.
     #[serde(default)]
-    pub sirds: stereolab_core::effects::sirds::SirdsSpec,
+    pub sirds: stereolab_core::SirdsSpec,
     /// Random-dot stereo pair options (`rds_left`, `rds_right`, `rds_anaglyph`).
     #[serde(default)]
-    pub rds: stereolab_core::effects::rds::RdsSettings,
+    pub rds: stereolab_core::RdsSettings,
     /// Crosstalk options (`ghosting_left`, `ghosting_right`).
     #[serde(default)]
-    pub ghosting: stereolab_core::effects::ghosting::GhostingSettings,
+    pub ghosting: stereolab_core::GhostingSettings,
     /// Frame-sequential animation options (`frame_sequential`).
     #[serde(default)]
-    pub frame_sequential: stereolab_core::effects::frame_sequential::FrameSequentialSettings,
+    pub frame_sequential: stereolab_core::FrameSequentialSettings,
     /// Objects, in `[[mesh]]` tables.
     #[serde(default, rename = "mesh")]
     pub meshes: Vec<MeshSpec>,

@@ -2,7 +2,7 @@
 
 use glam::{Vec2, Vec3};
 
-use stereolab_core::error::{Error, Result};
+use stereolab_core::{Error, Result};
 
 /// An indexed triangle mesh with per-vertex normals and texture coordinates.
 #[derive(Clone, Debug, Default, PartialEq)]

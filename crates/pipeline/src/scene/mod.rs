@@ -20,15 +20,11 @@ use std::path::Path;
 use glam::{EulerRot, Mat4, Quat, Vec3};
 
 use crate::plan::Output;
-use stereolab_core::effects::anaglyph::AnaglyphOptions;
-use stereolab_core::effects::chromadepth::ChromaDepthSettings;
-use stereolab_core::effects::parallax::ParallaxRig;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::files::InputRoot;
-use stereolab_core::framebuffer::check_size;
-use stereolab_core::math::{Camera, Separation, StereoRig, ZeroParallax, fit_zero_parallax};
-use stereolab_core::raster::RasterOptions;
-use stereolab_core::shade::{Light, to_rgba8};
+use stereolab_core::{
+    AnaglyphOptions, Camera, ChromaDepthSettings, Error, InputRoot, Light, ParallaxRig,
+    RasterOptions, Result, Separation, StereoRig, ZeroParallax, check_size, fit_zero_parallax,
+    to_rgba8,
+};
 
 /// One object: a mesh placed in the world with a color.
 #[derive(Clone, Debug)]
@@ -71,13 +67,13 @@ pub struct Scene {
     /// Finalize-pass options from `[finalize]` (anaglyph linear light, swapped eyes).
     pub finalize: AnaglyphOptions,
     /// Autostereogram options (`[sirds]`).
-    pub sirds: stereolab_core::effects::sirds::Settings,
+    pub sirds: stereolab_core::SirdsSettings,
     /// Random-dot stereo pair options (`[rds]`).
-    pub rds: stereolab_core::effects::rds::RdsSettings,
+    pub rds: stereolab_core::RdsSettings,
     /// Crosstalk options (`[ghosting]`).
-    pub ghosting: stereolab_core::effects::ghosting::GhostingSettings,
+    pub ghosting: stereolab_core::GhostingSettings,
     /// Frame-sequential options (`[frame_sequential]`).
-    pub frame_sequential: stereolab_core::effects::frame_sequential::FrameSequentialSettings,
+    pub frame_sequential: stereolab_core::FrameSequentialSettings,
     /// What loading read in an unusual way and accepted, each naming its file and line (an
     /// OBJ coordinate such as `3.1+e2`, read as assimp reads it); `stereolab render` prints
     /// them.
@@ -134,7 +130,7 @@ impl Scene {
     /// # Errors
     /// As [`Scene::load`].
     pub fn load_with(path: &Path, sets: &[String], opts: &LoadOptions) -> Result<Scene> {
-        let text = stereolab_core::files::read_text(path, MAX_SCENE_BYTES)?;
+        let text = stereolab_core::read_text(path, MAX_SCENE_BYTES)?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Scene::from_toml_with(&text, path, &opts.root(&base), sets, opts.max_triangles)
     }
@@ -290,7 +286,7 @@ impl Scene {
                 "stereo.zero_parallax = \"auto\": z0 = {z0:.4} (the camera target's distance)"
             ));
         }
-        let sirds = stereolab_core::effects::sirds::Settings::from_spec(&f.sirds, root)?;
+        let sirds = stereolab_core::SirdsSettings::from_spec(&f.sirds, root)?;
         checks::check_sirds_clip(&sirds, &f.camera)?;
         let depth = checks::depth_mode(&f.raster, &f.camera)?;
         let mut scene = Scene {
@@ -372,7 +368,7 @@ impl Scene {
 /// `zero_parallax = "fit"`: the eye distances of the nearest and farthest vertex inside the
 /// cyclopean view (strictly between near and far) give [`fit_zero_parallax`].
 fn fit_scene_zero_parallax(rig: &StereoRig, camera: &Camera, objects: &[Object]) -> Result<f32> {
-    use stereolab_core::math::CameraMode;
+    use stereolab_core::CameraMode;
     let balance = match rig.mode {
         // Image-shift: the balance before its whole-pixel rounding (z0 fixes that rounding).
         CameraMode::OffAxis | CameraMode::ImageShift => rig.user_balance,

@@ -6,8 +6,7 @@ use glam::{Vec2, Vec3};
 
 use super::mesh::Mesh;
 use super::polygon;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::files::excerpt;
+use stereolab_core::{Error, Result, excerpt};
 
 /// Refuse OBJ files above this size before reading them (the largest real model we ship is < 1 MB).
 const MAX_OBJ_BYTES: u64 = 512 * 1024 * 1024;
@@ -35,9 +34,9 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
 /// # Errors
 /// As [`load_obj`].
 pub fn load_obj_with_notes(path: &Path) -> Result<(Mesh, Vec<String>)> {
-    let bytes = stereolab_core::files::read_input(path, MAX_OBJ_BYTES)?;
+    let bytes = stereolab_core::read_input(path, MAX_OBJ_BYTES)?;
     let text = decode(path, bytes)?;
-    parse_obj_with_notes(path, stereolab_core::files::without_bom(text))
+    parse_obj_with_notes(path, stereolab_core::without_bom(text))
 }
 
 /// Text of an OBJ file's bytes: UTF-8, else UTF-16 if it starts with a byte-order mark
@@ -474,7 +473,7 @@ mod tests {
         let be: Vec<u8> = units.iter().flat_map(|u| u.to_be_bytes()).collect();
         let le: Vec<u8> = units.iter().flat_map(|u| u.to_le_bytes()).collect();
         for bytes in [be, le] {
-            let text = stereolab_core::files::without_bom(decode(path(), bytes).unwrap());
+            let text = stereolab_core::without_bom(decode(path(), bytes).unwrap());
             assert!(text.starts_with("# ä\n"), "{text:?}");
             assert_eq!(parse_obj(path(), text).unwrap().triangles.len(), 2);
         }

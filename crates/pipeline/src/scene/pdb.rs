@@ -14,8 +14,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use super::mesh::Mesh;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::files::excerpt;
+use stereolab_core::{Error, Result, excerpt};
 
 /// Refuse PDB files above this size before reading them (the largest entries in the archive
 /// that still use the PDB format are a few tens of megabytes).
@@ -185,7 +184,7 @@ fn element_of(line: &str) -> Option<String> {
 /// # Errors
 /// Unreadable or oversized file, and what [`parse_pdb`] refuses.
 pub fn load_pdb(path: &Path) -> Result<Vec<Atom>> {
-    let text = stereolab_core::files::read_text(path, MAX_PDB_BYTES)?;
+    let text = stereolab_core::read_text(path, MAX_PDB_BYTES)?;
     parse_pdb(path, &text)
 }
 

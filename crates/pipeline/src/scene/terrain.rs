@@ -8,8 +8,7 @@ use glam::{Vec2, Vec3};
 use spade::{DelaunayTriangulation, HierarchyHintGenerator, Point2, Triangulation};
 
 use super::mesh::Mesh;
-use stereolab_core::error::{Error, Result};
-use stereolab_core::files::excerpt;
+use stereolab_core::{Error, Result, excerpt};
 
 /// Refuse CSV files above this size before reading them.
 const MAX_CSV_BYTES: u64 = 256 * 1024 * 1024;
@@ -62,7 +61,7 @@ pub fn load_terrain_csv(path: &Path) -> Result<Terrain> {
 /// # Errors
 /// As [`load_terrain_csv`], and `Invalid` naming the point count and the budget.
 pub fn load_terrain_csv_within(path: &Path, max_triangles: u64) -> Result<Terrain> {
-    let text = stereolab_core::files::read_text(path, MAX_CSV_BYTES)?;
+    let text = stereolab_core::read_text(path, MAX_CSV_BYTES)?;
     let points = parse_csv(path, &text)?;
     drop(text);
     let most = 2 * points.len() as u64;

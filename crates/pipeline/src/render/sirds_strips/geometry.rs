@@ -5,8 +5,7 @@
 use glam::Vec4;
 
 use crate::scene::Scene;
-use stereolab_core::effects::sirds::{DepthRange, Disparity};
-use stereolab_core::math::EyeMatrices;
+use stereolab_core::{DepthRange, Disparity, EyeMatrices};
 
 /// The scene as the strip passes see it: cyclopean clip positions, each vertex's separation,
 /// and the triangles, the background plane last (drawn last, most of it fails the depth test).

@@ -33,13 +33,11 @@ use geometry::shift;
 use glam::Vec4;
 use rayon::prelude::*;
 
-use stereolab_core::effects::sirds::per_pixel::check_inputs;
-use stereolab_core::effects::sirds::{Disparity, Pattern};
-use stereolab_core::effects::sirds::{Filter, PerVertexOptions, Start};
-use stereolab_core::error::{Error, Result};
-use stereolab_core::raster::{RasterOptions, SetupTriangle, bin_rows, setup_triangles};
-use stereolab_core::shade::{Fragment, Shader, Varyings};
-use stereolab_core::simd::{Kernels, kernels};
+use stereolab_core::{
+    Disparity, Error, Fragment, Kernels, PerVertexOptions, RasterOptions, Result, SetupTriangle,
+    Shader, SirdsPattern, StripFilter, StripStart, Varyings, bin_rows, check_sirds_inputs, kernels,
+    setup_triangles,
+};
 
 /// What a strip run produced.
 #[derive(Clone, Debug, PartialEq)]
@@ -113,8 +111,8 @@ pub fn plan_strips(width: u32, d: &Disparity, opts: &PerVertexOptions) -> Result
     };
     let (w, mut strips) = (width as i64, Vec::new());
     let center = match opts.start {
-        Start::Left => 0,
-        Start::Center => width / 2,
+        StripStart::Left => 0,
+        StripStart::Center => width / 2,
     };
     let mut x = center;
     while x < width {
@@ -355,7 +353,7 @@ fn resolve_strip(
     strip: &Strip,
     bilinear: bool,
     kernels: Kernels,
-    pattern: &Pattern,
+    pattern: &SirdsPattern,
 ) {
     let simd = kernels.avx2();
     let rows = image
@@ -382,16 +380,16 @@ fn resolve_strip(
 /// [`per_vertex_reference`] and [`reference::k_passes`] start with.
 ///
 /// # Errors
-/// As [`check_inputs`], [`stereolab_core::framebuffer::check_size`] and [`plan_strips`].
+/// As [`check_sirds_inputs`], [`stereolab_core::check_size`] and [`plan_strips`].
 fn checked_strips(
     width: u32,
     height: u32,
     d: &Disparity,
-    pattern: &Pattern,
+    pattern: &SirdsPattern,
     opts: &PerVertexOptions,
 ) -> Result<Vec<Strip>> {
-    check_inputs(width, d, pattern)?;
-    stereolab_core::framebuffer::check_size(width, height)?;
+    check_sirds_inputs(width, d, pattern)?;
+    stereolab_core::check_size(width, height)?;
     plan_strips(width, d, opts)
 }
 
@@ -404,13 +402,13 @@ fn checked_strips(
 /// result is the paper's k render passes, byte for byte (see the module notes).
 ///
 /// # Errors
-/// As [`check_inputs`], and k too small for the front separation.
+/// As [`check_sirds_inputs`], and k too small for the front separation.
 pub fn per_vertex_reference(
     geometry: &StripGeometry,
     width: u32,
     height: u32,
     d: &Disparity,
-    pattern: &Pattern,
+    pattern: &SirdsPattern,
     opts: &PerVertexOptions,
     record_links: bool,
 ) -> Result<StripResult> {
@@ -436,7 +434,7 @@ pub fn per_vertex(
     width: u32,
     height: u32,
     d: &Disparity,
-    pattern: &Pattern,
+    pattern: &SirdsPattern,
     opts: &PerVertexOptions,
     record_links: bool,
 ) -> Result<StripResult> {
@@ -449,7 +447,7 @@ fn per_vertex_on(
     geometry: &StripGeometry,
     (width, height): (u32, u32),
     d: &Disparity,
-    pattern: &Pattern,
+    pattern: &SirdsPattern,
     opts: &PerVertexOptions,
     record_links: bool,
     kernels: Kernels,
@@ -480,7 +478,7 @@ fn per_vertex_on(
     let left = left
         .as_ref()
         .map_or_else(Vec::new, |l| bin_rows(l, BAND_ROWS, height));
-    let bilinear = opts.filter == Filter::Bilinear;
+    let bilinear = opts.filter == StripFilter::Bilinear;
     // Each direction covers the columns of its strips: right-going from the start column on,
     // left-going before it.
     let split = strips

@@ -22,15 +22,13 @@
 use glam::Vec4;
 
 use super::{
-    Filter, PerVertexOptions, Strip, StripGeometry, StripResult, address, checked_strips,
+    PerVertexOptions, Strip, StripFilter, StripGeometry, StripResult, address, checked_strips,
     in_bounds, mix, shift, source_coordinate,
 };
-use stereolab_core::effects::sirds::disparity::Disparity;
-use stereolab_core::effects::sirds::pattern::Pattern;
-use stereolab_core::error::Result;
-use stereolab_core::framebuffer::Framebuffer;
-use stereolab_core::raster::{RasterOptions, rasterize};
-use stereolab_core::shade::{Fragment, Shader, Varyings};
+use stereolab_core::{
+    Disparity, Fragment, Framebuffer, RasterOptions, Result, Shader, SirdsPattern, Varyings,
+    rasterize,
+};
 
 /// Fig. 4's vertex and fragment programs for the pass of one strip.
 struct StripPass<'a> {
@@ -114,12 +112,12 @@ pub fn k_passes(
     width: u32,
     height: u32,
     d: &Disparity,
-    pattern: &Pattern,
+    pattern: &SirdsPattern,
     opts: &PerVertexOptions,
     record_links: bool,
 ) -> Result<StripResult> {
     let strips = checked_strips(width, height, d, pattern, opts)?;
-    let bilinear = opts.filter == Filter::Bilinear;
+    let bilinear = opts.filter == StripFilter::Bilinear;
     let mut a = pattern.fill(width, height);
     // −1 (no link) where the pattern stays, as the fast path records.
     let mut links = record_links.then(|| vec![-1i32; a.len()]);
@@ -192,10 +190,7 @@ mod tests {
     use crate::render::render_view;
     use crate::render::sirds_strips::{per_vertex_on, per_vertex_reference};
     use crate::scene::Scene;
-    use stereolab_core::effects::sirds::Start;
-    use stereolab_core::effects::sirds::depth_range;
-    use stereolab_core::math::StereoRig;
-    use stereolab_core::simd::{Kernels, avx2_available};
+    use stereolab_core::{Kernels, StereoRig, StripStart, avx2_available, depth_range};
 
     /// The camera of tests/sirds.rs.
     const CAMERA: &str = "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\
@@ -276,7 +271,7 @@ mod tests {
                  compared with the k passes"
             );
         }
-        let pattern = Pattern::Color { seed: 11 };
+        let pattern = SirdsPattern::Color { seed: 11 };
         // (name, scene, size, dpi, k, cross-eyed): k `None` gives the widest strips
         // (⌊δ⌋ − 1: 71 px at 72 dpi, 23 px at 24 dpi), 96 px at k 16 strips of 6 px, narrower
         // than one AVX2 vector, at k 96 strips of 1 px, 257 px at k 43 strips of 6 px.
@@ -293,8 +288,8 @@ mod tests {
         let mut compared = 0;
         for (name, scene, (w, h), dpi, iterations, cross_eyed) in cases {
             let (g, d) = inputs(scene, (w, h), dpi, cross_eyed);
-            for start in [Start::Left, Start::Center] {
-                for filter in [Filter::Nearest, Filter::Bilinear] {
+            for start in [StripStart::Left, StripStart::Center] {
+                for filter in [StripFilter::Nearest, StripFilter::Bilinear] {
                     let opts = PerVertexOptions {
                         start,
                         filter,
@@ -334,7 +329,7 @@ mod tests {
     #[test]
     fn k_passes_refuse_what_the_fast_path_refuses() {
         let (g, d) = inputs(SPHERE, (96, 67), 72.0, false);
-        let pattern = Pattern::Gray { seed: 1 };
+        let pattern = SirdsPattern::Gray { seed: 1 };
         for (w, iterations) in [(96, Some(0)), (96, Some(1)), (80, None)] {
             let opts = PerVertexOptions {
                 iterations,

@@ -5,9 +5,7 @@ use super::*;
 use crate::fixtures::table_scene;
 use crate::plan::Shading;
 use crate::render::render_view;
-use stereolab_core::effects::sirds::depth_range;
-use stereolab_core::math::StereoRig;
-use stereolab_core::simd::avx2_available;
+use stereolab_core::{StereoRig, avx2_available, depth_range};
 
 /// Whether there are AVX2 loops to compare with the scalar ones; without them (a CPU without
 /// AVX2) it says so on stderr, and every path that runs is the scalar one the other tests cover.
@@ -30,8 +28,8 @@ fn reads_of_unfinished_pixels_see_the_pattern() {
     // Gray (the one-channel mix) and color.
     for (bilinear, pattern) in [false, true].into_iter().flat_map(|b| {
         [
-            (b, Pattern::Gray { seed: 3 }),
-            (b, Pattern::Color { seed: 4 }),
+            (b, SirdsPattern::Gray { seed: 3 }),
+            (b, SirdsPattern::Color { seed: 4 }),
         ]
     }) {
         let start: Vec<[u8; 4]> = (0..w as u32).map(|x| pattern.color(x, y)).collect();
@@ -116,12 +114,12 @@ fn avx2_strips_match_scalar_strips() {
         let (fb, _) = render_view(&s, &center, Shading::DepthOnly).expect("depth pass");
         let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far).expect("range");
         let g = StripGeometry::new(&s, &center, &range, &d, false);
-        let patterns = [s.sirds.pattern.clone(), Pattern::Color { seed: 9 }];
+        let patterns = [s.sirds.pattern.clone(), SirdsPattern::Color { seed: 9 }];
         for (pattern, start) in patterns
             .iter()
-            .flat_map(|p| [(p, Start::Left), (p, Start::Center)])
+            .flat_map(|p| [(p, StripStart::Left), (p, StripStart::Center)])
         {
-            for filter in [Filter::Nearest, Filter::Bilinear] {
+            for filter in [StripFilter::Nearest, StripFilter::Bilinear] {
                 let opts = PerVertexOptions {
                     start,
                     filter,
