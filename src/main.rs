@@ -1,7 +1,7 @@
 //! The `stereolab` command line: one module per subcommand. The library (`stereolab::…`)
 //! does the work; this binary parses arguments, prints, and sets process-wide things (the
 //! allocator, the thread pool). `STEREOLAB_SCALAR=1` (the scalar loops for every pass) is read
-//! where the kernels are chosen, `stereolab_core::kernels`.
+//! once, where the core chooses its loops (`stereolab_core::uses_avx2` tells which).
 
 /// `print!` to standard output, but a closed pipe or a full disk comes back as an error (which
 /// `main` reports, or ends on quietly for a closed pipe) instead of a panic.

@@ -411,7 +411,7 @@ fn shipped_scenes_match_coverage_depth_and_color() {
                 continue;
             }
             // The shear-vs-rotate picture shows the two left eyes' difference ×4
-            // (`effects::shear_rotate::difference`), so an eye's step shows as four there.
+            // (`stereolab_core::shear_rotate_difference`), so an eye's step shows as four there.
             let bound = if row.name == "shear_vs_rotate" {
                 4 * SHIPPED_MAX_CHANNEL_DIFF
             } else {

@@ -5,12 +5,12 @@
 
 use stereolab::output::sirds::scene_depth;
 use stereolab::plan::Plan;
-use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::scene::Scene;
 use stereolab_core::{
     PerVertexOptions, SirdsDecodeOptions, SirdsPattern, StripFilter, StripStart, decode_sirds,
     sirds_round_trip,
 };
+use stereolab_core::{StripGeometry, per_vertex};
 use stereolab_gpu::parity::compare_scene;
 use stereolab_gpu::sirds::GpuStrips;
 
@@ -46,7 +46,7 @@ fn gpu_strips_match_cpu_strips_and_decode() {
         let f = frame(&s);
         let (depth, range) = scene_depth(&f, &s).expect("depth");
         let d = s.sirds.geometry.to_pixels().expect("valid");
-        let g = StripGeometry::new(&s, &f.views.center, &range, &d, false);
+        let g = StripGeometry::new(&s.strip_objects(), &f.views.center, &range, &d, false);
         let intended: Vec<f32> = depth.z.iter().map(|&z| d.separation(z)).collect();
         for start in [StripStart::Left, StripStart::Center] {
             for filter in [StripFilter::Nearest, StripFilter::Bilinear] {
@@ -128,7 +128,7 @@ fn gpu_strips_reject_too_few_iterations_like_the_cpu() {
     let f = frame(&s);
     let (_, range) = scene_depth(&f, &s).expect("depth");
     let d = s.sirds.geometry.to_pixels().expect("valid");
-    let g = StripGeometry::new(&s, &f.views.center, &range, &d, false);
+    let g = StripGeometry::new(&s.strip_objects(), &f.views.center, &range, &d, false);
     let opts = PerVertexOptions {
         iterations: Some(2),
         ..PerVertexOptions::default()

@@ -707,7 +707,7 @@ fn catalogue_remap_at_near_far_1e_minus_6_stays_within_half_a_pixel() {
 }
 
 /// Catalogue: a model of size 2 at distance `t` from the origin, the camera 6 units from it.
-/// The renderer's f32 view (`math::look_at`, `math::frustum`) against the f64 rig on the same
+/// The renderer's f32 view (`stereolab_core::look_at`, `stereolab_core::frustum`) against the f64 rig on the same
 /// f32 vertices, so only the transform's precision is measured. Tolerance: no decided pixel
 /// differs while f32 spaces coordinates there at most 1e-4 of the model's size (where the
 /// scene check stays silent, `ORIGIN_PRECISION_WARN`); beyond, the check warns (tested in

@@ -5,7 +5,6 @@ use std::path::Path;
 
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::{Output, Pass, Plan, Shading, View};
-use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::render::{Frame, render};
 use stereolab::scene::Scene;
 use stereolab_core::{
@@ -14,6 +13,7 @@ use stereolab_core::{
     decode_sirds, per_pixel, separation_eye_distance, separation_view_angle, sirds_round_trip,
     tan_phi_eye_distance,
 };
+use stereolab_core::{StripGeometry, per_vertex};
 
 use crate::common;
 
@@ -228,7 +228,7 @@ fn per_vertex_nearest_copies_are_exact() {
     let f = frame(&s);
     let (_, range) = scene_depth(&f, &s).expect("depth");
     let d = SirdsGeometry::default().to_pixels().expect("valid");
-    let g = StripGeometry::new(&s, &f.views.center, &range, &d, false);
+    let g = StripGeometry::new(&s.strip_objects(), &f.views.center, &range, &d, false);
     for start in [StripStart::Left, StripStart::Center] {
         let opts = PerVertexOptions {
             start,

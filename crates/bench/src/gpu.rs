@@ -15,7 +15,7 @@ use stereolab_core::{
 use stereolab::output::{Image, produce};
 use stereolab::plan::{Output, Plan, Shading};
 use stereolab::render::render;
-use stereolab::render::sirds_strips::StripGeometry;
+use stereolab_core::StripGeometry;
 use stereolab_gpu::parity::compare_frames;
 use stereolab_gpu::sirds::GpuStrips;
 use stereolab_gpu::{GpuFinalize, GpuRenderer, GpuScene};
@@ -351,7 +351,7 @@ fn pair_and_anaglyph(
 fn sirds_rows(r: &GpuRenderer, iters: usize) -> Result<Vec<Row>> {
     use stereolab::fixtures::{TABLE_1, table_scene};
     use stereolab::render::render_view;
-    use stereolab::render::sirds_strips::per_vertex;
+    use stereolab_core::per_vertex;
     use stereolab_core::{StereoRig, depth_range};
 
     let (w, h, tris, k, paper_hz) = TABLE_1[0];
@@ -362,7 +362,7 @@ fn sirds_rows(r: &GpuRenderer, iters: usize) -> Result<Vec<Row>> {
     let cpu_frame = || -> Result<Vec<[u8; 4]>> {
         let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
         let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
-        let g = StripGeometry::new(&s, &center, &range, &d, false);
+        let g = StripGeometry::new(&s.strip_objects(), &center, &range, &d, false);
         Ok(per_vertex(&g, w, h, &d, &s.sirds.pattern, opts, false)?.pixels)
     };
     let gpu_scene = GpuScene::upload(r, &s)?;
@@ -370,7 +370,7 @@ fn sirds_rows(r: &GpuRenderer, iters: usize) -> Result<Vec<Row>> {
     let gpu_frame = || -> Result<Vec<[u8; 4]>> {
         let fb = r.render_view(&gpu_scene, &center, Shading::DepthOnly)?;
         let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
-        let g = StripGeometry::new(&s, &center, &range, &d, false);
+        let g = StripGeometry::new(&s.strip_objects(), &center, &range, &d, false);
         Ok(strips.run(r, &g, w, h, &d, &s.sirds.pattern, opts)?.pixels)
     };
     let (cpu, gpu) = (cpu_frame()?, gpu_frame()?);

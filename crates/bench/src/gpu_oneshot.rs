@@ -499,7 +499,7 @@ fn u32_bytes(v: &[u32]) -> Vec<u8> {
 }
 
 /// The goal-1 rows: the CPU stereo pair + Dubois anaglyph (on the loops
-/// [`kernels`](stereolab_core::kernels) chose: the AVX2 fragment stage where the CPU has
+/// [`uses_avx2`](stereolab_core::uses_avx2) tells: the AVX2 fragment stage where the CPU has
 /// it, the scalar stage with `STEREOLAB_SCALAR=1`), beside [`OneShot`] on the same scene, timed
 /// in the same run. The CPU row's note carries the ratio `cpu / wgpu`; the wgpu row's error is the largest
 /// channel difference to the CPU's anaglyph (its arithmetic is not the parity path's).
@@ -561,7 +561,7 @@ pub(super) fn rows(scene: &Scene, iters: usize) -> Result<Vec<super::Row>> {
     if let Some(e) = failed {
         return Err(e);
     }
-    let simd = if stereolab_core::kernels().avx2() {
+    let simd = if stereolab_core::uses_avx2() {
         "AVX2 fragment stage"
     } else if stereolab_core::avx2_available() {
         "STEREOLAB_SCALAR: scalar"

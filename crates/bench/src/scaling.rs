@@ -15,10 +15,10 @@
 use super::{Row, median_ms};
 use stereolab::fixtures::{TABLE_1, table_scene};
 use stereolab::plan::{Output, Plan, Shading};
-use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab::render::{render, render_view};
 use stereolab::scene::Scene;
 use stereolab_core::{Error, Result, StereoRig, depth_range};
+use stereolab_core::{StripGeometry, per_vertex};
 
 fn row(knob: &str, setting: impl Into<String>, ms: f64, note: impl Into<String>) -> Row {
     Row {
@@ -68,7 +68,7 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let sirds = || -> Result<Vec<[u8; 4]>> {
         let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
         let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
-        let g = StripGeometry::new(&s, &center, &range, &d, false);
+        let g = StripGeometry::new(&s.strip_objects(), &center, &range, &d, false);
         Ok(per_vertex(&g, w, h, &d, &s.sirds.pattern, &s.sirds.per_vertex, false)?.pixels)
     };
     sirds()?;

@@ -7,7 +7,6 @@ use super::{Row, interleaved_medians, median_ms};
 use stereolab::fixtures::{TABLE_1, scene_from_text, sphere_over_ramp, table_scene};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::{Output, Plan, Shading};
-use stereolab::render::sirds_strips::{StripGeometry, per_vertex, per_vertex_reference};
 use stereolab::render::{render, render_view};
 use stereolab::scene::Scene;
 use stereolab_core::{
@@ -15,6 +14,7 @@ use stereolab_core::{
     SirdsDecodeOptions, SirdsPattern, SirdsRoundTrip, StereoRig, StripFilter, StripStart,
     decode_sirds, depth_range, per_pixel, sirds_round_trip,
 };
+use stereolab_core::{StripGeometry, per_vertex, per_vertex_reference};
 
 /// The SIRDS paper's Table 1, two rows per line of the table, each rate also as a multiple of
 /// the paper's:
@@ -43,7 +43,7 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     }
     let strips =
         |(s, center, d): &(Scene, EyeMatrices, Disparity), range: &DepthRange, simd: bool| {
-            let g = StripGeometry::new(s, center, range, d, false);
+            let g = StripGeometry::new(&s.strip_objects(), center, range, d, false);
             let (p, opts) = (&s.sirds.pattern, &s.sirds.per_vertex);
             if simd {
                 per_vertex(&g, s.width, s.height, d, p, opts, false).map(drop)
@@ -80,7 +80,7 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     let loops = |simd: bool| {
         if !simd {
             ", scalar loops"
-        } else if stereolab_core::kernels().avx2() {
+        } else if stereolab_core::uses_avx2() {
             ", AVX2 loops"
         } else {
             ", scalar loops (no AVX2 here, or STEREOLAB_SCALAR set)"

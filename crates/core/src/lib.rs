@@ -106,6 +106,10 @@ pub use effects::sirds::search::{
     search as search_separation,
 };
 pub use effects::sirds::settings::DotKind;
+pub use effects::sirds::strips::reference::k_passes as per_vertex_k_passes;
+pub use effects::sirds::strips::{
+    Strip, StripGeometry, StripObject, StripResult, per_vertex, per_vertex_reference, plan_strips,
+};
 pub use effects::sirds::{
     Algorithm as SirdsAlgorithm, DepthMap, DepthRange, Disparity, DisparityModel,
     Filter as StripFilter, Geometry as SirdsGeometry, Pattern as SirdsPattern, PerVertexOptions,
@@ -128,11 +132,6 @@ pub use math::{
     Camera, CameraMode, EyeMatrices, ImageShift, Lighting, ResolvedRig, Separation, StereoRig,
     Viewer, ZeroParallax, fit_zero_parallax, frustum, look_at, perspective, project_ndc,
 };
-pub use raster::avx2::{
-    columns as avx2_columns, covered_vectors as avx2_covered_vectors, depth_at as avx2_depth_at,
-    floor_i32 as avx2_floor_i32, load as avx2_load, opaque as avx2_opaque,
-    plane_at as avx2_plane_at, store as avx2_store, tail_mask as avx2_tail_mask,
-};
 pub use raster::{
     Band as RasterBand, DepthMode, DepthPlane, Plane, RasterOptions, RasterStats,
     Setup as TriangleSetup, SetupTriangle, Setups, SmallBox, WindowVertex, bin_rows, rasterize,
@@ -144,5 +143,5 @@ pub use reference::{
     zero_parallax as zero_parallax_f64,
 };
 pub use shade::{BlinnPhong, DepthOnly, Fragment, Light, MAX_VARYINGS, Shader, Varyings, to_rgba8};
-pub use simd::{Kernels, avx2_available, kernels};
+pub use simd::{avx2_available, uses_avx2};
 pub use text::{Align as TextAlign, caption, draw_rgba as draw_text_rgba, width as text_width};

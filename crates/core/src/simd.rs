@@ -45,6 +45,14 @@ impl Kernels {
     }
 }
 
+/// Whether the fast paths run their AVX2 loops in this process: the CPU has AVX2
+/// ([`avx2_available`]) and the environment variable `STEREOLAB_SCALAR` is not set (empty or `0`
+/// count as not set). Decided once, on first use; `STEREOLAB_SCALAR=1` runs every pass on the
+/// scalar loops, each kernel's readable reference, with the same bytes.
+pub fn uses_avx2() -> bool {
+    kernels().avx2()
+}
+
 /// The loops every kernel runs in this process, decided once on first use: [`Kernels::Avx2`]
 /// where [`avx2_available`] holds and the environment variable `STEREOLAB_SCALAR` is not set
 /// (empty or `0` count as not set), else [`Kernels::Scalar`]. `STEREOLAB_SCALAR=1` thus runs

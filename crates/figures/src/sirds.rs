@@ -6,8 +6,8 @@ use super::canvas::{Axes, Canvas, GRAY, INK, LABEL, LEFT, RIGHT, SMALL};
 use super::thumbs::{grid, rendered};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::Output;
-use stereolab::render::sirds_strips::{StripGeometry, per_vertex};
 use stereolab_core::{DisparityModel, Result, SirdsGeometry, StripFilter, StripStart, TextAlign};
+use stereolab_core::{StripGeometry, per_vertex};
 
 /// The SIRDS paper's Fig. 1–3 with TIW's set-up: two surface points, the rays to both eyes,
 /// and the two linked pixels on the image plane, `d` apart ([`stereolab_core::Disparity::separation`]).
@@ -214,7 +214,13 @@ pub fn passes(ctx: &Context) -> Result<Canvas> {
     })?;
     let (depth, range) = scene_depth(&frame, &s)?;
     let d = s.sirds.geometry.to_pixels()?;
-    let g = StripGeometry::new(&s, &frame.views.center, &range, &d, s.sirds.cross_eyed);
+    let g = StripGeometry::new(
+        &s.strip_objects(),
+        &frame.views.center,
+        &range,
+        &d,
+        s.sirds.cross_eyed,
+    );
     let r = per_vertex(
         &g,
         s.width,

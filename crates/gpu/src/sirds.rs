@@ -1,7 +1,7 @@
 //! The SIRDS paper's per-vertex strip algorithm as the paper built it, on the GPU: render-to-texture
-//! ping-pong (§4). A mirror of [`per_vertex`](stereolab::render::sirds_strips::per_vertex)
+//! ping-pong (§4). A mirror of [`per_vertex`](stereolab_core::per_vertex)
 //! on the same [`StripGeometry`] and the same strips
-//! ([`plan_strips`](stereolab::render::sirds_strips)):
+//! ([`plan_strips`]):
 //!
 //! - texture A holds the image so far (the pattern at first), texture B is the render target;
 //! - each iteration draws the whole scene into B with the scissor rect = its strip (the CPU
@@ -26,10 +26,10 @@ use std::sync::mpsc;
 
 use glam::Vec4;
 
-use stereolab::render::sirds_strips::{StripGeometry, StripResult, plan_strips};
 use stereolab_core::{
     Disparity, PerVertexOptions, Result, SirdsPattern, StripFilter, check_sirds_inputs,
 };
+use stereolab_core::{StripGeometry, StripResult, plan_strips};
 
 use super::device::GpuRenderer;
 use super::readback::{COLOR_FORMAT, padded_row_bytes};
@@ -171,7 +171,7 @@ impl GpuStrips {
     }
 
     /// Makes a SIRDS with the strip algorithm on the GPU, as
-    /// [`per_vertex`](stereolab::render::sirds_strips::per_vertex) does on the CPU (same
+    /// [`per_vertex`](stereolab_core::per_vertex) does on the CPU (same
     /// strips, same starts and filters; `links` is never recorded).
     ///
     /// # Errors

@@ -41,7 +41,7 @@ pub fn from_frame(
 }
 
 /// Strip parity apart from raster parity: the SIRDS of the CPU frame's own depth pass made by
-/// the CPU strips and by the WGSL strips (same [`StripGeometry`](stereolab::render::sirds_strips::StripGeometry), same strips), as a row
+/// the CPU strips and by the WGSL strips (same [`StripGeometry`](stereolab_core::StripGeometry), same strips), as a row
 /// `sirds (wgsl strips)`. Empty unless the plan makes a per-vertex `sirds`.
 ///
 /// # Errors

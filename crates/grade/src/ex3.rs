@@ -1,7 +1,7 @@
 //! Exercise 3 (the SIRDS paper (Petz et al.), SIRDS): the tasks, reference answers, mistakes, image checks.
 //!
 //! The reference is stereolab's SIRDS module: its Eq. (3) separation and its per-pixel linking
-//! (`effects::sirds::per_pixel::RowLinker`, Thimbleby, Inglis and Witten's algorithm). The known
+//! (`stereolab_core::RowLinker`, Thimbleby, Inglis and Witten's algorithm). The known
 //! mistakes are modelled by `variant_links`, which a unit test holds equal to the module when
 //! no mistake is switched on.
 

@@ -294,7 +294,7 @@ pub fn anaglyph_reference(
 }
 
 /// The anaglyph of two eye images (color only; depth is not read): [`anaglyph_reference`]'s
-/// bytes, stored values on the AVX2 rows where [`kernels`] chose them.
+/// bytes, stored values on the AVX2 rows where the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)).
 ///
 /// # Errors
 /// As [`anaglyph_reference`].

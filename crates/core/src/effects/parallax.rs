@@ -409,7 +409,7 @@ pub fn parallax_image_reference(fb: &Framebuffer, rig: &ParallaxRig) -> Result<R
 /// The same bytes as [`parallax_image_reference`] (the readable program: the parallax map, its
 /// budget, the colors), computed without the map: S from the depth extremes
 /// (`ParallaxRig::color_scale_of`), each row's colors in parallel, four pixels at a time on
-/// AVX2 where [`kernels`] chose it (`parallax/avx2.rs`, the scalar [`parallax_color`]
+/// AVX2 where the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)) (`parallax/avx2.rs`, the scalar [`parallax_color`]
 /// elsewhere), the window violations from the border pixels alone.
 ///
 /// # Errors

@@ -223,7 +223,7 @@ pub fn remap_color_reference(
     remap_color_on(this, other, this_mvp, other_mvp, precision, Kernels::Scalar)
 }
 
-/// [`remap_color_reference`]'s bytes, on the AVX2 rows where [`kernels`] chose them.
+/// [`remap_color_reference`]'s bytes, on the AVX2 rows where the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)).
 ///
 /// # Errors
 /// As [`remap_color_reference`].

@@ -11,7 +11,7 @@ use super::{Band, Plane, SetupTriangle};
 /// store. Only an instruction choice: the bytes are the same without it. Measured in the depth
 /// pass, the gain was within noise (the hot load stayed as hot: it waits on the cache, not on
 /// store forwarding), so the depth pass does not use it; the strip pass
-/// (`render/sirds_strips/avx2.rs` in the `stereolab` crate) does.
+/// (`effects/sirds/strips/avx2.rs`) does.
 ///
 /// # Safety
 /// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).

@@ -84,7 +84,7 @@ pub(crate) const BAND_ROWS: usize = 32;
 /// Vertex stage and setup run once; traversal runs in parallel over bands of `BAND_ROWS`
 /// rows, each band applying the triangles in order, so the bytes never depend on the thread
 /// count. Each triangle goes through [`traverse`], the scalar reference, or, in a depth-only
-/// pass where [`kernels`] chose the AVX2 loops, through its AVX2 twin with the same bits
+/// pass where the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)), through its AVX2 twin with the same bits
 /// (see `traverse_band`).
 pub fn rasterize<S: Shader>(
     triangles: &[[u32; 3]],
@@ -97,7 +97,7 @@ pub fn rasterize<S: Shader>(
 }
 
 /// [`rasterize`] with [`BlinnPhong`]: the same pixels and depths, its fragment stage eight
-/// pixels wide (AVX2) where [`kernels`] chose the AVX2 loops and the specular
+/// pixels wide (AVX2) where the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)) and the specular
 /// exponent is a whole number (`shade_avx2`, held to [`BlinnPhong`]'s own stage by
 /// `avx2_blinn_phong_matches_traverse`).
 pub fn rasterize_blinn_phong(
@@ -369,7 +369,7 @@ fn setup_chunk(
 }
 
 /// For a test comparing the AVX2 loops with the scalar ones: whether there are AVX2 loops to
-/// compare, that is whether [`kernels`] chose them (the tests reach them through the public
+/// compare, that is whether they run ([`uses_avx2`](crate::uses_avx2)) (the tests reach them through the public
 /// functions). Without them (a CPU without AVX2, or `STEREOLAB_SCALAR` set) it says so on
 /// stderr and the test has nothing to hold: every path that runs is then the scalar one, which
 /// the other tests cover. (Unlike lavapipe, which `.ci/run` installs, AVX2 is the hardware's.)

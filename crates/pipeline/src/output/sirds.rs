@@ -6,12 +6,12 @@ use std::path::Path;
 
 use crate::plan::View;
 use crate::render::Frame;
-use crate::render::sirds_strips::{self, StripGeometry, StripResult};
 use crate::scene::Scene;
 use stereolab_core::{
     DepthMap, DepthMapping, DepthRange, DepthSamples, Disparity, DisparityModel, Error,
     Framebuffer, Near, PgmRows, Result, Sirds, SirdsAlgorithm, SirdsSettings, StripFilter,
-    depth_range, draw_guide_dots, per_pixel, write_atomic, write_png,
+    StripGeometry, StripResult, depth_range, draw_guide_dots, per_pixel, per_vertex, write_atomic,
+    write_png,
 };
 
 /// The cyclopean depth pass of `frame`.
@@ -39,11 +39,11 @@ pub fn scene_depth(frame: &Frame, scene: &Scene) -> Result<(DepthMap, DepthRange
 /// chose; adds guide dots if asked.
 ///
 /// # Errors
-/// As [`scene_depth`], [`per_pixel`] and [`sirds_strips::per_vertex`].
+/// As [`scene_depth`], [`per_pixel`] and [`per_vertex`].
 pub fn from_frame(frame: &Frame, scene: &Scene) -> Result<Sirds> {
     let s = &scene.sirds;
     from_frame_with(frame, scene, |g, d| {
-        sirds_strips::per_vertex(
+        per_vertex(
             g,
             scene.width,
             scene.height,
@@ -92,7 +92,7 @@ pub fn fig5_bands(frame: &Frame, scene: &Scene) -> Result<Sirds> {
 }
 
 /// [`from_frame`] with the per-vertex strips made by `strips` from the strip geometry and the
-/// disparity (the CPU's [`sirds_strips::per_vertex`], or the GPU's ping-pong); everything else
+/// disparity (the CPU's [`per_vertex`], or the GPU's ping-pong); everything else
 /// (depth range, TIW, guide dots) is the same for both.
 ///
 /// # Errors
@@ -115,7 +115,13 @@ pub fn from_frame_with(
             (per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?, None)
         }
         SirdsAlgorithm::PerVertex => {
-            let g = StripGeometry::new(scene, &frame.views.center, &range, &d, s.cross_eyed);
+            let g = StripGeometry::new(
+                &scene.strip_objects(),
+                &frame.views.center,
+                &range,
+                &d,
+                s.cross_eyed,
+            );
             let r = strips(&g, &d)?;
             (r.pixels, Some(r.iterations))
         }

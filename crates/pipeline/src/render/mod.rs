@@ -1,11 +1,14 @@
 //! The passes: runs a plan's rasterizations over a scene and returns their framebuffers.
 //!
 //! - [`render`]: the eye passes (Blinn-Phong color or depth only) and the center pass;
-//! - [`chromadepth`]: the ChromaDepth pass (texgen into the ramp);
-//! - [`sirds_strips`]: the SIRDS paper's per-vertex strip passes.
+//! - [`chromadepth`]: the ChromaDepth pass (texgen into the ramp).
+//!
+//! The SIRDS paper's per-vertex strip passes are the core's
+//! ([`per_vertex`](stereolab_core::per_vertex)); `output::sirds` runs them on a scene.
 
 pub mod chromadepth;
-pub mod sirds_strips;
+#[cfg(test)]
+mod strip_tests;
 
 use std::time::{Duration, Instant};
 

@@ -117,6 +117,19 @@ impl LoadOptions {
 }
 
 impl Scene {
+    /// Every object as the SIRDS strip passes take it ([`StripGeometry::new`](stereolab_core::StripGeometry::new)):
+    /// its model matrix and its mesh.
+    pub fn strip_objects(&self) -> Vec<stereolab_core::StripObject<'_>> {
+        self.objects
+            .iter()
+            .map(|o| stereolab_core::StripObject {
+                model: o.model,
+                positions: &o.mesh.positions,
+                triangles: &o.mesh.triangles,
+            })
+            .collect()
+    }
+
     /// Reads a scene file, applies `--set key=value` overrides, loads its models, validates it.
     ///
     /// # Errors

@@ -7,8 +7,7 @@
 //!
 //! - [`disparity`]: eq. 1 and eq. 3, physical units → pixels in one place;
 //! - [`depthmap`]: nearness per pixel from the depth pass or an image file;
-//! - the SIRDS paper's strip algorithm on stereolab's rasterizer is a pass:
-//!   `render::sirds_strips` (the `stereolab` crate);
+//! - [`strips`]: the SIRDS paper's strip algorithm on stereolab's rasterizer;
 //! - [`per_pixel`]: TIW with hidden-surface removal and oversampling;
 //! - [`pattern`]: random dots, pattern images, guide dots;
 //! - [`decode`]: separation (and depth) back from a finished image;
@@ -23,6 +22,7 @@ pub mod pattern;
 pub mod per_pixel;
 pub mod search;
 pub mod settings;
+pub mod strips;
 
 pub use depthmap::{DepthMap, DepthRange};
 pub use disparity::{Disparity, DisparityModel, Geometry};

@@ -10,9 +10,11 @@
 use std::arch::x86_64::*;
 
 use super::{Region, SpanTarget, Strip};
-use stereolab_core::{
-    SetupTriangle, avx2_columns, avx2_covered_vectors, avx2_depth_at, avx2_floor_i32, avx2_load,
-    avx2_opaque, avx2_plane_at, avx2_store, avx2_tail_mask,
+use crate::raster::SetupTriangle;
+use crate::raster::avx2::{
+    columns as avx2_columns, covered_vectors as avx2_covered_vectors, depth_at as avx2_depth_at,
+    floor_i32 as avx2_floor_i32, load as avx2_load, opaque as avx2_opaque,
+    plane_at as avx2_plane_at, store as avx2_store, tail_mask as avx2_tail_mask,
 };
 
 /// [`super::span_sources`] for every pixel of triangle `t` in region `r` of the band starting

@@ -19,25 +19,26 @@
 //!    its source, as the earlier strips left the image.
 //!
 //! Steps 2 and 3 run eight pixels at a time on AVX2 (`per_vertex/avx2.rs`) where
-//! [`kernels`] chose the AVX2 loops, with the scalar loops' bytes; [`per_vertex_reference`]
-//! (and `STEREOLAB_SCALAR=1`, see [`kernels`]) runs the scalar ones.
+//! the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)), with the scalar loops' bytes; [`per_vertex_reference`]
+//! (and `STEREOLAB_SCALAR=1`, see [`uses_avx2`](crate::uses_avx2)) runs the scalar ones.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 mod geometry;
 pub mod reference;
 
-pub use geometry::StripGeometry;
 use geometry::shift;
+pub use geometry::{StripGeometry, StripObject};
 
 use glam::Vec4;
 use rayon::prelude::*;
 
-use stereolab_core::{
-    Disparity, Error, Fragment, Kernels, PerVertexOptions, RasterOptions, Result, SetupTriangle,
-    Shader, SirdsPattern, StripFilter, StripStart, Varyings, bin_rows, check_sirds_inputs, kernels,
-    setup_triangles,
-};
+use crate::effects::sirds::per_pixel::check_inputs as check_sirds_inputs;
+use crate::error::{Error, Result};
+use crate::raster::{RasterOptions, SetupTriangle, bin_rows, setup_triangles};
+use crate::shade::{Fragment, Shader, Varyings};
+use crate::simd::{Kernels, kernels};
+use crate::{Disparity, PerVertexOptions, SirdsPattern, StripFilter, StripStart};
 
 /// What a strip run produced.
 #[derive(Clone, Debug, PartialEq)]
@@ -275,7 +276,7 @@ fn band_sources(regions: &[Region], width: u32, y0: u32, rows: u32, kernels: Ker
 }
 
 /// One covered span of triangle `t` in row `y`, pixels `x_lo ..` (as many as `depth` holds):
-/// the fragment stage of [`traverse`](stereolab_core::raster::traverse) (same expressions, same order)
+/// the fragment stage of [`traverse`](crate::traverse) (same expressions, same order)
 /// up to the source coordinate; a fragment wins when it passes the depth test LESS and its
 /// source is in bounds.
 fn span_sources(
@@ -380,7 +381,7 @@ fn resolve_strip(
 /// [`per_vertex_reference`] and [`reference::k_passes`] start with.
 ///
 /// # Errors
-/// As [`check_sirds_inputs`], [`stereolab_core::check_size`] and [`plan_strips`].
+/// As [`check_sirds_inputs`], [`check_size`](crate::check_size) and [`plan_strips`].
 fn checked_strips(
     width: u32,
     height: u32,
@@ -389,7 +390,7 @@ fn checked_strips(
     opts: &PerVertexOptions,
 ) -> Result<Vec<Strip>> {
     check_sirds_inputs(width, d, pattern)?;
-    stereolab_core::check_size(width, height)?;
+    crate::check_size(width, height)?;
     plan_strips(width, d, opts)
 }
 
@@ -425,7 +426,7 @@ pub fn per_vertex_reference(
 }
 
 /// Makes a SIRDS with the strip algorithm: [`per_vertex_reference`]'s bytes, steps 2 and 3
-/// eight pixels at a time on AVX2 where [`kernels`] chose the AVX2 loops.
+/// eight pixels at a time on AVX2 where the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)).
 ///
 /// # Errors
 /// As [`per_vertex_reference`].

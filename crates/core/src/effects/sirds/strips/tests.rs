@@ -1,21 +1,7 @@
-//! The strip loops' own checks: the AVX2 loops against the scalar ones, and reads of
-//! pixels not final yet.
+//! The strip loops' own check: reads of pixels not final yet, scalar and AVX2.
 
 use super::*;
-use crate::fixtures::table_scene;
-use crate::plan::Shading;
-use crate::render::render_view;
-use stereolab_core::{StereoRig, avx2_available, depth_range};
-
-/// Whether there are AVX2 loops to compare with the scalar ones; without them (a CPU without
-/// AVX2) it says so on stderr, and every path that runs is the scalar one the other tests cover.
-fn avx2_to_compare(test: &str) -> bool {
-    if avx2_available() {
-        return true;
-    }
-    eprintln!("{test}: NOT RUN: no AVX2 here, nothing to compare");
-    false
-}
+use crate::simd::avx2_available;
 
 /// A source reaching into the running strip or one still to come (in real scenes only
 /// past a sliver's edge) reads the pattern there, as the paper's ping-pong textures would
@@ -93,55 +79,6 @@ fn reads_of_unfinished_pixels_see_the_pattern() {
                 assert!(
                     row == a,
                     "bilinear {bilinear}, toward {toward}, simd {simd}, {pattern:?}"
-                );
-            }
-        }
-    }
-}
-
-/// The AVX2 loops only change the speed: for both starts and both filters, black-white and
-/// color dots (the gray and the three-channel mix), on an even and an odd size (spans and
-/// strips that end mid-vector), they give the scalar loops' pixels and links, byte for byte.
-#[test]
-fn avx2_strips_match_scalar_strips() {
-    if !avx2_to_compare("avx2_strips_match_scalar_strips") {
-        return;
-    }
-    for (w, h, tris) in [(512, 256, 2_500), (301, 77, 400)] {
-        let s = table_scene(w, h, tris, 10).expect("bench scene");
-        let center = StereoRig::center(&s.camera, s.aspect()).expect("camera");
-        let d = s.sirds.geometry.to_pixels().expect("geometry");
-        let (fb, _) = render_view(&s, &center, Shading::DepthOnly).expect("depth pass");
-        let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far).expect("range");
-        let g = StripGeometry::new(&s, &center, &range, &d, false);
-        let patterns = [s.sirds.pattern.clone(), SirdsPattern::Color { seed: 9 }];
-        for (pattern, start) in patterns
-            .iter()
-            .flat_map(|p| [(p, StripStart::Left), (p, StripStart::Center)])
-        {
-            for filter in [StripFilter::Nearest, StripFilter::Bilinear] {
-                let opts = PerVertexOptions {
-                    start,
-                    filter,
-                    iterations: None,
-                };
-                let run = |kernels| {
-                    per_vertex_on(&g, (w, h), &d, pattern, &opts, true, kernels).expect("strips")
-                };
-                let (fast, plain) = (run(Kernels::Avx2), run(Kernels::Scalar));
-                let differ = fast
-                    .pixels
-                    .iter()
-                    .zip(&plain.pixels)
-                    .filter(|(a, b)| a != b);
-                assert_eq!(
-                    differ.count(),
-                    0,
-                    "{w}x{h} {start:?} {filter:?} {pattern:?}: pixels differ"
-                );
-                assert_eq!(
-                    fast.links, plain.links,
-                    "{w}x{h} {start:?} {filter:?}: links"
                 );
             }
         }

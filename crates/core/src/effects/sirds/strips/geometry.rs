@@ -2,10 +2,20 @@
 //! cyclopean clip positions, each vertex's separation, and the shift both the fast path and the
 //! reference apply.
 
-use glam::Vec4;
+use glam::{Mat4, Vec3, Vec4};
 
-use crate::scene::Scene;
-use stereolab_core::{DepthRange, Disparity, EyeMatrices};
+use crate::{DepthRange, Disparity, EyeMatrices};
+
+/// One object of the scene as the strip passes take it: its model matrix and its mesh.
+#[derive(Clone, Copy, Debug)]
+pub struct StripObject<'a> {
+    /// Model → world.
+    pub model: Mat4,
+    /// The mesh's vertex positions (model space).
+    pub positions: &'a [Vec3],
+    /// The mesh's triangles (indices into `positions`).
+    pub triangles: &'a [[u32; 3]],
+}
 
 /// The scene as the strip passes see it: cyclopean clip positions, each vertex's separation,
 /// and the triangles, the background plane last (drawn last, most of it fails the depth test).
@@ -16,11 +26,12 @@ pub struct StripGeometry {
 }
 
 impl StripGeometry {
-    /// Transforms every object with the cyclopean `center` matrices, gives each vertex the
-    /// separation of its eye-space distance (`clip.w`) mapped through `range`, and adds the
-    /// background plane at `range.back` covering the whole view (the SIRDS paper's §3).
+    /// Transforms every object (its model matrix and its mesh's positions and triangles) with
+    /// the cyclopean `center` matrices, gives each vertex the separation of its eye-space
+    /// distance (`clip.w`) mapped through `range`, and adds the background plane at
+    /// `range.back` covering the whole view (the SIRDS paper's §3).
     pub fn new(
-        scene: &Scene,
+        objects: &[StripObject<'_>],
         center: &EyeMatrices,
         range: &DepthRange,
         d: &Disparity,
@@ -35,16 +46,16 @@ impl StripGeometry {
             separation: Vec::new(),
             triangles: Vec::new(),
         };
-        for o in &scene.objects {
+        for o in objects {
             let mvp = center.mvp * o.model;
             let base = g.clip.len() as u32;
-            for p in &o.mesh.positions {
+            for p in o.positions {
                 let c = mvp * p.extend(1.0);
                 g.clip.push(c);
                 g.separation.push(d.separation(nearness(c.w)));
             }
             g.triangles
-                .extend(o.mesh.triangles.iter().map(|t| t.map(|i| i + base)));
+                .extend(o.triangles.iter().map(|t| t.map(|i| i + base)));
         }
         // The plane, 5% larger than the frustum's cross-section at its distance.
         let [_, r, _, t, n, _] = center.frustum;
