@@ -6,7 +6,7 @@
 //! answers live here, in the grader.
 
 pub use exercise_api::{
-    AnaglyphKind, AnaglyphMatrices, Answer, ColorMatrix, EyeView, ScreenSetup, SirdsGeometry,
+    AnaglyphKind, AnaglyphMatrices, Answer, ColorMatrix, Eye, EyeView, ScreenSetup, SirdsGeometry,
     SirdsSetup, StereoSetup, decode_reply, protocol,
 };
 

@@ -275,8 +275,9 @@ Three exercises, one crate each:
 | `ex3_sirds` | single-image random-dot stereograms | Petz, Goldlücke, Magnor: *Hardware-accelerated Autostereogram Rendering for Interactive 3D Visualization* | {points:ex3_sirds} |
 
 Complete the `todo!`s in each crate's `src/stubs.rs`. Every stub's doc comment states the task,
-the formula's source and the conventions (right-handed, NDC z in [-1, 1], eye index 0 = left);
-`cargo run -p stereolab -- grade points` prints every task's points (the table above sums them).
+the formula's source and the conventions (right-handed, NDC z in [-1, 1], the eyes
+`exercise_api::Eye::Left` and `Eye::Right`); `cargo run -p stereolab -- grade points` prints
+every task's points (the table above sums them).
 
 What is here:
 - `ex1_stereo/`, `ex2_chromadepth/`, `ex3_sirds/`: your crates. **Only `src/stubs.rs` is

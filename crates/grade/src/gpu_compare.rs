@@ -10,6 +10,7 @@
 
 use std::path::Path;
 
+use super::exercise::Eye;
 use super::fixture::{reference_rig, stereo_setup};
 use super::{Exercise, Limits, child, default_work_dir, ex1, submission_binary};
 use stereolab::compare::{Comparison, compare, write_diff_strip};
@@ -62,7 +63,8 @@ pub fn compare_exercise(
     let lighting = scene.rig.lighting;
     let reference = reference_rig(&setup, lighting).eyes(&scene.camera, setup.aspect)?;
     let modelview = scene.camera.view();
-    let inputs: Vec<_> = (0..2)
+    let inputs: Vec<_> = Eye::BOTH
+        .into_iter()
         .map(|eye| ex1::eye_view_input(&setup, &modelview, eye, lighting))
         .collect();
     child::become_subreaper();

@@ -6,8 +6,8 @@
 //! Conventions (the same as stereolab's, see its README): right-handed eye space, the camera
 //! looks down −Z, Y up; OpenGL projection matrices with NDC Z in [−1, 1]; window depth and
 //! texture coordinates in [0, 1] with v = 0 at the bottom row; `glam` matrices are
-//! column-major and multiply column vectors (`P * MV * v`); eye index 0 is the left eye,
-//! 1 the right eye.
+//! column-major and multiply column vectors (`P * MV * v`); an eye is an `exercise_api::Eye`,
+//! `Eye::Left` or `Eye::Right` (the grader's JSON numbers them 0 and 1).
 #![warn(missing_docs)]
 
 // solution-begin

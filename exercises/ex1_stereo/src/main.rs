@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use exercise_api::Lighting;
 use exercise_api::{
-    AnaglyphKind, AnaglyphMatrices, ScreenSetup, StereoSetup, Texture, serve, task,
+    AnaglyphKind, AnaglyphMatrices, Eye, ScreenSetup, StereoSetup, Texture, serve, task,
 };
 use glam::{Mat4, Vec2};
 
@@ -28,15 +28,15 @@ fn main() -> ExitCode {
             task("frustum", |[l, r, b, t, n, f]: [f32; 6]| {
                 ex1_stereo::frustum(l, r, b, t, n, f)
             }),
-            task("stereo_frustum", |(s, eye): (StereoSetup, usize)| {
+            task("stereo_frustum", |(s, eye): (StereoSetup, Eye)| {
                 ex1_stereo::stereo_frustum(&s, eye)
             }),
-            task("sheet_frustum", |(s, eye): (ScreenSetup, usize)| {
+            task("sheet_frustum", |(s, eye): (ScreenSetup, Eye)| {
                 ex1_stereo::sheet_frustum(&s, eye)
             }),
             task(
                 "stereo_matrices",
-                |(s, mv, eye, lighting): (StereoSetup, [f32; 16], usize, Lighting)| {
+                |(s, mv, eye, lighting): (StereoSetup, [f32; 16], Eye, Lighting)| {
                     ex1_stereo::stereo_matrices(&s, Mat4::from_cols_array(&mv), eye, lighting)
                 },
             ),

@@ -9,7 +9,7 @@
 //! `rds-left-fallback`.
 
 use exercise_api::{
-    AnaglyphKind, AnaglyphMatrices, ColorMatrix, EyeView, ScreenSetup, StereoSetup, Texture,
+    AnaglyphKind, AnaglyphMatrices, ColorMatrix, Eye, EyeView, ScreenSetup, StereoSetup, Texture,
 };
 use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec2, Vec3, Vec4};
@@ -38,14 +38,17 @@ pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
     }
 }
 
-/// −1 for the left eye (index 0), +1 for the right eye.
-fn side(eye: usize) -> f32 {
+/// −1 for the left eye, +1 for the right eye.
+fn side(eye: Eye) -> f32 {
     let eye = if planted("swapped-eyes") {
-        1 - eye
+        eye.other()
     } else {
         eye
     };
-    if eye == 0 { -1.0 } else { 1.0 }
+    match eye {
+        Eye::Left => -1.0,
+        Eye::Right => 1.0,
+    }
 }
 
 /// Half the eye separation (the whole of it with the `full-separation` mistake).
@@ -58,7 +61,7 @@ fn half_separation(s: &StereoSetup) -> f32 {
 }
 
 /// `[l, r, b, t, n, f]` of `P_frustum±` (the exercise slides).
-pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
+pub fn stereo_frustum(setup: &StereoSetup, eye: Eye) -> [f32; 6] {
     let fov = if planted("fov-degrees") {
         setup.fov_y_degrees
     } else {
@@ -75,7 +78,7 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
 }
 
 /// `[l, r, b, t, n, f]` of `P_frustum±` in the exercise slides' screen-relative terms.
-pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
+pub fn sheet_frustum(screen: &ScreenSetup, eye: Eye) -> [f32; 6] {
     let scale = screen.near / screen.zero_parallax;
     let t = 0.5 * screen.height * scale;
     let r = 0.5 * screen.width * scale;
@@ -90,7 +93,10 @@ pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
     } else {
         offset * scale
     };
-    let shift = if eye == 0 { shift } else { -shift };
+    let shift = match eye {
+        Eye::Left => shift,
+        Eye::Right => -shift,
+    };
     [-r + shift, r + shift, -t, t, screen.near, screen.far]
 }
 
@@ -98,7 +104,7 @@ pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
 pub fn stereo_matrices(
     setup: &StereoSetup,
     modelview: Mat4,
-    eye: usize,
+    eye: Eye,
     lighting: Lighting,
 ) -> EyeView {
     let [l, r, b, t, n, f] = stereo_frustum(setup, eye);

@@ -3,7 +3,9 @@
 //! `stereolab grade points` prints each task's points.
 
 use exercise_api::Lighting;
-use exercise_api::{AnaglyphKind, AnaglyphMatrices, EyeView, ScreenSetup, StereoSetup, Texture};
+use exercise_api::{
+    AnaglyphKind, AnaglyphMatrices, Eye, EyeView, ScreenSetup, StereoSetup, Texture,
+};
 use glam::{Mat4, Vec2, Vec3};
 
 /// Task `frustum`: the projection matrix `P_frustum(l, r, b, t, n, f)`.
@@ -29,10 +31,10 @@ pub fn frustum(l: f32, r: f32, b: f32, t: f32, n: f32, f: f32) -> Mat4 {
 /// Source: the exercise slides, "Projection Matrix Stereo Case": the mono frustum has
 /// `t = n · tan(fov_y / 2)`, `b = −t`, `r = t · aspect`, `l = −r`; each eye's frustum is
 /// translated by ∓d/2 and sheared by ±d/(2 z0), so on the near plane `l` and `r` move by
-/// `± (d/2) · n / z0` (intercept theorem): the left eye (index 0, at x = −d/2) moves them by
-/// `+(d/2)·n/z0`, the right eye (index 1, at x = +d/2) by `−(d/2)·n/z0`. `t, b, n, f` do not
-/// change. Toe-in (rotating the eyes) is wrong: it gives vertical parallax (the StereoGraphics guide (Akka)).
-pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
+/// `± (d/2) · n / z0` (intercept theorem): the left eye ([`Eye::Left`], at x = −d/2) moves them
+/// by `+(d/2)·n/z0`, the right eye ([`Eye::Right`], at x = +d/2) by `−(d/2)·n/z0`. `t, b, n, f`
+/// do not change. Toe-in (rotating the eyes) is wrong: it gives vertical parallax (the StereoGraphics guide (Akka)).
+pub fn stereo_frustum(setup: &StereoSetup, eye: Eye) -> [f32; 6] {
     // TODO: the mono frustum, then shift l and r for this eye.
     todo!("frustum bounds of eye {eye:?} for {setup:?}")
 }
@@ -46,14 +48,14 @@ pub fn stereo_frustum(setup: &StereoSetup, eye: usize) -> [f32; 6] {
 /// intercept theorem the screen seen from the eye shrinks by n/z0 on the near plane:
 /// - `t = ½·h·n/z0`, `b = −t`;
 /// - the mono `r = ½·w·n/z0`, `l = −r`; each eye's `l` and `r` are translated by
-///   `±½·d·w·n/z0`: the left eye (index 0, at x = −½·d·w) moves them by `+½·d·w·n/z0`, the right
-///   eye (index 1, at x = +½·d·w) by `−½·d·w·n/z0`;
+///   `±½·d·w·n/z0`: the left eye ([`Eye::Left`], at x = −½·d·w) moves them by `+½·d·w·n/z0`, the
+///   right eye ([`Eye::Right`], at x = +½·d·w) by `−½·d·w·n/z0`;
 /// - `n`, `f` unchanged.
 ///
 /// (The slides' matching `T±` is the translation by `½·d·w` in x that moves this eye to the
 /// origin: `T_left = translate(+½·d·w, 0, 0)` for the left eye at x = −½·d·w,
 /// `T_right = translate(−½·d·w, 0, 0)`, as in [`stereo_matrices`].)
-pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
+pub fn sheet_frustum(screen: &ScreenSetup, eye: Eye) -> [f32; 6] {
     // TODO: t from h, l and r from w, then shift l and r for this eye; all scaled by n/z0.
     todo!("frustum bounds of eye {eye:?} for {screen:?}")
 }
@@ -71,10 +73,10 @@ pub fn sheet_frustum(screen: &ScreenSetup, eye: usize) -> [f32; 6] {
 pub fn stereo_matrices(
     setup: &StereoSetup,
     modelview: Mat4,
-    eye: usize,
+    eye: Eye,
     lighting: Lighting,
 ) -> EyeView {
-    // TODO: T± from the eye index, then combine as the lighting variant asks.
+    // TODO: T± from the eye, then combine as the lighting variant asks.
     todo!("view and projection of eye {eye:?}, {lighting:?}, {setup:?}, MV = {modelview:?}")
 }
 

@@ -1,7 +1,7 @@
 //! Checks you can run yourself (`cargo test -p ex1_stereo`): the worked examples of the source
 //! documents. They fail until your functions are complete; `stereolab grade ex1` scores more.
 
-use exercise_api::{AnaglyphKind, ScreenSetup, StereoSetup, Texture};
+use exercise_api::{AnaglyphKind, Eye, ScreenSetup, StereoSetup, Texture};
 use exercise_api::{Lighting, look_at};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
@@ -24,14 +24,14 @@ fn stereographics_guide() -> (StereoSetup, Mat4) {
 #[test]
 fn stereographics_guide_point_projects_to_5_875_left_and_6_125_right() {
     let (setup, mv) = stereographics_guide();
-    for (eye, x) in [(0, 5.875), (1, 6.125)] {
+    for (eye, x) in [(Eye::Left, 5.875), (Eye::Right, 6.125)] {
         let m = ex1_stereo::stereo_matrices(&setup, mv, eye, Lighting::PerEye);
         let clip = m.projection * m.view * Vec3::new(8.0, -5.0, -3.0).extend(1.0);
         // NDC → the zero-parallax plane, which spans ±9 at 90° fov.
         let on_screen = clip.xy() / clip.w * 9.0;
         assert!(
             (on_screen.x - x).abs() < 1e-4 && (on_screen.y + 3.75).abs() < 1e-4,
-            "eye {eye}: expected ({x}, -3.75), got {on_screen:?}"
+            "{eye:?} eye: expected ({x}, -3.75), got {on_screen:?}"
         );
     }
 }
@@ -78,7 +78,7 @@ fn stereographics_example_in_the_sheets_terms_projects_to_5_875_and_6_125() {
         eye_separation_fraction: 1.0 / 18.0,
     };
     let mv = look_at(Vec3::new(0.0, 0.0, 9.0), Vec3::ZERO, Vec3::Y);
-    for (eye, x) in [(0, 5.875), (1, 6.125)] {
+    for (eye, x) in [(Eye::Left, 5.875), (Eye::Right, 6.125)] {
         let [l, r, b, t, n, f] = ex1_stereo::sheet_frustum(&screen, eye);
         assert!(
             (t - 1.0).abs() < 1e-6 && (b + 1.0).abs() < 1e-6,
@@ -86,7 +86,7 @@ fn stereographics_example_in_the_sheets_terms_projects_to_5_875_and_6_125() {
         );
         // T± moves the eye at x = ∓½·d·w = ∓0.5 to the origin: translate(±0.5, 0, 0).
         let half = 0.5 * screen.eye_separation_fraction * screen.width;
-        let shift = if eye == 0 { half } else { -half };
+        let shift = -eye.sign() * half;
         let mvp = ex1_stereo::frustum(l, r, b, t, n, f)
             * Mat4::from_translation(Vec3::new(shift, 0.0, 0.0))
             * mv;
@@ -94,7 +94,7 @@ fn stereographics_example_in_the_sheets_terms_projects_to_5_875_and_6_125() {
         let on_screen = clip.xy() / clip.w * 9.0;
         assert!(
             (on_screen.x - x).abs() < 1e-4 && (on_screen.y + 3.75).abs() < 1e-4,
-            "eye {eye}: expected ({x}, -3.75), got {on_screen:?}"
+            "{eye:?} eye: expected ({x}, -3.75), got {on_screen:?}"
         );
     }
 }
@@ -106,7 +106,7 @@ fn remapping_to_the_right_and_back_returns_to_the_same_left_pixel() {
         let m = ex1_stereo::stereo_matrices(&setup, mv, eye, Lighting::PerEye);
         m.projection * m.view
     };
-    let (l, r) = (mvp(0), mvp(1));
+    let (l, r) = (mvp(Eye::Left), mvp(Eye::Right));
     let uv = glam::Vec2::new(0.3, 0.6);
     let there = ex1_stereo::remap(l, r, uv, 0.95).expect("in front of the right eye");
     let back = ex1_stereo::remap_right_to_left(l, r, there.truncate(), there.z)
@@ -126,7 +126,7 @@ fn rds_of_a_wall(z: f32) -> (Vec<bool>, Vec<bool>, Vec<bool>) {
         let m = ex1_stereo::stereo_matrices(&setup, mv, eye, Lighting::PerEye);
         m.projection * m.view
     };
-    let (l, r) = (mvp(0), mvp(1));
+    let (l, r) = (mvp(Eye::Left), mvp(Eye::Right));
     // The wall's window depth (the same for both eyes: the off-axis eyes share their z).
     let clip = l * Vec3::new(0.0, 0.0, 9.0 - z).extend(1.0);
     let depth = 0.5 * (clip.z / clip.w + 1.0);

@@ -9,12 +9,15 @@
 //!
 //! Conventions every stub states again: right-handed eye space looking down −Z, Y up, OpenGL
 //! NDC with Z in [−1, 1], window depth and texture coordinates in [0, 1] (v = 0 at the bottom
-//! row, as in OpenGL textures), eye index 0 = left, 1 = right (the exercise slides).
+//! row, as in OpenGL textures), an [`Eye`] is 0 (left) or 1 (right)
+//! in JSON, as the exercise slides number them.
 #![warn(missing_docs)]
 
+pub mod eye;
 pub mod protocol;
 pub mod types;
 
+pub use eye::Eye;
 pub use glam;
 pub use protocol::{Answer, Reply, Task, decode_reply, encode_reply, serve, task};
 pub use types::{

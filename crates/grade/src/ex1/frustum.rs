@@ -4,6 +4,7 @@ use glam::Mat4;
 use serde_json::json;
 
 use super::{HIDDEN_SETUPS, MATRIX_TOLERANCE, eyes, flat, random_setup, setups};
+use crate::exercise::Eye;
 use crate::fixture::Fixture;
 use crate::spec::{Case, Mistake, TaskSpec, Tolerance, hidden_cases};
 use stereolab_core::{CameraMode, Lighting, frustum};
@@ -91,17 +92,18 @@ pub(super) fn stereo_frustum_task(fx: &Fixture) -> TaskSpec {
         let ok = eyes(&s, &cam, d, CameraMode::OffAxis, Lighting::PerEye);
         let toe = eyes(&s, &cam, d, CameraMode::Parallel, Lighting::PerEye);
         let double = eyes(&s, &cam, 2.0 * d, CameraMode::OffAxis, Lighting::PerEye);
-        for eye in 0..2 {
+        for eye in Eye::BOTH {
+            let i = eye.index();
             cases.push(Case {
-                label: format!("eye {eye} of {s:?}"),
+                label: format!("eye {i} of {s:?}"),
                 input: json!([s, eye]),
-                expected: flat(&ok[eye].frustum),
+                expected: flat(&ok[i].frustum),
             });
-            wrong[0].push(flat(&ok[1 - eye].frustum));
-            wrong[1].push(flat(&toe[eye].frustum));
-            wrong[2].push(flat(&double[eye].frustum));
-            let mut no_scale = toe[eye].frustum;
-            let shift = if eye == 0 { 0.5 * d } else { -0.5 * d };
+            wrong[0].push(flat(&ok[eye.other().index()].frustum));
+            wrong[1].push(flat(&toe[i].frustum));
+            wrong[2].push(flat(&double[i].frustum));
+            let mut no_scale = toe[i].frustum;
+            let shift = -eye.sign() * 0.5 * d;
             no_scale[0] += shift;
             no_scale[1] += shift;
             wrong[3].push(flat(&no_scale));
@@ -113,9 +115,8 @@ pub(super) fn stereo_frustum_task(fx: &Fixture) -> TaskSpec {
         .flat_map(|(s, _)| {
             let t = s.near * (0.5 * s.fov_y_degrees).tan();
             let w = t * s.aspect;
-            (0..2).map(move |eye| {
-                let shift =
-                    if eye == 0 { 0.5 } else { -0.5 } * s.eye_separation * s.near / s.zero_parallax;
+            Eye::BOTH.map(|eye| {
+                let shift = -eye.sign() * 0.5 * s.eye_separation * s.near / s.zero_parallax;
                 flat(&[-w + shift, w + shift, -t, t, s.near, s.far])
             })
         })
@@ -128,7 +129,7 @@ pub(super) fn stereo_frustum_task(fx: &Fixture) -> TaskSpec {
         depends_on: &[],
         hidden: hidden_cases("stereo_frustum", 2 * HIDDEN_SETUPS, |rng, i| {
             let (s, cam) = random_setup(rng);
-            let eye = i % 2;
+            let eye = Eye::BOTH[i % 2];
             let ok = eyes(
                 &s,
                 &cam,
@@ -137,9 +138,9 @@ pub(super) fn stereo_frustum_task(fx: &Fixture) -> TaskSpec {
                 Lighting::PerEye,
             );
             Case {
-                label: format!("hidden: eye {eye} of {s:?}"),
+                label: format!("hidden: eye {} of {s:?}", eye.index()),
                 input: json!([s, eye]),
-                expected: flat(&ok[eye].frustum),
+                expected: flat(&ok[eye.index()].frustum),
             }
         }),
         tolerance: MATRIX_TOLERANCE,

@@ -5,16 +5,16 @@ use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
 use super::{HIDDEN_SETUPS, MATRIX_TOLERANCE, blank, camera, eyes, flat, random_setup, setups};
-use crate::exercise::StereoSetup;
+use crate::exercise::{Eye, StereoSetup};
 use crate::fixture::Fixture;
 use crate::spec::{Case, Mistake, Picture, TaskSpec, hidden_cases};
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab_core::{Camera, CameraMode, EyeMatrices, Framebuffer, Lighting};
 
-/// The `stereo_matrices` task's input for one eye: setup, cyclopean modelview, eye index
-/// (0 = left), lighting.
-pub(crate) fn eye_view_input(s: &StereoSetup, mv: &Mat4, eye: usize, lighting: Lighting) -> Value {
+/// The `stereo_matrices` task's input for one eye: setup, cyclopean modelview, eye (0 = left
+/// in JSON), lighting.
+pub(crate) fn eye_view_input(s: &StereoSetup, mv: &Mat4, eye: Eye, lighting: Lighting) -> Value {
     json!([s, mv.to_cols_array(), eye, lighting])
 }
 
@@ -71,15 +71,17 @@ fn rig_setups(fx: &Fixture) -> Vec<(StereoSetup, Camera)> {
 }
 
 /// The reference's answer for a random setup and camera (hidden cases).
-fn hidden_case(s: &StereoSetup, cam: &Camera, eye: usize, lighting: Lighting) -> Case {
+fn hidden_case(s: &StereoSetup, cam: &Camera, eye: Eye, lighting: Lighting) -> Case {
     let ok = eyes(s, cam, s.eye_separation, CameraMode::OffAxis, lighting);
     Case {
         label: format!(
-            "hidden: eye {eye}, {lighting:?} lighting, camera at {:?} looking at {:?}, {s:?}",
-            cam.eye, cam.target
+            "hidden: eye {}, {lighting:?} lighting, camera at {:?} looking at {:?}, {s:?}",
+            eye.index(),
+            cam.eye,
+            cam.target
         ),
         input: eye_view_input(s, &cam.view(), eye, lighting),
-        expected: eye_answer(&ok[eye]),
+        expected: eye_answer(&ok[eye.index()]),
     }
 }
 
@@ -94,25 +96,26 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
             let toe = eyes(&s, &cam, d, CameraMode::ToeIn, lighting);
             let double = eyes(&s, &cam, 2.0 * d, CameraMode::OffAxis, lighting);
             let swapped_light = eyes(&s, &cam, d, CameraMode::OffAxis, other(lighting));
-            for eye in 0..2 {
+            for eye in Eye::BOTH {
+                let i = eye.index();
                 cases.push(Case {
-                    label: format!("eye {eye}, {lighting:?} lighting, {s:?}"),
+                    label: format!("eye {i}, {lighting:?} lighting, {s:?}"),
                     input: eye_view_input(&s, &mv, eye, lighting),
-                    expected: eye_answer(&ok[eye]),
+                    expected: eye_answer(&ok[i]),
                 });
-                wrong[0].push(eye_answer(&ok[1 - eye]));
-                wrong[1].push(eye_answer(&toe[eye]));
-                wrong[2].push(eye_answer(&double[eye]));
-                wrong[3].push(eye_answer(&swapped_light[eye]));
+                wrong[0].push(eye_answer(&ok[eye.other().index()]));
+                wrong[1].push(eye_answer(&toe[i]));
+                wrong[2].push(eye_answer(&double[i]));
+                wrong[3].push(eye_answer(&swapped_light[i]));
                 // T± with the wrong sign, P± right.
-                let side = if eye == 0 { -1.0 } else { 1.0 };
+                let side = eye.sign();
                 let t = Mat4::from_translation(Vec3::new(side * 0.5 * d, 0.0, 0.0));
-                let p = ok[eye].projection;
+                let p = ok[i].projection;
                 let flipped = match lighting {
                     Lighting::PerEye => (t * mv, p),
                     Lighting::Cyclopic => {
                         let p_only = eyes(&s, &cam, d, CameraMode::OffAxis, Lighting::PerEye);
-                        (mv, p_only[eye].projection * t)
+                        (mv, p_only[i].projection * t)
                     }
                 };
                 let mut v = flat(&flipped.0);
@@ -123,10 +126,10 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
                 wrong[5].push(match lighting {
                     Lighting::PerEye => {
                         let mut v = flat(&(mv * t_ok));
-                        v.extend(flat(&ok[eye].projection));
+                        v.extend(flat(&ok[i].projection));
                         v
                     }
-                    Lighting::Cyclopic => eye_answer(&ok[eye]),
+                    Lighting::Cyclopic => eye_answer(&ok[i]),
                 });
             }
         }
@@ -148,7 +151,7 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
                 CameraMode::OffAxis,
                 l,
             );
-            let fb = render_view(&scene, &m[eye], Shading::Color)
+            let fb = render_view(&scene, &m[eye.index()], Shading::Color)
                 .expect("the fixture renders")
                 .0;
             (picture_name(eye, l), fb)
@@ -184,7 +187,7 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
             } else {
                 Lighting::Cyclopic
             };
-            hidden_case(&s, &cam, i % 2, lighting)
+            hidden_case(&s, &cam, Eye::BOTH[i % 2], lighting)
         }),
         tolerance: MATRIX_TOLERANCE,
         cases,
@@ -230,17 +233,20 @@ pub(super) fn stereo_matrices_task(fx: &Fixture) -> TaskSpec {
     }
 }
 
-fn fixture_eye_inputs(_fx: &Fixture) -> Vec<(usize, Lighting)> {
+fn fixture_eye_inputs(_fx: &Fixture) -> Vec<(Eye, Lighting)> {
     vec![
-        (0, Lighting::PerEye),
-        (1, Lighting::PerEye),
-        (0, Lighting::Cyclopic),
-        (1, Lighting::Cyclopic),
+        (Eye::Left, Lighting::PerEye),
+        (Eye::Right, Lighting::PerEye),
+        (Eye::Left, Lighting::Cyclopic),
+        (Eye::Right, Lighting::Cyclopic),
     ]
 }
 
-fn picture_name(eye: usize, l: Lighting) -> String {
-    let side = if eye == 0 { "left" } else { "right" };
+fn picture_name(eye: Eye, l: Lighting) -> String {
+    let side = match eye {
+        Eye::Left => "left",
+        Eye::Right => "right",
+    };
     let light = match l {
         Lighting::PerEye => "per_eye",
         Lighting::Cyclopic => "cyclopic",

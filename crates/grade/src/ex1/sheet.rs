@@ -5,7 +5,7 @@
 use serde_json::json;
 
 use super::flat;
-use crate::exercise::ScreenSetup;
+use crate::exercise::{Eye, ScreenSetup};
 use crate::spec::{Case, Mistake, SplitMix64, TaskSpec, Tolerance, hidden_cases};
 
 const SHEET_TOLERANCE: Tolerance = Tolerance {
@@ -30,8 +30,8 @@ struct SheetVariant {
 }
 
 /// The exercise slides' formulas, in f64: `t = ½·h·n/z0`, `l, r = ∓½·w·n/z0 ± ½·d·w·n/z0`
-/// (+ for the left eye, index 0), with the known slips as switches.
-fn sheet_reference(s: &ScreenSetup, eye: usize, v: SheetVariant) -> [f64; 6] {
+/// (+ for the left eye), with the known slips as switches.
+fn sheet_reference(s: &ScreenSetup, eye: Eye, v: SheetVariant) -> [f64; 6] {
     let (w, h) = (f64::from(s.width), f64::from(s.height));
     let (n, f, z0) = (
         f64::from(s.near),
@@ -54,7 +54,7 @@ fn sheet_reference(s: &ScreenSetup, eye: usize, v: SheetVariant) -> [f64; 6] {
     } else {
         offset * scale
     };
-    let left = (eye == 0) != v.swapped;
+    let left = (eye == Eye::Left) != v.swapped;
     let shift = if left { shift } else { -shift };
     [-r + shift, r + shift, -t, t, n, f]
 }
@@ -128,9 +128,9 @@ fn random_screen(rng: &mut SplitMix64) -> ScreenSetup {
 }
 
 pub(super) fn sheet_frustum_task() -> TaskSpec {
-    let inputs: Vec<(&str, ScreenSetup, usize)> = named_screens()
+    let inputs: Vec<(&str, ScreenSetup, Eye)> = named_screens()
         .into_iter()
-        .flat_map(|(name, s)| [(name, s, 0), (name, s, 1)])
+        .flat_map(|(name, s)| Eye::BOTH.map(|eye| (name, s, eye)))
         .collect();
     let each = |v: SheetVariant| {
         inputs
@@ -145,9 +145,9 @@ pub(super) fn sheet_frustum_task() -> TaskSpec {
         depends_on: &[],
         hidden: hidden_cases("sheet_frustum", 8, |rng, i| {
             let s = random_screen(rng);
-            let eye = i % 2;
+            let eye = Eye::BOTH[i % 2];
             Case {
-                label: format!("hidden: eye {eye} of {s:?}"),
+                label: format!("hidden: eye {} of {s:?}", eye.index()),
                 input: json!([s, eye]),
                 expected: flat(&sheet_reference(&s, eye, SheetVariant::default())),
             }
@@ -156,7 +156,7 @@ pub(super) fn sheet_frustum_task() -> TaskSpec {
         cases: inputs
             .iter()
             .map(|(name, s, eye)| Case {
-                label: format!("eye {eye}, {name}: {s:?}"),
+                label: format!("eye {}, {name}: {s:?}", eye.index()),
                 input: json!([s, eye]),
                 expected: flat(&sheet_reference(s, *eye, SheetVariant::default())),
             })
@@ -219,20 +219,20 @@ mod tests {
         // Camera 9 from the screen, 90°: t = n·tan(45°) = 1 = ½·18·1/9; the shift (d/2)·n/z0
         // with d = 1 is 1/18 = ½·(1/18)·18·(1/9).
         let s = &named_screens()[0].1;
-        let left = sheet_reference(s, 0, SheetVariant::default());
+        let left = sheet_reference(s, Eye::Left, SheetVariant::default());
         let expected = [-1.0 + 1.0 / 18.0, 1.0 + 1.0 / 18.0, -1.0, 1.0, 1.0, 100.0];
         for (a, e) in left.iter().zip(expected) {
             assert!((a - e).abs() < 1e-7, "{left:?}");
         }
-        let right = sheet_reference(s, 1, SheetVariant::default());
+        let right = sheet_reference(s, Eye::Right, SheetVariant::default());
         assert!((right[0] + 1.0 + 1.0 / 18.0).abs() < 1e-7, "{right:?}");
     }
 
     #[test]
     fn every_public_case_tells_each_slip_from_the_right_answer() {
-        let inputs: Vec<(ScreenSetup, usize)> = named_screens()
+        let inputs: Vec<(ScreenSetup, Eye)> = named_screens()
             .into_iter()
-            .flat_map(|(_, s)| [(s, 0), (s, 1)])
+            .flat_map(|(_, s)| Eye::BOTH.map(|eye| (s, eye)))
             .collect();
         let slips = [
             SheetVariant {
@@ -260,7 +260,7 @@ mod tests {
             for (s, eye) in &inputs {
                 let ok = sheet_reference(s, *eye, SheetVariant::default());
                 let bad = sheet_reference(s, *eye, v);
-                assert!(!SHEET_TOLERANCE.accepts(&ok, &bad), "{s:?} eye {eye}");
+                assert!(!SHEET_TOLERANCE.accepts(&ok, &bad), "{s:?} {eye:?} eye");
             }
         }
     }
