@@ -25,10 +25,44 @@ mod shade;
 mod simd;
 mod text;
 
+// The names, in the order a course meets them. Each module is private: these are the crate.
+
+// Errors, eyes, framebuffers.
 pub use error::{Error, Result};
 pub use eye::Eye;
-pub use framebuffer::{EyePair, Framebuffer};
+pub use framebuffer::{
+    BACK_LEFT, BACK_RIGHT, DrawBuffer, EyePair, Framebuffer, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE,
+    check_size, open_image,
+};
 
+// The camera and the stereo rig: each formula a short function (`math::stereo`), the rig that
+// checks its inputs and calls them.
+pub use math::stereo::{
+    auto_eye_separation, cyclopic_projection, eye_translation, frustum_asymmetry,
+    image_shift_translation, off_axis_frustum, toe_in_view, view_width_at,
+    zero_parallax_at_fraction,
+};
+pub use math::{
+    Camera, CameraMode, EyeMatrices, ImageShift, Lighting, ResolvedRig, Separation, StereoRig,
+    Viewer, ZeroParallax, fit_zero_parallax, frustum, look_at, perspective, project_ndc,
+};
+
+// Shading and the fixed-point rasterizer (knows nothing of stereo).
+pub use raster::{
+    Band as RasterBand, DepthMode, DepthPlane, Plane, RasterOptions, RasterStats,
+    Setup as TriangleSetup, SetupTriangle, Setups, SmallBox, WindowVertex, rasterize,
+    rasterize_blinn_phong, setup_triangle, setup_triangles, traverse,
+};
+pub use shade::{BlinnPhong, DepthOnly, Fragment, Light, MAX_VARYINGS, Shader, Varyings, to_rgba8};
+
+// The f64 reference the hard cases are measured against.
+pub use reference::{
+    IdShader, Mismatch, Visible, compare as compare_with_reference, eye as eye_matrices_f64,
+    frustum as frustum_f64, look_at as look_at_f64, soup as triangle_soup, visible as visible_f64,
+    zero_parallax as zero_parallax_f64,
+};
+
+// Anaglyphs and layouts.
 pub use effects::anaglyph::{
     AnaglyphKind, AnaglyphMatrices, AnaglyphOptions, ColorMatrix, anaglyph, anaglyph_pixel,
     anaglyph_reference, linear_to_srgb, mix as anaglyph_mix, srgb_to_linear,
@@ -37,6 +71,46 @@ pub use effects::calibration::{
     ARROW_COLOR as CALIBRATION_ARROW_COLOR, BLANK_COLOR as CALIBRATION_BLANK_COLOR,
     CalibrationLayout, VIEW_COLOR as CALIBRATION_VIEW_COLOR, calibration_screen,
 };
+pub use effects::eye_input::check_same_size;
+pub use effects::frame_sequential::{
+    Field as FrameField, FrameSequentialSettings, MAX_CYCLES, MAX_EYE_RATE_HZ,
+};
+pub use effects::ghosting::{
+    BRIGHT as GHOST_BRIGHT, DARK as GHOST_DARK, DEFAULT_LEAK as DEFAULT_GHOSTING_LEAK, GhostRisk,
+    GhostingSettings, contrast_warning, ghost_risk, ghosted,
+};
+pub use effects::layout::{above_below, above_below_squashed, interleave, side_by_side};
+
+// Remapping, the visibility check, random-dot pairs.
+pub use effects::occlusion::{
+    BACKGROUND_COLOR as OCCLUSION_BACKGROUND_COLOR, FARTHER_COLOR as OCCLUSION_FARTHER_COLOR,
+    OCCLUDED_COLOR as OCCLUSION_OCCLUDED_COLOR, OUT_OF_VIEW_COLOR as OCCLUSION_OUT_OF_VIEW_COLOR,
+    occlusion_image,
+};
+pub use effects::rds::{
+    MAX_DOT_SIZE, RdsSettings, as_framebuffer as rds_framebuffer, dot as rds_dot, rds_left,
+    rds_right, right_only_seed, source_texel,
+};
+pub use effects::remap::{
+    DEPTH_PRECISION, Precision, Remapped, Remapper, Visibility, classify as classify_visibility,
+    depth_slope, remap_color, remap_color_pixel, remap_color_reference, remap_coordinates,
+    tolerance as remap_tolerance, visibility_map,
+};
+
+// Parallax, its budget, and shear against rotate.
+pub use effects::legend::{LEGEND_HEIGHT, draw_legend, draw_legend_reference};
+pub use effects::parallax::{
+    PARALLAX_BACKGROUND, PARALLAX_BUDGET_PERCENT, ParallaxBudget, ParallaxRig,
+    VIOLATION_COLOR as PARALLAX_VIOLATION_COLOR, budget as parallax_budget,
+    budget_of as parallax_budget_of, color_scale as parallax_color_scale, parallax_color,
+    parallax_image, parallax_image_reference, parallax_map, violation_band, window_violation_marks,
+};
+pub use effects::shear_rotate::{
+    Difference as ShearRotateDifference, difference as shear_rotate_difference,
+    max_abs as max_abs_vertical_parallax, vertical_parallax_image, vertical_parallax_map,
+};
+
+// ChromaDepth: texgen, the ramp, the glasses.
 pub use effects::chromadepth::glasses::{
     channel_weights, glasses_pair, glasses_view, pixel_shift, shift_map,
 };
@@ -50,40 +124,9 @@ pub use effects::chromadepth::texgen::{
 pub use effects::chromadepth::{
     ChromaDepthSettings, ChromaDepthView, TexgenMode, chromadepth_view,
 };
-pub use effects::eye_input::check_same_size;
-pub use effects::frame_sequential::{
-    Field as FrameField, FrameSequentialSettings, MAX_CYCLES, MAX_EYE_RATE_HZ,
-};
-pub use effects::ghosting::{
-    BRIGHT as GHOST_BRIGHT, DARK as GHOST_DARK, DEFAULT_LEAK as DEFAULT_GHOSTING_LEAK, GhostRisk,
-    GhostingSettings, contrast_warning, ghost_risk, ghosted,
-};
-pub use effects::layout::{above_below, above_below_squashed, interleave, side_by_side};
-pub use effects::legend::{LEGEND_HEIGHT, draw_legend, draw_legend_reference};
-pub use effects::occlusion::{
-    BACKGROUND_COLOR as OCCLUSION_BACKGROUND_COLOR, FARTHER_COLOR as OCCLUSION_FARTHER_COLOR,
-    OCCLUDED_COLOR as OCCLUSION_OCCLUDED_COLOR, OUT_OF_VIEW_COLOR as OCCLUSION_OUT_OF_VIEW_COLOR,
-    occlusion_image,
-};
-pub use effects::parallax::{
-    PARALLAX_BACKGROUND, PARALLAX_BUDGET_PERCENT, ParallaxBudget, ParallaxRig,
-    VIOLATION_COLOR as PARALLAX_VIOLATION_COLOR, budget as parallax_budget,
-    budget_of as parallax_budget_of, color_scale as parallax_color_scale, parallax_color,
-    parallax_image, parallax_image_reference, parallax_map, violation_band, window_violation_marks,
-};
-pub use effects::rds::{
-    MAX_DOT_SIZE, RdsSettings, as_framebuffer as rds_framebuffer, dot as rds_dot, rds_left,
-    rds_right, right_only_seed, source_texel,
-};
-pub use effects::remap::{
-    DEPTH_PRECISION, Precision, Remapped, Remapper, Visibility, classify as classify_visibility,
-    depth_slope, remap_color, remap_color_pixel, remap_color_reference, remap_coordinates,
-    tolerance as remap_tolerance, visibility_map,
-};
-pub use effects::shear_rotate::{
-    Difference as ShearRotateDifference, difference as shear_rotate_difference,
-    max_abs as max_abs_vertical_parallax, vertical_parallax_image, vertical_parallax_map,
-};
+
+// SIRDS: disparity, depth maps, TIW's per-pixel linking, the paper's per-vertex strips, and
+// decoding.
 pub use effects::sirds::decode::{
     AUTOSTEREOGRAM_SHARE, AutoDecoded as AutoDecodedSirds, DecodeOptions as SirdsDecodeOptions,
     Decoded as DecodedSirds, RoundTrip as SirdsRoundTrip, decode as decode_sirds,
@@ -115,33 +158,12 @@ pub use effects::sirds::{
     Filter as StripFilter, Geometry as SirdsGeometry, Pattern as SirdsPattern, PerVertexOptions,
     Settings as SirdsSettings, Sirds, SirdsSpec, Start as StripStart, depth_range, from_depth_map,
 };
+
+// Reading and writing files within bounds, text in pictures, the CPU's vector loops.
 pub use files::{
     EXCERPT_CHARS, InputRoot, check_input, check_output_path, excerpt, image_error,
     open_image as open_image_within, read_input, read_text, without_bom, write_atomic, write_bytes,
     write_png,
 };
-pub use framebuffer::{
-    BACK_LEFT, BACK_RIGHT, DrawBuffer, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_size, open_image,
-};
-pub use math::stereo::{
-    auto_eye_separation, cyclopic_projection, eye_translation, frustum_asymmetry,
-    image_shift_translation, off_axis_frustum, toe_in_view, view_width_at,
-    zero_parallax_at_fraction,
-};
-pub use math::{
-    Camera, CameraMode, EyeMatrices, ImageShift, Lighting, ResolvedRig, Separation, StereoRig,
-    Viewer, ZeroParallax, fit_zero_parallax, frustum, look_at, perspective, project_ndc,
-};
-pub use raster::{
-    Band as RasterBand, DepthMode, DepthPlane, Plane, RasterOptions, RasterStats,
-    Setup as TriangleSetup, SetupTriangle, Setups, SmallBox, WindowVertex, bin_rows, rasterize,
-    rasterize_blinn_phong, setup_triangle, setup_triangles, traverse,
-};
-pub use reference::{
-    IdShader, Mismatch, Visible, compare as compare_with_reference, eye as eye_matrices_f64,
-    frustum as frustum_f64, look_at as look_at_f64, soup as triangle_soup, visible as visible_f64,
-    zero_parallax as zero_parallax_f64,
-};
-pub use shade::{BlinnPhong, DepthOnly, Fragment, Light, MAX_VARYINGS, Shader, Varyings, to_rgba8};
 pub use simd::{avx2_available, uses_avx2};
 pub use text::{Align as TextAlign, caption, draw_rgba as draw_text_rgba, width as text_width};
