@@ -576,3 +576,62 @@ fn a_successful_gpu_run_prints_no_errors_without_a_runtime_dir() {
     assert!(out.status.success(), "{err}");
     assert!(err.trim().is_empty(), "stderr of a successful run: {err}");
 }
+
+/// Two 32×32 images: black, and black with a white 8×8 square (6.25% of the pixels).
+fn square_and_blank(dir: &Path) -> (String, String) {
+    let square = image::RgbImage::from_fn(32, 32, |x, y| {
+        if (8..16).contains(&x) && (8..16).contains(&y) {
+            image::Rgb([255, 255, 255])
+        } else {
+            image::Rgb([0, 0, 0])
+        }
+    });
+    let (a, b) = (dir.join("square.png"), dir.join("blank.png"));
+    square.save(&a).expect("png");
+    image::RgbImage::new(32, 32).save(&b).expect("png");
+    (s(&a), s(&b))
+}
+
+/// A failed `compare` says which limits were exceeded and by how much, in sentences, not a
+/// count dressed as a threshold value.
+#[test]
+fn a_failed_compare_names_each_exceeded_limit_and_by_how_much() {
+    let dir = out_dir("reliability-compare-words");
+    let (square, blank) = square_and_blank(&dir);
+    let out = stereolab(&["compare", &square, &blank]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("--threshold = "), "{err}");
+    assert!(err.contains("blank.png: 3 limits exceeded"), "{err}");
+    assert!(
+        err.contains(
+            "coverage differs on 6.25000% of the pixels (drawn in one image, background in the \
+             other), 6.15000 points over the limit of 0.1% (coverage=)"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains("the color channels differ by") && err.contains("over the limit of 1 (mean=)"),
+        "{err}"
+    );
+    assert!(
+        err.contains("dB under the least allowed 30 dB (psnr=)"),
+        "{err}"
+    );
+    let out = stereolab(&[
+        "compare",
+        &square,
+        &blank,
+        "--threshold",
+        "coverage=10",
+        "--threshold",
+        "mean=100",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("1 limit exceeded"), "{err}");
+    assert!(
+        err.contains("(psnr=)") && !err.contains("(coverage=)"),
+        "{err}"
+    );
+}
