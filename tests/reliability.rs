@@ -577,6 +577,22 @@ fn a_successful_gpu_run_prints_no_errors_without_a_runtime_dir() {
     assert!(err.trim().is_empty(), "stderr of a successful run: {err}");
 }
 
+/// `stereolab` with standard output closed in the child (`>&-`), not redirected anywhere.
+#[cfg(unix)]
+fn stereolab_with_stdout_closed(args: &[&str]) -> Output {
+    use std::os::unix::process::CommandExt as _;
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_stereolab"));
+    cmd.args(args).stderr(Stdio::piped());
+    // SAFETY: close(2) is async-signal-safe; the child closes its own descriptor 1 before exec.
+    unsafe {
+        cmd.pre_exec(|| {
+            libc::close(1);
+            Ok(())
+        });
+    }
+    cmd.output().expect("run stereolab")
+}
+
 /// Two 32×32 images: black, and black with a white 8×8 square (6.25% of the pixels).
 fn square_and_blank(dir: &Path) -> (String, String) {
     let square = image::RgbImage::from_fn(32, 32, |x, y| {
@@ -633,5 +649,31 @@ fn a_failed_compare_names_each_exceeded_limit_and_by_how_much() {
     assert!(
         err.contains("(psnr=)") && !err.contains("(coverage=)"),
         "{err}"
+    );
+}
+
+/// A closed standard output (`>&-`) is not a closed pipe: what the command would print is
+/// lost, so it fails with a message on standard error.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_closed_standard_output_is_an_error() {
+    let out = stereolab_with_stdout_closed(&["info", &s(&asset("scenes/wuson.toml"))]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("standard output") && err.contains("closed"),
+        "{err}"
+    );
+    // The same command with standard output on /dev/null (written, then discarded) succeeds.
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(["info", &s(&asset("scenes/wuson.toml"))])
+        .stdout(Stdio::null())
+        .output()
+        .expect("run");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
 }
