@@ -72,6 +72,8 @@ pub fn run(args: CompareArgs) -> Result<()> {
         limits.set(t)?;
     }
     let mut problems = Vec::new();
+    // A failure is named by the input judged: the actual image, or the scene.
+    let judged = second.clone().unwrap_or_else(|| first.clone());
     let rows = match second {
         None if exercise.is_some() => {
             let name = exercise.unwrap_or_default();
@@ -120,17 +122,21 @@ pub fn run(args: CompareArgs) -> Result<()> {
     for p in &problems {
         outln!("  {p}");
     }
-    let mut failed = limits.violations(&rows);
-    failed.extend(problems);
-    if failed.is_empty() {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            "--threshold",
-            format!("{} exceeded", failed.len()),
-            failed.join("; "),
-        ))
+    let violations = limits.violations(&rows);
+    if violations.is_empty() && problems.is_empty() {
+        return Ok(());
     }
+    let heading = match violations.len() {
+        0 => "the comparison found problems".to_string(),
+        1 => "1 limit exceeded (a limit is set with --threshold KEY=VALUE)".to_string(),
+        n => format!("{n} limits exceeded (a limit is set with --threshold KEY=VALUE)"),
+    };
+    let lines: Vec<String> = violations.into_iter().chain(problems).collect();
+    Err(Error::parse(
+        &judged,
+        None,
+        format!("{heading}:\n  {}", lines.join("\n  ")),
+    ))
 }
 
 /// A file name with an image extension stereolab reads.

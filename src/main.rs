@@ -174,8 +174,47 @@ fn load_scene(path: &std::path::Path, sets: &[String], size: Option<&str>) -> Re
     Ok(s)
 }
 
-/// Writes to standard output and flushes, reporting what the write met.
+/// Whether standard output was closed when the process started (`stereolab info >&-`). Before
+/// `main`, the Rust runtime opens `/dev/null` on a closed standard descriptor, after which
+/// every write succeeds and goes nowhere; [`CHECK_STDOUT`] records the state before it does.
+#[cfg(target_os = "linux")]
+static STDOUT_CLOSED_AT_START: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// Run by the loader with the program's constructors, before the runtime's descriptor
+/// sanitizing: notes whether descriptor 1 is open.
+#[cfg(target_os = "linux")]
+#[used]
+#[unsafe(link_section = ".init_array")]
+static CHECK_STDOUT: extern "C" fn() = {
+    extern "C" fn check_stdout() {
+        // SAFETY: F_GETFD only reads the descriptor's flags; it fails (EBADF) when fd 1 is
+        // not open.
+        let closed = unsafe { libc::fcntl(1, libc::F_GETFD) } == -1;
+        STDOUT_CLOSED_AT_START.store(closed, std::sync::atomic::Ordering::Relaxed);
+    }
+    check_stdout
+};
+
+/// An error when standard output was closed at the start: what would be printed is lost.
+fn check_stdout_open() -> Result<()> {
+    #[cfg(target_os = "linux")]
+    if STDOUT_CLOSED_AT_START.load(std::sync::atomic::Ordering::Relaxed) {
+        return Err(Error::io(
+            Path::new("standard output"),
+            std::io::Error::other(
+                "it is closed (>&-), so nothing can be printed; redirect it to a file or to \
+                 /dev/null instead",
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Writes to standard output and flushes, reporting what the write met (a standard output
+/// closed at the start included).
 fn write_stdout(args: std::fmt::Arguments) -> Result<()> {
+    check_stdout_open()?;
     let mut stdout = std::io::stdout().lock();
     stdout
         .write_fmt(args)

@@ -20,18 +20,23 @@ pub struct SirdsArgs {
     /// PNG, netpbm PGM/PPM/PAM (full scale: v / max), or float PFM (its own min..max).
     #[arg(long, conflicts_with = "scene")]
     pub depth: Option<PathBuf>,
-    /// With --depth: which values are near, `white` (larger; netpbm, stereolab) or `black`
-    /// (smaller; distance maps, Z-buffers).
-    #[arg(long, default_value = "white", value_parser = ["white", "black"], requires = "depth")]
-    pub near: String,
+    /// With --depth only: which values are near, `white` (larger; netpbm, stereolab; the
+    /// default) or `black` (smaller; distance maps, Z-buffers).
+    // No clap default, so that `report` sees whether it was given: clap drops `requires`
+    // when the required argument conflicts with one present (a scene, --decode).
+    #[arg(long, value_parser = ["white", "black"], requires = "depth")]
+    pub near: Option<String>,
     /// Decode this autostereogram: write the depth it encodes to --out and say whether it is
     /// one at all. With a scene (its `[sirds]` table) or `--set sirds.*` flags the decoder is
     /// told the viewing set-up: it decodes over that model's separations (eq. 1 or eq. 3,
     /// wall- or cross-eyed) instead of searching for them.
     #[arg(long, conflicts_with_all = ["depth", "frames"])]
     pub decode: Option<PathBuf>,
-    /// Output file: .png, or .ppm / .pgm (uncompressed; .pgm for gray patterns, one byte a
-    /// pixel); with --frames a .gif. Default sirds.png, or sirds.gif with --frames.
+    /// Output file, written in the format its extension names (case ignored): .png, .jpg /
+    /// .jpeg, .gif (one frame), or .ppm / .pnm / .pgm (uncompressed; .pgm for gray patterns,
+    /// one byte a pixel); with --frames a .gif; with --decode a .png or .pgm (16-bit), .pam
+    /// (16-bit), .ppm / .pnm or .jpg / .jpeg (8-bit). Any other name is refused before any
+    /// work. Default sirds.png, or sirds.gif with --frames.
     #[arg(long, short)]
     pub out: Option<PathBuf>,
     /// Override a `[sirds]` field, e.g. --set sirds.dpi=100 (repeatable; with a scene any
@@ -80,6 +85,40 @@ fn has_extension(path: &Path, extensions: &[&str]) -> bool {
         .is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
 }
 
+/// The extensions a decoded depth map may be named with ([`write_depth`]).
+const DEPTH_EXTENSIONS: [&str; 7] = ["png", "pgm", "ppm", "pnm", "pam", "jpg", "jpeg"];
+
+/// The output's name (`--out`, or sirds.png / sirds.gif with `--frames`), refused before any
+/// work when its extension names a container this mode does not write: an animation is a GIF,
+/// a decoded depth map one of [`DEPTH_EXTENSIONS`], a still SIRDS one of
+/// [`STILL_EXTENSIONS`](stereolab::output::sirds::STILL_EXTENSIONS).
+fn output_name(args: &SirdsArgs) -> Result<PathBuf> {
+    let out = match (&args.out, args.frames) {
+        (Some(out), _) => out.clone(),
+        (None, Some(_)) => PathBuf::from("sirds.gif"),
+        (None, None) => PathBuf::from("sirds.png"),
+    };
+    if args.frames.is_some() {
+        if !has_extension(&out, &["gif"]) {
+            return Err(Error::invalid(
+                "--out",
+                out.display(),
+                "an animation (--frames) is written as GIF: name the file .gif",
+            ));
+        }
+    } else if args.decode.is_some() {
+        if !has_extension(&out, &DEPTH_EXTENSIONS) {
+            return Err(stereolab::output::sirds::unsupported_extension(
+                &out,
+                &DEPTH_EXTENSIONS,
+            ));
+        }
+    } else {
+        stereolab::output::sirds::StillFormat::of(&out)?;
+    }
+    Ok(out)
+}
+
 /// Runs `stereolab sirds`.
 ///
 /// # Errors
@@ -91,26 +130,21 @@ pub fn run(args: &SirdsArgs) -> Result<()> {
 
 /// What `stereolab sirds` prints, after doing the work.
 fn report(args: &SirdsArgs) -> Result<String> {
-    // An animation is a GIF (default sirds.gif), everything else an image (default sirds.png):
-    // a GIF under another name would be a wrong container.
-    let out = match (&args.out, args.frames) {
-        (Some(out), Some(_)) if !has_extension(out, &["gif"]) => {
-            return Err(Error::invalid(
-                "--out",
-                out.display(),
-                "an animation (--frames) is written as GIF: name the file .gif",
-            ));
-        }
-        (Some(out), _) => out.clone(),
-        (None, Some(_)) => PathBuf::from("sirds.gif"),
-        (None, None) => PathBuf::from("sirds.png"),
-    };
+    if let (Some(near), None) = (&args.near, &args.depth) {
+        return Err(Error::invalid(
+            "--near",
+            near,
+            "--near applies to --depth only (which values of a depth map are near); a scene or \
+             --decode has no depth map to read it for",
+        ));
+    }
+    let out = output_name(args)?;
     if let Some(path) = &args.decode {
         return decode_report(args, path, &out);
     }
     if let Some(path) = &args.depth {
         let settings = settings_from_sets(&args.sets)?;
-        let near = Near::parse(&args.near)?;
+        let near = Near::parse(args.near.as_deref().unwrap_or("white"))?;
         let d = settings.geometry.to_pixels()?;
         let netpbm = stereolab::output::sirds::Netpbm::of(&out).is_some();
         let (w, h, mapping) = super::with_spinner("making the autostereogram", || {
@@ -314,7 +348,9 @@ fn decode_told(
 }
 
 /// Writes the decoded depth (and with `--pair` the views and their anaglyph); returns the
-/// verdict and what was written.
+/// verdict and what was written. An image that is no autostereogram (less than
+/// [`AUTOSTEREOGRAM_SHARE`](stereolab_core::AUTOSTEREOGRAM_SHARE) of its pixels matched) is
+/// refused with the share measured, and nothing is written.
 #[allow(clippy::too_many_arguments)]
 fn finish_decode(
     args: &SirdsArgs,
@@ -326,7 +362,22 @@ fn finish_decode(
     (lo, hi): (u32, u32),
     settings: &SirdsSettings,
 ) -> Result<String> {
-    use stereolab_core::{AnaglyphKind, AnaglyphOptions, anaglyph, sirds_views};
+    use stereolab_core::{
+        AUTOSTEREOGRAM_SHARE, AnaglyphKind, AnaglyphOptions, anaglyph, sirds_views,
+    };
+    if !decoded.is_autostereogram() {
+        return Err(Error::invalid(
+            "--decode",
+            args.decode.as_deref().unwrap_or(out).display(),
+            format!(
+                "only {:.1}% of the pixels matched a separation in {lo}..={hi} px, and an \
+                 autostereogram matches at least {:.0}%: not an autostereogram (no consistent \
+                 repetition), nothing written",
+                decoded.matched_share * 100.0,
+                AUTOSTEREOGRAM_SHARE * 100.0
+            ),
+        ));
+    }
     let z = z
         .into_iter()
         .map(|z| {
@@ -346,13 +397,8 @@ fn finish_decode(
         out,
     )?;
     let mut report = format!(
-        "  {:.1}% of pixels matched a separation in {lo}..={hi} px: {}\n  wrote {}\n",
+        "  {:.1}% of pixels matched a separation in {lo}..={hi} px: an autostereogram\n  wrote {}\n",
         decoded.matched_share * 100.0,
-        if decoded.is_autostereogram() {
-            "an autostereogram"
-        } else {
-            "not an autostereogram (no consistent repetition)"
-        },
         out.display()
     );
     if let Some(dir) = &args.pair {
@@ -396,32 +442,49 @@ fn finish_decode(
     Ok(report)
 }
 
-/// Writes a decoded depth map (white = near) as `out`'s extension asks: PNG (16-bit), a .pgm
-/// as netpbm's binary P5 at 16 bits, a .ppm as binary P6 (8-bit gray in RGB).
+/// Writes a decoded depth map (white = near) as `out`'s extension asks ([`DEPTH_EXTENSIONS`]):
+/// PNG (16-bit), a .pgm as netpbm's binary P5 at 16 bits, a .ppm or .pnm as binary P6 (8-bit
+/// gray in RGB), a .pam as PAM (16-bit `GRAYSCALE`), a .jpg or .jpeg as 8-bit gray JPEG.
 fn write_depth(map: &DepthMap, out: &Path) -> Result<()> {
+    use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
     let depth = map.to_image();
-    let format = image::ImageFormat::from_path(out)
-        .map_err(|e| Error::invalid("--out", out.display(), format!("no image format: {e}")))?;
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
     let mut bytes = std::io::Cursor::new(Vec::new());
-    let encoded = if format == image::ImageFormat::Pnm {
-        // The image crate would pick PAM for 16-bit gray: a .ppm gets binary P6 (8-bit gray
-        // in RGB), a .pgm binary P5 at 16 bits, as netpbm writes them.
-        use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
-        if has_extension(out, &["pgm"]) {
+    let encoded = match ext.as_str() {
+        "png" => {
+            image::DynamicImage::ImageLuma16(depth).write_to(&mut bytes, image::ImageFormat::Png)
+        }
+        "pgm" => {
             // P5 with maxval 65535: two bytes a sample, most significant first (netpbm).
             let (w, h) = depth.dimensions();
             let b = bytes.get_mut();
             b.extend_from_slice(format!("P5\n{w} {h}\n65535\n").as_bytes());
             b.extend(depth.as_raw().iter().flat_map(|v| v.to_be_bytes()));
             Ok(())
-        } else {
+        }
+        "ppm" | "pnm" => {
             let sub = PnmSubtype::Pixmap(SampleEncoding::Binary);
             image::DynamicImage::ImageLuma16(depth)
                 .into_rgb8()
                 .write_with_encoder(PnmEncoder::new(&mut bytes).with_subtype(sub))
         }
-    } else {
-        image::DynamicImage::ImageLuma16(depth).write_to(&mut bytes, format)
+        // The image crate's netpbm encoder writes 16-bit gray as PAM when not told a subtype.
+        "pam" => depth.write_with_encoder(PnmEncoder::new(&mut bytes)),
+        "jpg" | "jpeg" => image::DynamicImage::ImageLuma16(depth)
+            .into_luma8()
+            .write_with_encoder(image::codecs::jpeg::JpegEncoder::new_with_quality(
+                &mut bytes,
+                stereolab::output::sirds::JPEG_QUALITY,
+            )),
+        _ => {
+            return Err(stereolab::output::sirds::unsupported_extension(
+                out,
+                &DEPTH_EXTENSIONS,
+            ));
+        }
     };
     encoded.map_err(|e| Error::invalid("--out", out.display(), e.to_string()))?;
     stereolab_core::write_bytes(out, bytes.get_ref())

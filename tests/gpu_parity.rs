@@ -759,7 +759,7 @@ fn cli_renders_on_the_gpu_and_compares_scenes_and_images() {
         "left vs right must exceed the default coverage threshold"
     );
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("coverage mismatch %"), "{stderr}");
+    assert!(stderr.contains("coverage differs on"), "{stderr}");
     let out = stereolab(&[
         "compare",
         l,

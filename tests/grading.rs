@@ -1035,7 +1035,7 @@ fn compare_exercise_solution_matches_the_gpu_and_swapped_eyes_exceed_the_parity_
     assert_eq!(code, Some(1), "{text}");
     for side in ["left", "right"] {
         assert!(
-            text.contains(&format!("{side} (gpu | yours): coverage mismatch %")),
+            text.contains(&format!("{side} (gpu | yours): coverage differs on")),
             "{text}"
         );
     }

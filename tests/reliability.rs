@@ -576,3 +576,301 @@ fn a_successful_gpu_run_prints_no_errors_without_a_runtime_dir() {
     assert!(out.status.success(), "{err}");
     assert!(err.trim().is_empty(), "stderr of a successful run: {err}");
 }
+
+/// `stereolab` with standard output closed in the child (`>&-`), not redirected anywhere.
+#[cfg(unix)]
+fn stereolab_with_stdout_closed(args: &[&str]) -> Output {
+    use std::os::unix::process::CommandExt as _;
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_stereolab"));
+    cmd.args(args).stderr(Stdio::piped());
+    // SAFETY: close(2) is async-signal-safe; the child closes its own descriptor 1 before exec.
+    unsafe {
+        cmd.pre_exec(|| {
+            libc::close(1);
+            Ok(())
+        });
+    }
+    cmd.output().expect("run stereolab")
+}
+
+/// The first bytes of each container, to tell which one a file holds.
+fn container_of(bytes: &[u8]) -> &'static str {
+    match bytes {
+        [0x89, b'P', b'N', b'G', ..] => "png",
+        [0xff, 0xd8, 0xff, ..] => "jpeg",
+        [b'G', b'I', b'F', b'8', ..] => "gif",
+        [b'P', b'5', ..] => "pgm",
+        [b'P', b'6', ..] => "ppm",
+        [b'P', b'7', ..] => "pam",
+        _ => "unknown",
+    }
+}
+
+/// Every name `sirds` writes an image under gets the container its extension names (case
+/// ignored), or is refused before any work with the argument, the extension and the accepted
+/// extensions, and nothing is written.
+#[test]
+fn an_image_is_written_in_the_format_its_name_says_or_refused_before_any_work() {
+    let dir = out_dir("reliability-formats");
+    let scene = s(&asset("scenes/sirds_sphere.toml"));
+    for (name, container) in [
+        ("s.PNG", "png"),
+        ("s.jpg", "jpeg"),
+        ("s.JPEG", "jpeg"),
+        ("s.gif", "gif"),
+        ("s.ppm", "ppm"),
+        ("s.pgm", "pgm"),
+    ] {
+        let path = dir.join(name);
+        let out = stereolab(&["sirds", &scene, "-o", &s(&path)]);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = std::fs::read(&path).expect("written");
+        assert_eq!(container_of(&bytes), container, "{name}");
+        let img = image::load_from_memory(&bytes).expect("a whole image");
+        assert_eq!((img.width(), img.height()), (512, 256), "{name}");
+    }
+    // The decoded depth map: .pam is PAM (16-bit gray), .jpg an 8-bit gray JPEG.
+    let sirds = s(&dir.join("s.PNG"));
+    for (name, container) in [("d.pam", "pam"), ("d.jpg", "jpeg")] {
+        let path = dir.join(name);
+        let out = stereolab(&["sirds", "--decode", &sirds, "-o", &s(&path)]);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = std::fs::read(&path).expect("written");
+        assert_eq!(container_of(&bytes), container, "{name}");
+        let img = image::load_from_memory(&bytes).expect("a whole image");
+        assert_eq!((img.width(), img.height()), (512, 256), "{name}");
+    }
+    let before = names(&dir);
+    // Refused before any work: the inputs named here do not exist, and the error is still the
+    // name's, not the missing input's.
+    let missing = s(&dir.join("missing.toml"));
+    let missing_image = s(&dir.join("missing.png"));
+    let cases: Vec<(Vec<String>, &str, &str)> = vec![
+        (
+            vec![missing.clone()],
+            "x.bmp",
+            ".png, .ppm, .pnm, .pgm, .jpg, .jpeg, .gif",
+        ),
+        (vec![missing.clone()], "x.tiff", ".jpg"),
+        (vec![missing.clone()], "x.WebP", ".gif"),
+        (vec![missing.clone()], "x.txt", ".png"),
+        (vec![missing], "x", ".png"),
+        (
+            vec!["--depth".into(), missing_image.clone()],
+            "x.webp",
+            ".ppm",
+        ),
+        (
+            vec!["--decode".into(), missing_image.clone()],
+            "x.gif",
+            ".png, .pgm, .ppm, .pnm, .pam, .jpg, .jpeg",
+        ),
+        (vec!["--decode".into(), missing_image], "x.bmp", ".pam"),
+    ];
+    for (input, name, accepted) in cases {
+        let path = dir.join(name);
+        let mut argv = vec!["sirds".to_string()];
+        argv.extend(input);
+        argv.extend(["-o".into(), s(&path)]);
+        let argv: Vec<&str> = argv.iter().map(String::as_str).collect();
+        let out = stereolab(&argv);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{argv:?}: {err}");
+        let ext = match name.rsplit_once('.') {
+            Some((_, ext)) => format!("unsupported extension .{ext}"),
+            None => "no extension".into(),
+        };
+        assert!(
+            err.contains("--out") && err.contains(&ext) && err.contains(accepted),
+            "{argv:?}: {err}"
+        );
+        assert!(!path.exists(), "{name} was written");
+    }
+    assert_eq!(names(&dir), before, "a refused name leaves nothing behind");
+}
+
+/// Two 32×32 images: black, and black with a white 8×8 square (6.25% of the pixels).
+fn square_and_blank(dir: &Path) -> (String, String) {
+    let square = image::RgbImage::from_fn(32, 32, |x, y| {
+        if (8..16).contains(&x) && (8..16).contains(&y) {
+            image::Rgb([255, 255, 255])
+        } else {
+            image::Rgb([0, 0, 0])
+        }
+    });
+    let (a, b) = (dir.join("square.png"), dir.join("blank.png"));
+    square.save(&a).expect("png");
+    image::RgbImage::new(32, 32).save(&b).expect("png");
+    (s(&a), s(&b))
+}
+
+/// A failed `compare` says which limits were exceeded and by how much, in sentences, not a
+/// count dressed as a threshold value.
+#[test]
+fn a_failed_compare_names_each_exceeded_limit_and_by_how_much() {
+    let dir = out_dir("reliability-compare-words");
+    let (square, blank) = square_and_blank(&dir);
+    let out = stereolab(&["compare", &square, &blank]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("--threshold = "), "{err}");
+    assert!(err.contains("blank.png: 3 limits exceeded"), "{err}");
+    assert!(
+        err.contains(
+            "coverage differs on 6.25000% of the pixels (drawn in one image, background in the \
+             other), 6.15000 points over the limit of 0.1% (coverage=)"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains("the color channels differ by") && err.contains("over the limit of 1 (mean=)"),
+        "{err}"
+    );
+    assert!(
+        err.contains("dB under the least allowed 30 dB (psnr=)"),
+        "{err}"
+    );
+    let out = stereolab(&[
+        "compare",
+        &square,
+        &blank,
+        "--threshold",
+        "coverage=10",
+        "--threshold",
+        "mean=100",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("1 limit exceeded"), "{err}");
+    assert!(
+        err.contains("(psnr=)") && !err.contains("(coverage=)"),
+        "{err}"
+    );
+}
+
+/// `--near` says which values of a depth map are near: without `--depth` there is no map, and
+/// the flag is refused instead of ignored.
+#[test]
+fn near_without_a_depth_map_is_refused() {
+    let dir = out_dir("reliability-near");
+    let scene = s(&asset("scenes/sirds_sphere.toml"));
+    let out_png = s(&dir.join("s.png"));
+    for near in ["black", "white"] {
+        for input in [vec![scene.as_str()], vec!["--decode", out_png.as_str()]] {
+            let mut argv = vec!["sirds"];
+            argv.extend(&input);
+            argv.extend(["--near", near, "-o", &out_png]);
+            let out = stereolab(&argv);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(!out.status.success(), "{argv:?}: {err}");
+            assert!(
+                err.contains("--near") && err.contains("--depth"),
+                "{argv:?}: {err}"
+            );
+        }
+    }
+    assert!(names(&dir).is_empty(), "nothing is written");
+}
+
+/// A closed standard output (`>&-`) is not a closed pipe: what the command would print is
+/// lost, so it fails with a message on standard error.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_closed_standard_output_is_an_error() {
+    let out = stereolab_with_stdout_closed(&["info", &s(&asset("scenes/wuson.toml"))]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("standard output") && err.contains("closed"),
+        "{err}"
+    );
+    // The same command with standard output on /dev/null (written, then discarded) succeeds.
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(["info", &s(&asset("scenes/wuson.toml"))])
+        .stdout(Stdio::null())
+        .output()
+        .expect("run");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Images that are no autostereogram are refused by `sirds --decode`, with the share of pixels
+/// that matched, and nothing is written: a photo-like gradient, noise, a flat image and a
+/// rendered eye view.
+#[test]
+fn decoding_an_image_that_is_no_autostereogram_is_refused_and_writes_nothing() {
+    let dir = out_dir("reliability-not-sirds");
+    let (w, h) = (256u32, 192u32);
+    let gradient = image::RgbImage::from_fn(w, h, |x, y| {
+        let (fx, fy) = (x as f32 / w as f32, y as f32 / h as f32);
+        let v = |a: f32| (255.0 * a.clamp(0.0, 1.0)) as u8;
+        image::Rgb([
+            v(0.5 + 0.5 * (6.0 * fx).sin() * fy),
+            v(fx * 0.8 + 0.2 * (9.0 * fy).cos()),
+            v(1.0 - fy),
+        ])
+    });
+    gradient.save(dir.join("gradient.png")).expect("png");
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let noise = image::RgbImage::from_fn(w, h, |_, _| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        let b = state.to_le_bytes();
+        image::Rgb([b[0], b[1], b[2]])
+    });
+    noise.save(dir.join("noise.png")).expect("png");
+    image::RgbImage::from_pixel(w, h, image::Rgb([90, 120, 150]))
+        .save(dir.join("flat.png"))
+        .expect("png");
+    let rendered = out_dir("reliability-not-sirds-render");
+    let out = stereolab(&[
+        "render",
+        &s(&asset("scenes/wuson.toml")),
+        "--size",
+        "256x192",
+        "--out",
+        &s(&rendered),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::copy(rendered.join("left.png"), dir.join("left.png")).expect("copy");
+    let scene = s(&asset("scenes/sirds_sphere.toml"));
+    for name in ["gradient.png", "noise.png", "flat.png", "left.png"] {
+        let input = s(&dir.join(name));
+        let depth = dir.join(format!("depth-{name}"));
+        // Untold (the separations searched for) and told the set-up (by the scene).
+        for told in [false, true] {
+            let mut argv = vec!["sirds"];
+            if told {
+                argv.push(&scene);
+            }
+            let depth_s = s(&depth);
+            argv.extend(["--decode", &input, "-o", &depth_s]);
+            let out = stereolab(&argv);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{argv:?}: {err}");
+            assert!(
+                err.contains("not an autostereogram") && err.contains("nothing written"),
+                "{argv:?}: {err}"
+            );
+            assert!(err.contains("% of the"), "the share measured: {err}");
+            assert!(!depth.exists(), "{argv:?} wrote {}", depth.display());
+        }
+    }
+}

@@ -300,48 +300,56 @@ impl Thresholds {
         Ok(())
     }
 
-    /// Every limit a comparison exceeds, as `name: what = value > limit`.
+    /// Every limit a comparison exceeds, one sentence each: the row's name, what differs and
+    /// by how much, how far past its limit, and the `--threshold` key that moves the limit
+    /// (e.g. `left pass: PSNR 20.00 dB, 10.00 dB under the least allowed 30 dB (psnr=)`).
     pub fn violations(&self, rows: &[Comparison]) -> Vec<String> {
         let mut v = Vec::new();
         for r in rows {
             let m = &r.metrics;
-            let mut fail = |what: &str, value: String, limit: String| {
-                v.push(format!("{}: {what} = {value}, limit {limit}", r.name));
-            };
-            if m.coverage_mismatch_percent() > self.coverage_percent {
-                fail(
-                    "coverage mismatch %",
-                    format!("{:.5}", m.coverage_mismatch_percent()),
-                    format!("{}", self.coverage_percent),
-                );
+            let mut fail = |sentence: String| v.push(format!("{}: {sentence}", r.name));
+            let coverage = m.coverage_mismatch_percent();
+            if coverage > self.coverage_percent {
+                fail(format!(
+                    "coverage differs on {coverage:.5}% of the pixels (drawn in one image, \
+                     background in the other), {:.5} points over the limit of {}% (coverage=)",
+                    coverage - self.coverage_percent,
+                    self.coverage_percent
+                ));
             }
             if m.max_channel_diff > self.max_channel {
-                fail(
-                    "max channel difference",
-                    m.max_channel_diff.to_string(),
-                    self.max_channel.to_string(),
-                );
+                fail(format!(
+                    "a color channel differs by {} levels, {} over the limit of {} (max=)",
+                    m.max_channel_diff,
+                    m.max_channel_diff - self.max_channel,
+                    self.max_channel
+                ));
             }
             if m.mean_channel_diff > self.mean_channel {
-                fail(
-                    "mean channel difference",
-                    format!("{:.4}", m.mean_channel_diff),
-                    self.mean_channel.to_string(),
-                );
+                fail(format!(
+                    "the color channels differ by {:.4} levels on average, {:.4} over the \
+                     limit of {} (mean=)",
+                    m.mean_channel_diff,
+                    m.mean_channel_diff - self.mean_channel,
+                    self.mean_channel
+                ));
             }
             if m.psnr < self.min_psnr {
-                fail(
-                    "PSNR dB",
-                    format!("{:.2}", m.psnr),
-                    format!("at least {}", self.min_psnr),
-                );
+                fail(format!(
+                    "PSNR {:.2} dB, {:.2} dB under the least allowed {} dB (psnr=)",
+                    m.psnr,
+                    self.min_psnr - m.psnr,
+                    self.min_psnr
+                ));
             }
             if r.has_depth && m.max_depth_diff > self.max_depth {
-                fail(
-                    "max depth difference",
-                    format!("{:.3e}", m.max_depth_diff),
-                    format!("{:e}", self.max_depth),
-                );
+                fail(format!(
+                    "the depth differs by up to {:.3e} where both images cover, {:.3e} over \
+                     the limit of {:e} (depth=)",
+                    m.max_depth_diff,
+                    m.max_depth_diff - self.max_depth,
+                    self.max_depth
+                ));
             }
         }
         v
@@ -575,10 +583,19 @@ mod tests {
         );
         let bad = t.violations(&[row(metrics(2, 9, 2.0, 20.0, 1e-3), true)]);
         assert_eq!(bad.len(), 4, "coverage 0.2%, mean, PSNR, depth: {bad:?}");
+        assert_eq!(
+            bad[0],
+            "left pass: coverage differs on 0.20000% of the pixels (drawn in one image, \
+             background in the other), 0.10000 points over the limit of 0.1% (coverage=)"
+        );
+        assert_eq!(
+            bad[2],
+            "left pass: PSNR 20.00 dB, 10.00 dB under the least allowed 30 dB (psnr=)"
+        );
         assert!(
-            bad[0].contains("coverage mismatch % = 0.20000"),
+            bad[3].contains("depth differs by up to 1.000e-3"),
             "{}",
-            bad[0]
+            bad[3]
         );
         // Without depth (PNG files), depth is not judged.
         let no_depth = t.violations(&[row(metrics(0, 0, 0.0, 90.0, 1.0), false)]);

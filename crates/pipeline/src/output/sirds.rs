@@ -10,8 +10,8 @@ use crate::scene::Scene;
 use stereolab_core::{
     DepthMap, DepthMapping, DepthRange, DepthSamples, Disparity, DisparityModel, Error,
     Framebuffer, Near, PgmRows, Result, Sirds, SirdsAlgorithm, SirdsSettings, StripFilter,
-    StripGeometry, StripResult, depth_range, draw_guide_dots, per_pixel, per_vertex, write_atomic,
-    write_png,
+    StripGeometry, StripResult, depth_range, draw_guide_dots, image_error, per_pixel, per_vertex,
+    write_atomic, write_png,
 };
 
 /// The cyclopean depth pass of `frame`.
@@ -205,15 +205,79 @@ impl Netpbm {
     }
 }
 
-/// Writes RGBA pixels as PNG, or uncompressed as binary PPM (`.ppm`/`.pnm`) or PGM (`.pgm`,
-/// gray SIRDS only, see [`Netpbm`]), all or nothing ([`write_atomic`]).
+/// The extensions a still SIRDS may be named with ([`StillFormat::of`]), in the order an
+/// error lists them.
+pub const STILL_EXTENSIONS: [&str; 7] = ["png", "ppm", "pnm", "pgm", "jpg", "jpeg", "gif"];
+
+/// The container a still SIRDS is written as, by its name's extension (ASCII case ignored).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StillFormat {
+    /// `.png`: lossless RGBA.
+    Png,
+    /// `.ppm`, `.pnm`, `.pgm`: uncompressed netpbm ([`Netpbm`]).
+    Netpbm(Netpbm),
+    /// `.jpg`, `.jpeg`: baseline JPEG at quality [`JPEG_QUALITY`] (lossy: the dots blur a
+    /// little).
+    Jpeg,
+    /// `.gif`: one frame, quantized to 256 colors as the frames of an animation are (lossless
+    /// for black-and-white and gray patterns).
+    Gif,
+}
+
+/// The JPEG quality a still SIRDS is written at: at the encoder's default of 75 the random
+/// dots smear into their neighbours, which the eyes then fuse less well.
+pub const JPEG_QUALITY: u8 = 95;
+
+impl StillFormat {
+    /// The format `path`'s extension names.
+    ///
+    /// # Errors
+    /// `Invalid` naming `--out`, the extension and the accepted ones ([`STILL_EXTENSIONS`]).
+    pub fn of(path: &Path) -> Result<StillFormat> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        Ok(match ext.as_deref() {
+            Some("png") => StillFormat::Png,
+            Some("jpg" | "jpeg") => StillFormat::Jpeg,
+            Some("gif") => StillFormat::Gif,
+            _ => match Netpbm::of(path) {
+                Some(kind) => StillFormat::Netpbm(kind),
+                None => return Err(unsupported_extension(path, &STILL_EXTENSIONS)),
+            },
+        })
+    }
+}
+
+/// The error for an output name whose extension is not one of `accepted`: names `--out`, the
+/// extension (or its absence) and the accepted extensions.
+pub fn unsupported_extension(path: &Path, accepted: &[&str]) -> Error {
+    let what = match path.extension() {
+        Some(e) => format!("unsupported extension .{}", e.to_string_lossy()),
+        None => "no extension".to_string(),
+    };
+    let list: Vec<String> = accepted.iter().map(|e| format!(".{e}")).collect();
+    Error::invalid(
+        "--out",
+        path.display(),
+        format!(
+            "{what}; use {} (the file is written in the format its name says)",
+            list.join(", ")
+        ),
+    )
+}
+
+/// Writes RGBA pixels in the format `path`'s extension names ([`StillFormat`]): PNG, JPEG, a
+/// one-frame GIF, or uncompressed binary PPM (`.ppm`/`.pnm`) or PGM (`.pgm`, gray SIRDS only,
+/// see [`Netpbm`]); all or nothing ([`write_atomic`]).
 ///
 /// # Errors
-/// The file cannot be written, or its name is a link or a special file; a `.pgm` of a color
-/// SIRDS.
+/// An extension [`StillFormat::of`] refuses (nothing is written); the file cannot be written,
+/// or its name is a link or a special file; a `.pgm` of a color SIRDS.
 pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<()> {
-    if let Some(kind) = Netpbm::of(path) {
-        write_atomic(path, |w| {
+    let format = StillFormat::of(path)?;
+    if let StillFormat::Netpbm(kind) = format {
+        return write_atomic(path, |w| {
             w.write_all(kind.header(width, height).as_bytes())
                 .map_err(|e| Error::io(path, e))?;
             let mut row = Vec::with_capacity(width as usize * 3);
@@ -222,32 +286,46 @@ pub fn save(pixels: &[[u8; 4]], width: u32, height: u32, path: &Path) -> Result<
                 w.write_all(&row).map_err(|e| Error::io(path, e))?;
             }
             Ok(())
-        })
-    } else {
-        let bytes = pixels.iter().flatten().copied().collect();
-        let img = image::RgbaImage::from_raw(width, height, bytes).ok_or_else(|| {
-            Error::internal(
-                "sirds",
-                format!("{} pixels for {width}x{height}", pixels.len()),
-            )
-        })?;
-        write_png(path, &img)
+        });
+    }
+    let bytes = pixels.iter().flatten().copied().collect();
+    let img = image::RgbaImage::from_raw(width, height, bytes).ok_or_else(|| {
+        Error::internal(
+            "sirds",
+            format!("{} pixels for {width}x{height}", pixels.len()),
+        )
+    })?;
+    match format {
+        StillFormat::Jpeg => write_atomic(path, |w| {
+            let rgb = image::DynamicImage::ImageRgba8(img).into_rgb8();
+            rgb.write_with_encoder(image::codecs::jpeg::JpegEncoder::new_with_quality(
+                w,
+                JPEG_QUALITY,
+            ))
+            .map_err(|e| image_error(path, e))
+        }),
+        StillFormat::Gif => write_atomic(path, |w| {
+            let mut gif = image::codecs::gif::GifEncoder::new_with_speed(w, 10);
+            gif.encode_frame(image::Frame::new(img))
+                .map_err(|e| image_error(path, e))
+        }),
+        StillFormat::Png | StillFormat::Netpbm(_) => write_png(path, &img),
     }
 }
 
-/// TIW from a depth-map file straight into a PPM or PGM (`out`'s extension, see [`Netpbm`];
-/// anything else is written as PPM), a chunk of rows at a time: the depth map is never held as
+/// TIW from a depth-map file straight into a PPM or PGM (`out`'s extension, see [`Netpbm`]), a chunk of rows at a time: the depth map is never held as
 /// floats, nor the image as RGBA (a 4096×3072 map would need 100 MB for both).
 ///
 /// # Errors
-/// The depth map cannot be read or is too large, or the file cannot be written; a `.pgm` of
-/// a color SIRDS.
+/// `out` is not named `.ppm`, `.pnm` or `.pgm` (refused before the map is read); the depth map
+/// cannot be read or is too large, or the file cannot be written; a `.pgm` of a color SIRDS.
 pub fn stream_depth_map(
     depth: &Path,
     near: Near,
     settings: &SirdsSettings,
     out: &Path,
 ) -> Result<(u32, u32, DepthMapping)> {
+    let kind = Netpbm::of(out).ok_or_else(|| unsupported_extension(out, &["ppm", "pnm", "pgm"]))?;
     // A binary PGM is read as it is used; anything else whole first.
     let mut source = match PgmRows::open(depth, near)? {
         Some(rows) => Ok(rows),
@@ -275,7 +353,6 @@ pub fn stream_depth_map(
     // The rows stream into a temporary file: a failure in TIW or in the writing leaves `out`
     // as it was.
     write_atomic(out, |writer| {
-        let kind = Netpbm::of(out).unwrap_or(Netpbm::Ppm);
         writer
             .write_all(kind.header(width, height).as_bytes())
             .map_err(|e| Error::io(out, e))?;
