@@ -4,6 +4,7 @@
 
 #![warn(missing_docs)]
 
+use std::borrow::Cow;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -120,35 +121,73 @@ impl Error {
     }
 }
 
+/// `text` with every control character escaped as Rust writes it (`\u{1b}` for ESC, `\u{7}`
+/// for BEL) except line breaks and tabs, so that nothing an input held (a file name, a field,
+/// a value) reaches a terminal as a control sequence. C1 controls (U+0080–U+009F) are escaped
+/// too: some terminals read U+009B as the start of a sequence.
+pub fn printable(text: &str) -> Cow<'_, str> {
+    if !text.chars().any(is_escaped) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if is_escaped(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    Cow::Owned(out)
+}
+
+fn is_escaped(c: char) -> bool {
+    c.is_control() && c != '\n' && c != '\t'
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let p = printable;
         match self {
-            Error::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            Error::Io { path, source } => write!(
+                f,
+                "{}: {}",
+                p(&path.display().to_string()),
+                p(&source.to_string())
+            ),
             Error::Parse {
                 path,
                 line: Some(line),
                 message,
             } => {
-                write!(f, "{}:{line}: {message}", path.display())
+                write!(
+                    f,
+                    "{}:{line}: {}",
+                    p(&path.display().to_string()),
+                    p(message)
+                )
             }
             Error::Parse {
                 path,
                 line: None,
                 message,
-            } => write!(f, "{}: {message}", path.display()),
+            } => write!(f, "{}: {}", p(&path.display().to_string()), p(message)),
             Error::Invalid {
                 field,
                 value,
                 reason,
-            } => write!(f, "{field} = {value}: {reason}"),
+            } => write!(f, "{} = {}: {}", p(field), p(value), p(reason)),
             Error::Gpu { context, message } => write!(
                 f,
-                "gpu {context}: {message} (the CPU renderer, --backend cpu, needs no GPU)"
+                "gpu {}: {} (the CPU renderer, --backend cpu, needs no GPU)",
+                p(context),
+                p(message)
             ),
             Error::Internal { context, message } => write!(
                 f,
-                "internal error in {context}: {message}; this is a bug in stereolab, not in \
-                 your input: please report it with the command and scene that triggered it"
+                "internal error in {}: {}; this is a bug in stereolab, not in \
+                 your input: please report it with the command and scene that triggered it",
+                p(context),
+                p(message)
             ),
         }
     }
@@ -184,6 +223,27 @@ mod tests {
             i.contains("bug in stereolab") && i.contains("report"),
             "{i}"
         );
+    }
+
+    #[test]
+    fn control_characters_never_reach_the_terminal_raw() {
+        let e = Error::invalid(
+            "outputs\u{1b}[2J",
+            "\"a\u{7}\u{9b}b\"",
+            "unknown\u{0} output",
+        );
+        let shown = e.to_string();
+        assert_eq!(
+            shown,
+            "outputs\\u{1b}[2J = \"a\\u{7}\\u{9b}b\": unknown\\u{0} output"
+        );
+        let e = Error::parse(
+            Path::new("a\u{1b}.toml"),
+            Some(2),
+            "line one\nline two\tend",
+        );
+        assert_eq!(e.to_string(), "a\\u{1b}.toml:2: line one\nline two\tend");
+        assert!(!shown.chars().any(|c| c.is_control()), "{shown}");
     }
 
     #[test]

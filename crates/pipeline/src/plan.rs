@@ -293,7 +293,7 @@ impl Output {
                 let known: Vec<&str> = Output::ALL.iter().map(|o| o.name()).collect();
                 Error::invalid(
                     "outputs",
-                    format!("\"{name}\""),
+                    format!("\"{}\"", stereolab_core::excerpt(name)),
                     format!("unknown output; known: {}", known.join(", ")),
                 )
             })
