@@ -221,6 +221,18 @@ mod tests {
         d
     }
 
+    #[test]
+    fn utf16_is_told_from_utf8_by_its_nul_bytes() {
+        let text = "outputs = [\"left\"]\n";
+        let le: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+        let be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+        assert!(looks_like_utf16(&le) && looks_like_utf16(&be));
+        assert!(!looks_like_utf16(text.as_bytes()));
+        // All NULs, or too short to tell, is not text of either kind.
+        assert!(!looks_like_utf16(&[0; 64]));
+        assert!(!looks_like_utf16(b"a\0"));
+    }
+
     fn leftovers(d: &Path) -> Vec<String> {
         std::fs::read_dir(d)
             .expect("read dir")
@@ -354,17 +366,44 @@ pub fn excerpt(text: &str) -> String {
 /// [`read_input`] of a UTF-8 text file, without its byte-order mark ([`without_bom`]).
 ///
 /// # Errors
-/// As [`read_input`], and `Parse` naming the first byte that is not UTF-8.
+/// As [`read_input`], and `Parse` naming the first byte that is not UTF-8 (or
+/// [`UTF16_WITHOUT_BOM`] when the bytes look like UTF-16).
 pub fn read_text(path: &Path, max_bytes: u64) -> Result<String> {
     let bytes = read_input(path, max_bytes)?;
     let text = String::from_utf8(bytes).map_err(|e| {
-        Error::parse(
-            path,
-            None,
-            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-        )
+        let message = if looks_like_utf16(e.as_bytes()) {
+            UTF16_WITHOUT_BOM.to_string()
+        } else {
+            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())
+        };
+        Error::parse(path, None, message)
     })?;
     Ok(without_bom(text))
+}
+
+/// What a text reader says of a file that [`looks_like_utf16`]: the encoding and the remedy.
+pub const UTF16_WITHOUT_BOM: &str =
+    "UTF-16 without a byte-order mark (NUL bytes every other byte); save the file as UTF-8";
+
+/// Whether `bytes` look like UTF-16 text without a byte-order mark: in their first 512 bytes
+/// (at least 4), every byte at one parity (odd for little-endian, even for big-endian) is NUL
+/// and at most a quarter of the bytes at the other are, the pattern ASCII text has in UTF-16.
+pub fn looks_like_utf16(bytes: &[u8]) -> bool {
+    let head = &bytes[..bytes.len().min(512)];
+    if head.len() < 4 {
+        return false;
+    }
+    let nuls_at = |parity: usize| {
+        let (mut nul, mut all) = (0usize, 0usize);
+        for b in head.iter().skip(parity).step_by(2) {
+            all += 1;
+            nul += usize::from(*b == 0);
+        }
+        (nul, all)
+    };
+    let (even, evens) = nuls_at(0);
+    let (odd, odds) = nuls_at(1);
+    (odd == odds && even * 4 <= evens) || (even == evens && odd * 4 <= odds)
 }
 
 /// `text` without a leading byte-order mark (U+FEFF), which Windows editors write at the start
