@@ -874,3 +874,230 @@ fn decoding_an_image_that_is_no_autostereogram_is_refused_and_writes_nothing() {
         }
     }
 }
+
+/// A small scene with `extra` lines appended (after `[camera]`, so bare keys land there unless
+/// `extra` opens a table), written to `dir/name`.
+fn small_scene(dir: &Path, name: &str, outputs: &str, extra: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(
+        &p,
+        format!(
+            "outputs = {outputs}\n[image]\nwidth = 32\nheight = 24\n[camera]\neye = [0, 0, 5]\n\
+             target = [0, 0, 0]\nnear = 1\nfar = 10\n{extra}"
+        ),
+    )
+    .expect("write scene");
+    s(&p)
+}
+
+/// What no message may say: serde's and Rust's own words.
+const RUST_WORDS: [&str; 8] = [
+    "untagged",
+    "SeparationSpec",
+    "struct",
+    "Camera",
+    "wanted",
+    "f32",
+    "u32",
+    "invalid type",
+];
+
+fn refused_with(args: &[&str], says: &[&str]) {
+    let out = stereolab(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    for s in says {
+        assert!(err.contains(s), "{args:?}: wanted {s:?} in {err}");
+    }
+    for w in RUST_WORDS {
+        assert!(!err.contains(w), "{args:?}: {w:?} in {err}");
+    }
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
+
+#[test]
+fn scene_type_errors_name_the_field_the_value_and_what_is_accepted() {
+    let dir = out_dir("reliability-field-errors");
+    let left = "[\"left\"]";
+    let cases: [(&str, &str, &[&str]); 7] = [
+        (
+            left,
+            "[stereo]\neye_separation = true\n",
+            &[
+                "stereo.eye_separation = true",
+                "a number (world units) or \"auto\"",
+            ],
+        ),
+        (
+            left,
+            "[stereo]\nzero_parallax = [1]\n",
+            &["stereo.zero_parallax = [1]", "\"auto\"", "\"fit\""],
+        ),
+        (
+            left,
+            "[stereo]\nmode = 3\n",
+            &["stereo.mode = 3", "one of \"off-axis\"", "\"toe-in\""],
+        ),
+        (
+            left,
+            "[[mesh]]\nkind = \"sphere\"\n[[mesh]]\nkind = \"cube\"\ncolor = \"red\"\n",
+            &["mesh[1].color = \"red\"", "a list of 3 numbers"],
+        ),
+        (
+            left,
+            "fov_y = \"wide\"\n",
+            &["camera.fov_y = \"wide\"", "must be a number"],
+        ),
+        (
+            left,
+            "fovy = 40\n",
+            &["camera.fovy", "no such field in [camera]", "fov_y"],
+        ),
+        (
+            "\"left\"",
+            "",
+            &["outputs = \"left\"", "a list of output names"],
+        ),
+    ];
+    for (i, (outputs, extra, says)) in cases.iter().enumerate() {
+        let scene = small_scene(&dir, &format!("s{i}.toml"), outputs, extra);
+        refused_with(&["info", &scene], says);
+    }
+    // A table given as a number.
+    let p = dir.join("camera.toml");
+    std::fs::write(
+        &p,
+        "outputs = [\"left\"]\ncamera = 5\n[image]\nwidth = 32\nheight = 24\n",
+    )
+    .unwrap();
+    refused_with(&["info", &s(&p)], &["camera = 5", "must be a table"]);
+    // A long value is quoted in part.
+    let long = format!("fov_y = \"{}\"\n", "w".repeat(200));
+    let scene = small_scene(&dir, "long.toml", left, &long);
+    let out = stereolab(&["info", &scene]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(&format!("\"{}…\"", "w".repeat(40))), "{err}");
+    assert!(!err.contains(&"w".repeat(41)), "{err}");
+}
+
+#[test]
+fn set_errors_name_the_key_the_value_and_what_is_accepted() {
+    let wuson = s(&asset("scenes/wuson.toml"));
+    let cases: [(&str, &[&str]); 7] = [
+        (
+            "camera.fov_y=abc",
+            &["--set camera.fov_y = abc: must be a number"],
+        ),
+        (
+            "image.width=64.5",
+            &["--set image.width = 64.5: must be a whole number"],
+        ),
+        (
+            "camera.near=",
+            &["--set camera.near = \"\": the value is empty; it must be a number"],
+        ),
+        (
+            "mesh.0.color=[1,0,0",
+            &[
+                "--set mesh.0.color = [1,0,0: not a complete TOML value",
+                "[1, 0, 0]",
+            ],
+        ),
+        (
+            "nosuch.table=1",
+            &[
+                "--set nosuch.table = 1: nosuch: no such table or field",
+                "camera",
+            ],
+        ),
+        (
+            "mesh.3.color=[1,0,0]",
+            &["--set mesh.3.color", "mesh has 1 entry (index 0)"],
+        ),
+        (
+            "camera.fov_y.x=1",
+            &["--set camera.fov_y.x = 1", "fov_y is a value, not a table"],
+        ),
+    ];
+    for (set, says) in cases {
+        refused_with(&["info", &wuson, "--set", set], says);
+    }
+}
+
+#[test]
+fn control_characters_from_a_scene_never_reach_the_terminal() {
+    let dir = out_dir("reliability-control");
+    let evil = "\\u001b]0;owned\\u0007\\u001b[2J\\u0001";
+    let cases = [
+        small_scene(&dir, "output.toml", &format!("[\"{evil}\"]"), ""),
+        small_scene(
+            &dir,
+            "kind.toml",
+            "[\"left\"]",
+            &format!("[[mesh]]\nkind = \"{evil}\"\n"),
+        ),
+        small_scene(
+            &dir,
+            "separation.toml",
+            "[\"left\"]",
+            &format!("[stereo]\neye_separation = \"{evil}\"\n"),
+        ),
+        small_scene(
+            &dir,
+            "field.toml",
+            "[\"left\"]",
+            &format!("\"{evil}\" = 1\n"),
+        ),
+    ];
+    for scene in cases {
+        let out = stereolab(&["info", &scene]);
+        assert_eq!(out.status.code(), Some(1), "{scene}");
+        let raw = &out.stderr;
+        for byte in [0x1b, 0x07, 0x01] {
+            assert!(
+                !raw.contains(&byte),
+                "{scene}: raw byte {byte:#x} in {}",
+                String::from_utf8_lossy(raw).escape_debug()
+            );
+        }
+        let err = String::from_utf8_lossy(raw);
+        assert!(err.contains("\\u{1b}]0;owned\\u{7}"), "{scene}: {err}");
+    }
+}
+
+#[test]
+fn a_utf16_scene_without_a_byte_order_mark_is_named() {
+    let dir = out_dir("reliability-utf16");
+    let text = "outputs = [\"left\"]\n[image]\nwidth = 32\nheight = 24\n";
+    for (name, bytes) in [
+        (
+            "le.toml",
+            text.encode_utf16()
+                .flat_map(u16::to_le_bytes)
+                .collect::<Vec<u8>>(),
+        ),
+        (
+            "be.toml",
+            text.encode_utf16().flat_map(u16::to_be_bytes).collect(),
+        ),
+        (
+            "le-accent.toml",
+            "# é\n"
+                .encode_utf16()
+                .chain(text.encode_utf16())
+                .flat_map(u16::to_le_bytes)
+                .collect(),
+        ),
+    ] {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        let out = stereolab(&["info", &s(&p)]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{name}: {err}");
+        assert!(
+            err.contains("UTF-16 without a byte-order mark"),
+            "{name}: {err}"
+        );
+        assert!(!err.contains("key with no value"), "{name}: {err}");
+    }
+}

@@ -4,6 +4,7 @@ mod checks;
 pub mod dem;
 mod file;
 mod mesh;
+mod messages;
 mod obj;
 pub mod pdb;
 mod polygon;
@@ -167,13 +168,10 @@ impl Scene {
         let mut table: toml::Table =
             toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
         apply_sets(&mut table, sets)?;
-        let file: SceneFile = table.try_into().map_err(|e: toml::de::Error| {
-            // After --set the spans refer to nothing; re-parse the text for a line number when we can.
-            match toml::from_str::<SceneFile>(text) {
-                Err(orig) if sets.is_empty() => toml_error(path, text, &orig),
-                _ => Error::parse(path, None, e.message().to_string()),
-            }
-        })?;
+        let file: SceneFile = table
+            .clone()
+            .try_into()
+            .map_err(|e: toml::de::Error| field_error(path, text, &table, sets, &e))?;
         Scene::from_file(file, root, max_triangles).map_err(|e| e.in_file(path))
     }
 
@@ -191,7 +189,7 @@ impl Scene {
             Some(file::SeparationSpec::Word(w)) => {
                 return Err(Error::invalid(
                     "stereo.eye_separation",
-                    format!("\"{w}\""),
+                    format!("\"{}\"", stereolab_core::excerpt(w)),
                     "must be a number or \"auto\"",
                 ));
             }
@@ -217,7 +215,7 @@ impl Scene {
             (Some(file::SeparationSpec::Word(w)), None) => {
                 return Err(Error::invalid(
                     "stereo.zero_parallax",
-                    format!("\"{w}\""),
+                    format!("\"{}\"", stereolab_core::excerpt(w)),
                     "must be a distance, \"auto\" (the camera target's distance) or \"fit\" \
                      (centre the scene's depth range in the parallax budget)",
                 ));
@@ -543,7 +541,7 @@ fn load_object(
         other => {
             return Err(Error::invalid(
                 field("kind"),
-                format!("\"{other}\""),
+                format!("\"{}\"", stereolab_core::excerpt(other)),
                 "known kinds: obj, sphere, cube, torus, plane, triangles, terrain, dem, pdb",
             ));
         }
@@ -621,12 +619,67 @@ pub fn model_matrix(translate: [f32; 3], rotate_degrees: [f32; 3], scale: f32) -
     )
 }
 
-/// A TOML error with the line it points at.
+/// A TOML error with the line it points at (or, for text that is UTF-16 without a byte-order
+/// mark, which TOML reads as keys with no value, that encoding).
 fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
-    let line = e
-        .span()
-        .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-    Error::parse(path, line, e.message().to_string())
+    if stereolab_core::looks_like_utf16(text.as_bytes()) {
+        return Error::parse(path, None, stereolab_core::UTF16_WITHOUT_BOM);
+    }
+    Error::parse(path, line_of(text, e), e.message().to_string())
+}
+
+/// The 1-based line `e`'s span starts on.
+fn line_of(text: &str, e: &toml::de::Error) -> Option<usize> {
+    e.span().map(|s| {
+        text.get(..s.start.min(text.len()))
+            .map_or(0, |t| t.matches('\n').count())
+            + 1
+    })
+}
+
+/// serde's error for the scene's table as a message naming the field, the value as written and
+/// what it accepts ([`messages::describe`]); a field a `--set` wrote is named by that `--set`.
+fn field_error(
+    path: &Path,
+    text: &str,
+    table: &toml::Table,
+    sets: &[String],
+    e: &toml::de::Error,
+) -> Error {
+    let d = messages::describe(table, e);
+    let from_set = sets.iter().rev().find_map(|set| {
+        let (key, raw) = set.split_once('=')?;
+        let parts: Vec<&str> = key.trim().split('.').collect();
+        let n = parts.len().min(d.path.len());
+        (parts[..n]
+            .iter()
+            .zip(&d.path[..n])
+            .all(|(a, b)| *a == b.as_str()))
+        .then_some((key.trim(), raw))
+    });
+    if let Some((key, raw)) = from_set {
+        let reason = match (d.field() == key, raw.trim().is_empty()) {
+            (true, true) => format!("the value is empty; it {}", d.reason),
+            (true, false) => d.reason.clone(),
+            (false, _) => format!("{}: {}", d.field(), d.reason),
+        };
+        return Error::invalid(format!("--set {key}"), set_value(raw), reason);
+    }
+    // The table has no spans; the text's own error points at the line when no --set moved it.
+    let line = match toml::from_str::<SceneFile>(text) {
+        Err(orig) if sets.is_empty() => line_of(text, &orig),
+        _ => None,
+    };
+    Error::parse(path, line, d.message())
+}
+
+/// A `--set` value as a message quotes it: escaped, cut to an excerpt, `""` when empty.
+fn set_value(raw: &str) -> String {
+    if raw.trim().is_empty() {
+        "\"\"".to_string()
+    } else {
+        stereolab_core::excerpt(raw)
+    }
 }
 
 /// Applies `--set key=value` overrides to a scene file's table, in order (what
@@ -641,15 +694,34 @@ pub fn apply_sets(table: &mut toml::Table, sets: &[String]) -> Result<()> {
 /// Applies one `key.path=value` override; the value is read as TOML (`0.3`, `"auto"`, `[1,2,3]`)
 /// or, failing that, as a bare string. Numeric segments index arrays (`mesh.0.color`).
 fn apply_set(table: &mut toml::Table, set: &str) -> Result<()> {
-    let (key, raw) = set
-        .split_once('=')
-        .ok_or_else(|| Error::invalid("--set", set, "expected key=value"))?;
-    let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
-        .ok()
-        .and_then(|mut t| t.remove("v"))
-        .unwrap_or_else(|| toml::Value::String(raw.to_string()));
-    let parts: Vec<&str> = key.trim().split('.').collect();
-    set_path(table, &parts, value).map_err(|reason| Error::invalid("--set", set, reason))
+    let (key, raw) = set.split_once('=').ok_or_else(|| {
+        Error::invalid(
+            "--set",
+            stereolab_core::excerpt(set),
+            "expected key=value, e.g. camera.fov_y=40",
+        )
+    })?;
+    let key = key.trim();
+    let field = format!("--set {}", stereolab_core::excerpt(key));
+    let value = match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
+        Ok(mut t) => t.remove("v"),
+        // A value that opens a list, a table or a quoted string must be TOML, not a bare word.
+        Err(e) if raw.trim_start().starts_with(['[', '{', '"', '\'']) => {
+            return Err(Error::invalid(
+                field,
+                set_value(raw),
+                format!(
+                    "not a complete TOML value ({}); write a number, true or false, \"text\" \
+                     or a list such as [1, 0, 0]",
+                    e.message().trim()
+                ),
+            ));
+        }
+        Err(_) => None,
+    }
+    .unwrap_or_else(|| toml::Value::String(raw.to_string()));
+    let parts: Vec<&str> = key.split('.').collect();
+    set_path(table, &parts, value).map_err(|reason| Error::invalid(field, set_value(raw), reason))
 }
 
 /// Walks `parts` down from `cur`, creating tables as needed, and sets the last one.
@@ -659,6 +731,9 @@ fn set_path(
     value: toml::Value,
 ) -> std::result::Result<(), String> {
     let (first, rest) = parts.split_first().ok_or("empty key")?;
+    if first.is_empty() {
+        return Err("a key has an empty part; write e.g. camera.fov_y=40".to_string());
+    }
     if rest.is_empty() {
         cur.insert(first.to_string(), value);
         return Ok(());
@@ -670,15 +745,36 @@ fn set_path(
         toml::Value::Table(t) => set_path(t, rest, value),
         toml::Value::Array(a) => {
             let len = a.len();
-            let idx: usize = rest[0]
-                .parse()
-                .map_err(|_| format!("{first} is a list: give an index, e.g. {first}.0"))?;
+            let idx: usize = rest[0].parse().map_err(|_| {
+                format!(
+                    "{} is a list: give an index, e.g. {}.0",
+                    stereolab_core::excerpt(first),
+                    stereolab_core::excerpt(first)
+                )
+            })?;
             match a.get_mut(idx) {
                 Some(toml::Value::Table(t)) if rest.len() > 1 => set_path(t, &rest[1..], value),
-                Some(_) => Err(format!("{first}.{idx} is not a table with that field")),
-                None => Err(format!("{first} has {len} entries")),
+                Some(_) => Err(format!(
+                    "{}.{idx} is not a table with that field",
+                    stereolab_core::excerpt(first)
+                )),
+                None if len == 0 => {
+                    Err(format!("{} has no entries", stereolab_core::excerpt(first)))
+                }
+                None if len == 1 => Err(format!(
+                    "{} has 1 entry (index 0)",
+                    stereolab_core::excerpt(first)
+                )),
+                None => Err(format!(
+                    "{} has {len} entries (indices 0 to {})",
+                    stereolab_core::excerpt(first),
+                    len - 1
+                )),
             }
         }
-        _ => Err(format!("{first} is not a table")),
+        _ => Err(format!(
+            "{} is a value, not a table: no field can be set inside it",
+            stereolab_core::excerpt(first)
+        )),
     }
 }
