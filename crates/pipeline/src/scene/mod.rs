@@ -738,6 +738,8 @@ fn set_path(
         cur.insert(first.to_string(), value);
         return Ok(());
     }
+    // The key as messages quote it.
+    let name = stereolab_core::excerpt(first);
     match cur
         .entry(first.to_string())
         .or_insert_with(|| toml::Value::Table(toml::Table::new()))
@@ -745,36 +747,22 @@ fn set_path(
         toml::Value::Table(t) => set_path(t, rest, value),
         toml::Value::Array(a) => {
             let len = a.len();
-            let idx: usize = rest[0].parse().map_err(|_| {
-                format!(
-                    "{} is a list: give an index, e.g. {}.0",
-                    stereolab_core::excerpt(first),
-                    stereolab_core::excerpt(first)
-                )
-            })?;
+            let idx: usize = rest[0]
+                .parse()
+                .map_err(|_| format!("{name} is a list: give an index, e.g. {name}.0"))?;
             match a.get_mut(idx) {
                 Some(toml::Value::Table(t)) if rest.len() > 1 => set_path(t, &rest[1..], value),
-                Some(_) => Err(format!(
-                    "{}.{idx} is not a table with that field",
-                    stereolab_core::excerpt(first)
-                )),
-                None if len == 0 => {
-                    Err(format!("{} has no entries", stereolab_core::excerpt(first)))
-                }
-                None if len == 1 => Err(format!(
-                    "{} has 1 entry (index 0)",
-                    stereolab_core::excerpt(first)
-                )),
+                Some(_) => Err(format!("{name}.{idx} is not a table with that field")),
+                None if len == 0 => Err(format!("{name} has no entries")),
+                None if len == 1 => Err(format!("{name} has 1 entry (index 0)")),
                 None => Err(format!(
-                    "{} has {len} entries (indices 0 to {})",
-                    stereolab_core::excerpt(first),
+                    "{name} has {len} entries (indices 0 to {})",
                     len - 1
                 )),
             }
         }
         _ => Err(format!(
-            "{} is a value, not a table: no field can be set inside it",
-            stereolab_core::excerpt(first)
+            "{name} is a value, not a table: no field can be set inside it"
         )),
     }
 }

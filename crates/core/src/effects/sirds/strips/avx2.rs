@@ -4,7 +4,7 @@
 //!
 //! Each lane performs the scalar loop's IEEE operations in the same order (no fused
 //! multiply-add, which would round once instead of twice), so the bytes are the same as the
-//! scalar path's; the unit test `avx2_strips_match_scalar_strips` holds them equal. Lanes past
+//! scalar path's; the pipeline's `avx2_strips_match_scalar_strips` holds them equal on real scenes. Lanes past
 //! the end of a span are masked off, never loaded or stored.
 
 use std::arch::x86_64::*;
@@ -12,13 +12,11 @@ use std::arch::x86_64::*;
 use super::{Region, SpanTarget, Strip};
 use crate::raster::SetupTriangle;
 use crate::raster::avx2::{
-    columns as avx2_columns, covered_vectors as avx2_covered_vectors, depth_at as avx2_depth_at,
-    floor_i32 as avx2_floor_i32, load as avx2_load, opaque as avx2_opaque,
-    plane_at as avx2_plane_at, store as avx2_store, tail_mask as avx2_tail_mask,
+    columns, covered_vectors, depth_at, floor_i32, load, opaque, plane_at, store, tail_mask,
 };
 
 /// [`super::span_sources`] for every pixel of triangle `t` in region `r` of the band starting
-/// at row `y0` (`rows` rows of `width` pixels), eight pixels at a time ([`avx2_covered_vectors`]:
+/// at row `y0` (`rows` rows of `width` pixels), eight pixels at a time ([`covered_vectors`]:
 /// small triangles a vector per row).
 ///
 /// # Safety
@@ -32,7 +30,7 @@ pub(super) unsafe fn triangle_sources(
     sources: &mut [f32],
 ) {
     let w = width as usize;
-    avx2_covered_vectors(t, (r.x0, y0, r.x1 - r.x0, rows), |y, x, mask| {
+    covered_vectors(t, (r.x0, y0, r.x1 - r.x0, rows), |y, x, mask| {
         let i = (y - y0) as usize * w + x as usize;
         // SAFETY: this function runs only where AVX2 is available.
         unsafe { sources_vector(t, y, x, mask, &mut depth[i..], &mut sources[i..], &r.target) };
@@ -59,22 +57,22 @@ unsafe fn sources_vector(
     let full = depth.len().min(sources.len()) >= 8;
     let fy = t.fy(y);
     let half = _mm256_set1_ps(0.5);
-    let (xf, fx) = avx2_columns(t, x);
-    let z = avx2_depth_at(t, xf, y);
+    let (xf, fx) = columns(t, x);
+    let z = depth_at(t, xf, y);
     let (dp, sp) = (depth.as_mut_ptr(), sources.as_mut_ptr());
     // SAFETY: eight lanes fit in both when `full`; otherwise `mask` covers only covered
     // pixels, inside both.
-    let d = avx2_opaque(unsafe { avx2_load(dp, mask, full) });
+    let d = opaque(unsafe { load(dp, mask, full) });
     let nearer = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
     if _mm256_movemask_ps(nearer) == 0 {
         return; // hidden everywhere (the background plane behind the scene)
     }
     let w = if target.perspective_correct {
-        _mm256_div_ps(_mm256_set1_ps(1.0), avx2_plane_at(&t.inv_w_plane(), fx, fy))
+        _mm256_div_ps(_mm256_set1_ps(1.0), plane_at(&t.inv_w_plane(), fx, fy))
     } else {
         _mm256_set1_ps(1.0)
     };
-    let sep = _mm256_mul_ps(avx2_plane_at(&t.varying_plane(0), fx, fy), w);
+    let sep = _mm256_mul_ps(plane_at(&t.varying_plane(0), fx, fy), w);
     let src = _mm256_sub_ps(xf, _mm256_mul_ps(_mm256_set1_ps(target.toward), sep));
     let (lo, hi) = (_mm256_set1_ps(target.lo), _mm256_set1_ps(target.hi));
     let inside = if target.bilinear {
@@ -92,9 +90,9 @@ unsafe fn sources_vector(
     let wins = _mm256_and_ps(nearer, inside);
     // SAFETY: as above.
     unsafe {
-        let s = avx2_opaque(avx2_load(sp, mask, full));
-        avx2_store(dp, mask, full, _mm256_blendv_ps(d, z, wins));
-        avx2_store(sp, mask, full, _mm256_blendv_ps(s, src, wins));
+        let s = opaque(load(sp, mask, full));
+        store(dp, mask, full, _mm256_blendv_ps(d, z, wins));
+        store(sp, mask, full, _mm256_blendv_ps(s, src, wins));
     }
 }
 
@@ -172,7 +170,7 @@ pub(super) unsafe fn resolve_row(
     let byte = _mm256_set1_epi32(0xff);
     let mut k = 0;
     while k < n {
-        let mask = avx2_tail_mask(n - k);
+        let mask = tail_mask(n - k);
         // SAFETY: the mask covers lanes k .. min(k + 8, n), inside `sources` (asserted).
         let p = unsafe { _mm256_maskload_ps(sources.as_ptr().add(x0 + k), mask) };
         let has = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_ORD_Q>(p, p));
@@ -191,7 +189,7 @@ pub(super) unsafe fn resolve_row(
         let (color, i0, i1) = unsafe {
             let base = row.as_ptr() as *const i32;
             if bilinear {
-                let i0 = _mm256_and_si256(avx2_floor_i32(p), has);
+                let i0 = _mm256_and_si256(floor_i32(p), has);
                 let t = _mm256_sub_ps(p, _mm256_cvtepi32_ps(i0));
                 let mixes = _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_setzero_ps());
                 let i1 = _mm256_sub_epi32(i0, _mm256_castps_si256(mixes));
@@ -227,7 +225,7 @@ pub(super) unsafe fn resolve_row(
                 let color = _mm256_blendv_epi8(a, mixed, _mm256_castps_si256(mixes));
                 (color, i0, i1)
             } else {
-                let i = _mm256_and_si256(avx2_floor_i32(_mm256_add_ps(p, half)), has);
+                let i = _mm256_and_si256(floor_i32(_mm256_add_ps(p, half)), has);
                 (_mm256_i32gather_epi32::<4>(base, i), i, i)
             }
         };

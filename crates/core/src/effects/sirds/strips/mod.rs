@@ -33,7 +33,7 @@ pub use geometry::{StripGeometry, StripObject};
 use glam::Vec4;
 use rayon::prelude::*;
 
-use crate::effects::sirds::per_pixel::check_inputs as check_sirds_inputs;
+use crate::effects::sirds::per_pixel::check_inputs;
 use crate::error::{Error, Result};
 use crate::raster::{RasterOptions, SetupTriangle, bin_rows, setup_triangles};
 use crate::shade::{Fragment, Shader, Varyings};
@@ -381,7 +381,7 @@ fn resolve_strip(
 /// [`per_vertex_reference`] and [`reference::k_passes`] start with.
 ///
 /// # Errors
-/// As [`check_sirds_inputs`], [`check_size`](crate::check_size) and [`plan_strips`].
+/// As [`check_inputs`], [`check_size`](crate::check_size) and [`plan_strips`].
 fn checked_strips(
     width: u32,
     height: u32,
@@ -389,7 +389,7 @@ fn checked_strips(
     pattern: &SirdsPattern,
     opts: &PerVertexOptions,
 ) -> Result<Vec<Strip>> {
-    check_sirds_inputs(width, d, pattern)?;
+    check_inputs(width, d, pattern)?;
     crate::check_size(width, height)?;
     plan_strips(width, d, opts)
 }
@@ -403,7 +403,7 @@ fn checked_strips(
 /// result is the paper's k render passes, byte for byte (see the module notes).
 ///
 /// # Errors
-/// As [`check_sirds_inputs`], and k too small for the front separation.
+/// As [`check_inputs`], and k too small for the front separation.
 pub fn per_vertex_reference(
     geometry: &StripGeometry,
     width: u32,

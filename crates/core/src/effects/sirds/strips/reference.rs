@@ -1,7 +1,7 @@
 //! The strip algorithm as the SIRDS paper (Petz et al.) §3–4 states it: k render passes, one
 //! per strip, on stereolab's rasterizer. This is the definition; the fast path
 //! [`per_vertex`](super::per_vertex) (deferred texturing, strips resolved in place, AVX2) is
-//! held to it byte for byte by the tests below.
+//! held to it byte for byte on real scenes by the pipeline's `render/strip_tests.rs`.
 //!
 //! Two images, as the paper's render-to-texture ping-pong (and `gpu::sirds`):
 //!

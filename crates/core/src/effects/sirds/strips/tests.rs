@@ -63,7 +63,7 @@ fn reads_of_unfinished_pixels_see_the_pattern() {
             }
             for simd in [false, true] {
                 if simd && !avx2_available() {
-                    continue; // the scalar loop alone (see `avx2_to_compare`)
+                    continue; // no AVX2 here: the scalar loop alone
                 }
                 let mut row = vec![[0u8; 4]; w];
                 for strip in &strips {
