@@ -55,7 +55,7 @@ pub struct SirdsArgs {
     pub pair: Option<PathBuf>,
 }
 
-/// SirdsSettings from `--set sirds.key=value` alone (no scene file).
+/// Settings from `--set sirds.key=value` alone (no scene file).
 fn settings_from_sets(sets: &[String]) -> Result<SirdsSettings> {
     let mut text = String::new();
     for s in sets {

@@ -538,7 +538,7 @@ fn sirds_knobs(scale: Scale) -> Result<Vec<Knob>> {
         negligible,
     };
     let mut out = Vec::new();
-    // StripStart strip and filter.
+    // Start strip and filter.
     let mut pts = Vec::new();
     for (start, filter) in [
         (StripStart::Left, StripFilter::Nearest),
