@@ -266,9 +266,67 @@ fn ensure_runtime_dir() {
     }
 }
 
+/// Ctrl-C (SIGINT), SIGTERM and SIGHUP end the command cleanly: a thread waits for them,
+/// removes the temporary files of the outputs being written
+/// ([`remove_temporaries`](stereolab_core::remove_temporaries); every output keeps its old
+/// content or stays absent) and exits with 128 + the signal's number, as a shell reports a
+/// process that a signal ended. A file-size limit (`ulimit -f`, SIGXFSZ) makes the write fail
+/// with an error naming the file instead of killing the process without a word.
+#[cfg(unix)]
+fn end_cleanly_on_signals() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    // SAFETY: setting a signal's disposition to "ignore" has no preconditions.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return; // the default dispositions stay: the run ends, its temporaries stay behind
+    };
+    std::thread::spawn(move || {
+        if let Some(sig) = signals.forever().next() {
+            let removed = stereolab_core::remove_temporaries(true);
+            let name = match sig {
+                SIGINT => "SIGINT (Ctrl-C)",
+                SIGTERM => "SIGTERM",
+                _ => "SIGHUP",
+            };
+            let _ = writeln!(
+                std::io::stderr(),
+                "\nstopped by {name}: {removed} unfinished output file(s) removed; no output \
+                 is left half-written"
+            );
+            std::process::exit(128 + sig);
+        }
+    });
+}
+
+/// The most threads a run starts: `RAYON_NUM_THREADS` above it is lowered to it (with a note),
+/// since thousands of threads for a few hundred rows only wait on each other.
+pub const MAX_THREADS: usize = 256;
+
+/// The thread count of the run: `RAYON_NUM_THREADS` when set to a number from 1 to
+/// [`MAX_THREADS`] (above it, the cap, said on stderr), else one a core (rayon's default).
+fn thread_count() -> Option<usize> {
+    let asked = std::env::var("RAYON_NUM_THREADS").ok()?;
+    match asked.trim().parse::<usize>() {
+        Ok(n) if n > MAX_THREADS => {
+            let _ = writeln!(
+                std::io::stderr(),
+                "note: RAYON_NUM_THREADS = {n} is more than the {MAX_THREADS} threads a run \
+                 uses; using {MAX_THREADS}"
+            );
+            Some(MAX_THREADS)
+        }
+        Ok(n) if n > 0 => Some(n),
+        _ => None, // 0 or not a number: rayon's own default, one thread a core
+    }
+}
+
 fn main() -> ExitCode {
     #[cfg(all(feature = "gpu", unix))]
     ensure_runtime_dir();
+    #[cfg(unix)]
+    end_cleanly_on_signals();
     let cli = Cli::parse();
     let _ = LOAD_OPTIONS.set(stereolab::scene::LoadOptions {
         allow_outside_paths: cli.allow_outside_paths,
@@ -278,7 +336,17 @@ fn main() -> ExitCode {
     // starts from the pool instead of waking it from outside: a 512×512 SIRDS frame (the SIRDS
     // paper's Table 1 row 1) made of seven parallel passes took 6–8% less time. The main
     // thread's 8 MB of stack carries over.
-    let pool = rayon::ThreadPoolBuilder::new().stack_size(8 << 20).build();
+    let threads = thread_count();
+    if let Some(n) = threads {
+        // The viewer's frames render in the global pool: the same cap.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .stack_size(8 << 20)
+        .build();
     let result = match pool {
         // A window's event loop belongs on the main thread (winit's rule); the viewer's frames
         // render on its own worker thread, in rayon's global pool.

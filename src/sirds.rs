@@ -85,7 +85,7 @@ fn has_extension(path: &Path, extensions: &[&str]) -> bool {
         .is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
 }
 
-/// The extensions a decoded depth map may be named with ([`write_depth`]).
+/// The extensions a decoded depth map may be named with ([`encode_depth`]).
 const DEPTH_EXTENSIONS: [&str; 7] = ["png", "pgm", "ppm", "pnm", "pam", "jpg", "jpeg"];
 
 /// The output's name (`--out`, or sirds.png / sirds.gif with `--frames`), refused before any
@@ -388,7 +388,7 @@ fn finish_decode(
             }
         })
         .collect();
-    write_depth(
+    let depth = encode_depth(
         &DepthMap {
             width: w,
             height: h,
@@ -396,6 +396,8 @@ fn finish_decode(
         },
         out,
     )?;
+    // The depth map and, with --pair, the views: all written, or none.
+    let mut set = stereolab_core::OutputSet::new();
     let mut report = format!(
         "  {:.1}% of pixels matched a separation in {lo}..={hi} px: an autostereogram\n  wrote {}\n",
         decoded.matched_share * 100.0,
@@ -419,13 +421,14 @@ fn finish_decode(
             dir.join("right.png"),
             dir.join("anaglyph.png"),
         ];
-        for p in &names {
+        for p in names.iter().chain([&out.to_path_buf()]) {
             stereolab_core::check_output_path(p)?;
         }
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        stereolab_core::write_png(&names[0], &left.to_rgba_image())?;
-        stereolab_core::write_png(&names[1], &right.to_rgba_image())?;
-        stereolab_core::write_png(&names[2], &ana)?;
+        set.stage_bytes(out, &depth)?;
+        set.stage_png(&names[0], &left.to_rgba_image())?;
+        set.stage_png(&names[1], &right.to_rgba_image())?;
+        set.stage_png(&names[2], &ana)?;
         report += &format!(
             "  stereo pair ({} viewing, background at zero parallax: {:.1} px)\n",
             if settings.cross_eyed {
@@ -438,14 +441,17 @@ fn finish_decode(
         for p in names {
             report += &format!("  wrote {}\n", p.display());
         }
+    } else {
+        set.stage_bytes(out, &depth)?;
     }
+    set.commit()?;
     Ok(report)
 }
 
-/// Writes a decoded depth map (white = near) as `out`'s extension asks ([`DEPTH_EXTENSIONS`]):
+/// Encodes a decoded depth map (white = near) as `out`'s extension asks ([`DEPTH_EXTENSIONS`]):
 /// PNG (16-bit), a .pgm as netpbm's binary P5 at 16 bits, a .ppm or .pnm as binary P6 (8-bit
 /// gray in RGB), a .pam as PAM (16-bit `GRAYSCALE`), a .jpg or .jpeg as 8-bit gray JPEG.
-fn write_depth(map: &DepthMap, out: &Path) -> Result<()> {
+fn encode_depth(map: &DepthMap, out: &Path) -> Result<Vec<u8>> {
     use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
     let depth = map.to_image();
     let ext = out
@@ -487,5 +493,5 @@ fn write_depth(map: &DepthMap, out: &Path) -> Result<()> {
         }
     };
     encoded.map_err(|e| Error::invalid("--out", out.display(), e.to_string()))?;
-    stereolab_core::write_bytes(out, bytes.get_ref())
+    Ok(bytes.into_inner())
 }

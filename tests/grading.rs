@@ -1145,7 +1145,18 @@ fn functions_under(
 fn the_exported_handout_holds_no_reference_function() {
     use stereolab_grade::similarity::{DEFAULT_THRESHOLD, base_hashes, score};
     let handout = out_dir("handout_no_reference");
+    // An earlier handout in the folder, its README a link planted to a file outside: the new
+    // handout replaces the folder whole and writes through no link.
+    let victim = out_dir("handout_no_reference_victim").join("victim.txt");
+    std::fs::write(&victim, "keep me").unwrap();
+    std::fs::create_dir_all(handout.join("stereolab/data")).unwrap();
+    std::fs::write(handout.join("stereolab/data/ex1.json"), "{}").unwrap();
+    std::fs::write(handout.join("Cargo.toml"), "").unwrap();
+    std::os::unix::fs::symlink(&victim, handout.join("README.md")).unwrap();
     export_handout(&handout, None);
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me");
+    let readme = handout.join("README.md");
+    assert!(std::fs::symlink_metadata(&readme).unwrap().is_file());
     let base: std::collections::BTreeSet<u64> = Exercise::ALL
         .iter()
         .flat_map(|ex| {

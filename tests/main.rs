@@ -27,6 +27,7 @@ mod grading_sandbox;
 mod grading_trust;
 mod hard_cases;
 mod image_shift;
+mod interruptions;
 mod layout;
 mod obj_corpus;
 mod readme;

@@ -130,17 +130,15 @@ pub fn draw_all(ctx: &Context) -> Result<Vec<(String, Vec<u8>)>> {
         .collect()
 }
 
-/// Draws every figure into `dir` (each file written all or nothing); returns the paths.
+/// Draws every figure into `dir`, all of them or none (one [`OutputSet`](stereolab_core::OutputSet)); returns the paths.
 ///
 /// # Errors
 /// A figure fails, or the folder cannot be created or written.
 pub fn write_all(ctx: &Context, dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let mut paths = Vec::new();
+    let mut set = stereolab_core::OutputSet::new();
     for (name, png) in draw_all(ctx)? {
-        let path = dir.join(name);
-        stereolab_core::write_bytes(&path, &png)?;
-        paths.push(path);
+        set.stage_bytes(&dir.join(name), &png)?;
     }
-    Ok(paths)
+    set.commit()
 }

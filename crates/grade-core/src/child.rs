@@ -498,7 +498,7 @@ pub(crate) struct Rlimits {
 /// Sets `l` (and no core dumps) in `cmd`'s process before it starts.
 pub(crate) fn limit_resources(cmd: &mut Command, l: Rlimits) {
     #[cfg(unix)]
-    // SAFETY: between fork and exec only async-signal-safe calls (setrlimit).
+    // SAFETY: between fork and exec only async-signal-safe calls (setrlimit, sigaction).
     unsafe {
         use std::os::unix::process::CommandExt;
         cmd.pre_exec(move || {
@@ -519,6 +519,13 @@ pub(crate) fn limit_resources(cmd: &mut Command, l: Rlimits) {
                 limit(libc::RLIMIT_CPU, c, c + 1)?;
             }
             limit(libc::RLIMIT_FSIZE, l.file_bytes, l.file_bytes)?;
+            // The file-size limit kills the task (SIGXFSZ), whatever its parent does with the
+            // signal (the stereolab command ignores it, to report the error instead).
+            let mut dfl: libc::sigaction = std::mem::zeroed();
+            dfl.sa_sigaction = libc::SIG_DFL;
+            if libc::sigaction(libc::SIGXFSZ, &dfl, std::ptr::null_mut()) < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
             limit(libc::RLIMIT_CORE, 0, 0)?;
             if let Some(n) = l.processes {
                 limit(libc::RLIMIT_NPROC, n, n)?;

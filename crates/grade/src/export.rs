@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use stereolab_core::{Error, Result};
+use stereolab_core::{Error, Result, StagingDir};
 use stereolab_grade_core::build::{HANDOUT_PROFILE, strip_solution};
 use stereolab_grade_core::data::{exercise_data, task_to_data};
 use stereolab_grade_core::{
@@ -138,9 +138,54 @@ fn write_task_data(root: &Path, data: &Path) -> Result<()> {
 /// reference code and no renderer; the docs), `dir/ex*/` (stubs, student tests, the grader's
 /// entry binary; no `solution.rs`, no `solution` feature), `dir/slides/`, `dir/README.md`.
 ///
+/// The handout is made in a new folder beside `dir` and put in its place only when complete
+/// ([`StagingDir`]): a failure (a full disk, the solution not building, Ctrl-C) leaves `dir` as
+/// it was. `dir` may be absent, an empty folder, or a handout this command wrote, which is
+/// replaced; any other folder is refused.
+///
 /// # Errors
-/// Unreadable sources, the instructor's solution not building, or an unwritable `dir`.
+/// Unreadable sources, the instructor's solution not building, `dir` holding something else,
+/// or an unwritable `dir`.
 pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
+    if let Some(docs) = documents {
+        if !docs.is_dir() {
+            return Err(Error::invalid(
+                "--documents",
+                docs.display(),
+                "not a folder: name the folder holding the course's copies of the documents \
+                 listed in docs/sources.md",
+            ));
+        }
+    }
+    if !replaceable(dir) {
+        return Err(Error::invalid(
+            "DIR",
+            dir.display(),
+            "is a folder with other files in it, not a handout this command wrote: name a new \
+             or empty folder",
+        ));
+    }
+    let staging = StagingDir::new(dir)?;
+    write_handout(root, staging.path(), documents)?;
+    staging.commit()
+}
+
+/// Whether the handout may be written at `dir`: it does not exist, or is an empty folder, or
+/// holds a handout (its grader's task data, manifest and README).
+fn replaceable(dir: &Path) -> bool {
+    match std::fs::read_dir(dir) {
+        Err(_) => true, // absent (or not a folder: StagingDir::new says what it is)
+        Ok(mut entries) => {
+            entries.next().is_none()
+                || ["Cargo.toml", "README.md", "stereolab/data/ex1.json"]
+                    .iter()
+                    .all(|f| dir.join(f).is_file())
+        }
+    }
+}
+
+/// Writes the handout's files into the new folder `dir`.
+fn write_handout(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     let manifest_path = root.join("Cargo.toml");
     let manifest = std::fs::read_to_string(&manifest_path).map_err(io(&manifest_path))?;
     let lib = dir.join("stereolab");
@@ -237,14 +282,6 @@ pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
     // The course's own copies of the source documents (not redistributable, so not in the
     // repository): copied in when the instructor names the folder that holds them.
     if let Some(docs) = documents {
-        if !docs.is_dir() {
-            return Err(Error::invalid(
-                "--documents",
-                docs.display(),
-                "not a folder: name the folder holding the course's copies of the documents \
-                 listed in docs/sources.md",
-            ));
-        }
         copy_tree(docs, &dir.join("documents"), &|_| false)?;
     }
     Ok(())

@@ -17,8 +17,7 @@ use stereo_photo::{PhotoFormat, RigMetadata, StereoPhoto};
 use stereolab_core::{
     AnaglyphKind, Error, Framebuffer, Precision, Result, above_below, above_below_squashed,
     anaglyph, calibration_screen, check_output_path, ghosted, interleave, occlusion_image,
-    parallax_image, rds_framebuffer, rds_left, rds_right, remap_color, side_by_side, write_bytes,
-    write_png,
+    parallax_image, rds_framebuffer, rds_left, rds_right, remap_color, side_by_side, OutputSet,
 };
 
 /// One finished output image.
@@ -40,11 +39,22 @@ impl Image {
     /// # Errors
     /// The file cannot be written, or its name is a link or a special file.
     pub fn save_png(&self, path: &Path) -> Result<()> {
+        let mut set = OutputSet::new();
+        self.stage(&mut set, path)?;
+        set.commit().map(drop)
+    }
+
+    /// Writes the image as [`save_png`](Image::save_png) does into `set`, to be renamed onto
+    /// `path` with the set's other files.
+    ///
+    /// # Errors
+    /// As [`OutputSet::stage`].
+    pub fn stage(&self, set: &mut OutputSet, path: &Path) -> Result<()> {
         match self {
-            Image::Rgba(i) => write_png(path, i),
-            Image::Gray16(i) => write_png(path, i),
-            Image::Stereo(photo) => write_bytes(path, &photo.encode()?),
-            Image::Sequence(seq) => write_bytes(path, &seq.encode()?),
+            Image::Rgba(i) => set.stage_png(path, i),
+            Image::Gray16(i) => set.stage_png(path, i),
+            Image::Stereo(photo) => set.stage_bytes(path, &photo.encode()?),
+            Image::Sequence(seq) => set.stage_bytes(path, &seq.encode()?),
         }
     }
 
@@ -264,8 +274,9 @@ pub fn write_all_with(
     dir: &Path,
     mut make: impl FnMut(Output) -> Result<Image>,
 ) -> Result<Vec<PathBuf>> {
-    // Every output is made (and every final name checked) before any is written: an output
-    // that fails leaves the folder as it was.
+    // Every output is made (and every final name checked) before any is written, and all are
+    // written before any is renamed onto its name: an output that fails, a full disk or a
+    // signal leaves the folder as it was.
     let outputs = frame
         .plan
         .outputs
@@ -277,11 +288,9 @@ pub fn write_all_with(
         })
         .collect::<Result<Vec<_>>>()?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    outputs
-        .into_iter()
-        .map(|(path, image)| {
-            image.save_png(&path)?;
-            Ok(path)
-        })
-        .collect()
+    let mut set = OutputSet::new();
+    for (path, image) in &outputs {
+        image.stage(&mut set, path)?;
+    }
+    set.commit()
 }
