@@ -48,6 +48,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
         quick,
         slides,
     } = args;
+    if let Some(path) = &csv {
+        crate::require_extension("--csv", path, &["csv"])?;
+    }
     let mut opts = bench::BenchOptions {
         iterations,
         only,

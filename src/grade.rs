@@ -109,11 +109,13 @@ pub struct BundleArgs {
     pub root: Option<PathBuf>,
 }
 
-/// Runs `stereolab grade`.
+/// Runs `stereolab grade`; returns whether the command succeeded in its own terms: a grading
+/// run whose verdict is NOT PASSED returns `false` (exit code
+/// [`EXIT_NOT_PASSED`](stereolab_grade_core::EXIT_NOT_PASSED)).
 ///
 /// # Errors
 /// Whatever the work fails with; the message names the input.
-pub fn run(args: GradeArgs) -> Result<()> {
+pub fn run(args: GradeArgs) -> Result<bool> {
     let started = std::time::Instant::now();
     let GradeArgs {
         command,
@@ -128,16 +130,19 @@ pub fn run(args: GradeArgs) -> Result<()> {
         build_timeout,
     } = args;
     match command {
-        Some(GradeCommand::Batch(b)) => return batch(b),
-        Some(GradeCommand::Bundle(b)) => return bundle(b),
+        Some(GradeCommand::Batch(b)) => return batch(b).map(|()| true),
+        Some(GradeCommand::Bundle(b)) => return bundle(b).map(|()| true),
         Some(GradeCommand::Points) => {
             out!(
                 "{}",
                 grade::points::points_text(&grade::points::points_table()?)
             );
-            return Ok(());
+            return Ok(true);
         }
         None => {}
+    }
+    if let Some(path) = &json {
+        crate::require_extension("--json", path, &["json"])?;
     }
     let exercise = exercise.ok_or_else(|| {
         Error::invalid(
@@ -181,7 +186,7 @@ pub fn run(args: GradeArgs) -> Result<()> {
             ));
         }
     }
-    Ok(())
+    Ok(report.passed())
 }
 
 fn parse_memory(mib: u64) -> Result<u64> {
@@ -278,6 +283,7 @@ fn batch(args: BatchArgs) -> Result<()> {
 }
 
 fn bundle(args: BundleArgs) -> Result<()> {
+    crate::require_extension("--out", &args.out, &["zip"])?;
     let root = args.root.unwrap_or_else(|| {
         if std::path::Path::new("exercises/ex1_stereo").is_dir() {
             PathBuf::from(".")

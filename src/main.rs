@@ -222,17 +222,34 @@ fn write_stdout(args: std::fmt::Arguments) -> Result<()> {
         .map_err(|e| Error::io(Path::new("standard output"), e))
 }
 
+/// Refuses a file name given to `flag` unless its extension (ASCII case ignored) is one of
+/// `accepted`: a file is written in the format its name says, or not at all.
+///
+/// # Errors
+/// `Invalid` naming the flag, the extension and the accepted ones.
+fn require_extension(flag: &str, path: &Path, accepted: &[&str]) -> Result<()> {
+    let ext = path.extension().and_then(|e| e.to_str());
+    if ext.is_some_and(|e| accepted.iter().any(|a| e.eq_ignore_ascii_case(a))) {
+        return Ok(());
+    }
+    Err(stereolab::output::sirds::unsupported_extension_of(
+        flag, path, accepted,
+    ))
+}
+
 /// Whether `e` is a write to standard output whose reader went away (`stereolab info … | head`):
 /// the normal end of a pipeline, not a failure.
 fn is_closed_pipe(e: &Error) -> bool {
     matches!(e, Error::Io { source, .. } if source.kind() == std::io::ErrorKind::BrokenPipe)
 }
 
-fn run(cli: Cli) -> Result<()> {
-    match cli.command {
+/// Runs the command; `Ok(false)` is a run that worked and says no (a grading verdict of NOT
+/// PASSED).
+fn run(cli: Cli) -> Result<bool> {
+    let done = match cli.command {
+        Command::Grade(args) => return grade::run(args),
         Command::Render(args) => render::run(args),
         Command::Compare(args) => compare::run(args),
-        Command::Grade(args) => grade::run(args),
         Command::Exercises { command } => exercises::run(command),
         Command::Info(args) => info::run(args),
         Command::Figures(args) => figures::run(args),
@@ -240,7 +257,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Sirds(args) => sirds::run(&args),
         #[cfg(feature = "viewer")]
         Command::View(args) => view::run(args),
-    }
+    };
+    done.map(|()| true)
 }
 
 /// Mesa's Vulkan driver complains twice on stderr ("XDG_RUNTIME_DIR is invalid or not set")
@@ -356,7 +374,8 @@ fn main() -> ExitCode {
         Err(_) => run(cli),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(stereolab_grade::EXIT_NOT_PASSED),
         Err(e) if is_closed_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             // Standard error may be gone too; nothing more can be said then.

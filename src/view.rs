@@ -40,6 +40,9 @@ pub struct ViewArgs {
 /// # Errors
 /// The scene does not load, there is no display, or a frame fails.
 pub fn run(args: ViewArgs) -> Result<()> {
+    if let Some(path) = &args.state_file {
+        crate::require_extension("--state-file", path, &["json"])?;
+    }
     let mut scene = load_scene(&args.scene, &args.sets, args.size.as_deref())?;
     if let Some(name) = &args.output {
         let o = Output::parse(name).map_err(|e| match e {

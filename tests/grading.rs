@@ -37,6 +37,29 @@ pub(crate) fn grade(
     grade_seeded(what, extra, exercises, mutant, None, name)
 }
 
+/// A grading run ended cleanly, with the exit code its verdict gives: 0 for PASSED,
+/// [`EXIT_NOT_PASSED`](stereolab_grade::EXIT_NOT_PASSED) for NOT PASSED.
+pub(crate) fn assert_verdict_exit(out: &Output, what: &str) {
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let not_passed = stdout.contains("NOT PASSED:");
+    assert!(
+        not_passed || stdout.contains("PASSED:"),
+        "{what}: no verdict; stdout:\n{stdout}\nstderr:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let expected = if not_passed {
+        i32::from(stereolab_grade::EXIT_NOT_PASSED)
+    } else {
+        0
+    };
+    assert_eq!(
+        out.status.code(),
+        Some(expected),
+        "{what}: the exit code must follow the verdict; stdout:\n{stdout}\nstderr:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// [`grade`] with the instructor's seed for hidden cases (`STEREOLAB_GRADER_SEED`) when given.
 pub(crate) fn grade_seeded(
     what: &str,
@@ -66,12 +89,7 @@ pub(crate) fn grade_seeded(
         cmd.env("STEREOLAB_GRADER_SEED", s);
     }
     let out = cmd.output().expect("run stereolab grade");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "grade {what} {extra:?} (mutant {mutant:?}) must exit cleanly; stdout:\n{stdout}\nstderr:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_verdict_exit(&out, &format!("grade {what} {extra:?} (mutant {mutant:?})"));
     let text = std::fs::read_to_string(&json).expect("results.json written");
     (
         out,
@@ -838,12 +856,7 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
             .env("CARGO_TARGET_DIR", target_dir().join("handout-grader"))
             .output()
             .expect("run the handout's grader");
-        assert!(
-            out.status.success(),
-            "{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_verdict_exit(&out, "the handout's grader");
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap()
     };
     let solution =

@@ -194,7 +194,10 @@ fn figures_are_written_all_or_none() {
         .expect("figures");
     let err = stderr(&out);
     assert!(!out.status.success());
-    assert!(err.contains(last.as_str()) && err.contains("a folder"), "{err}");
+    assert!(
+        err.contains(last.as_str()) && err.contains("a folder"),
+        "{err}"
+    );
     for n in written.iter().filter(|n| *n != last) {
         assert_eq!(std::fs::read(dir.join(n)).expect("kept"), b"old", "{n}");
     }
@@ -227,8 +230,14 @@ fn a_decoded_pair_that_cannot_be_written_writes_no_depth_either() {
         .expect("decode");
     let err = stderr(&out);
     assert!(!out.status.success(), "{err}");
-    assert!(err.contains("right.png") && err.contains("a folder"), "{err}");
-    assert!(!depth.exists(), "depth.png written although the pair was not");
+    assert!(
+        err.contains("right.png") && err.contains("a folder"),
+        "{err}"
+    );
+    assert!(
+        !depth.exists(),
+        "depth.png written although the pair was not"
+    );
     assert_eq!(names(&pair), vec!["right.png".to_string()]);
 }
 

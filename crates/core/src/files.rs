@@ -147,7 +147,8 @@ pub const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(600)
 static LIVE: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
 fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
-    LIVE.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    LIVE.lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Removes every temporary file this process is writing and returns how many there were; any
@@ -676,7 +677,11 @@ mod tests {
         let mut set = OutputSet::new();
         set.stage_bytes(&a, b"new left").expect("first");
         set.stage_bytes(&b, b"new right").expect("second");
-        assert_eq!(std::fs::read(&a).expect("left"), b"old left", "not before commit");
+        assert_eq!(
+            std::fs::read(&a).expect("left"),
+            b"old left",
+            "not before commit"
+        );
         assert_eq!(set.commit().expect("commit"), vec![a.clone(), b.clone()]);
         assert_eq!(std::fs::read(&a).expect("left"), b"new left");
         assert_eq!(std::fs::read(&b).expect("right"), b"new right");
@@ -713,10 +718,7 @@ mod tests {
             p
         };
         let stale = plant(temporary_name("a.png", dead), old);
-        let recent = plant(
-            temporary_name("b.png", dead),
-            std::time::SystemTime::now(),
-        );
+        let recent = plant(temporary_name("b.png", dead), std::time::SystemTime::now());
         let live = plant(temporary_name("c.png", std::process::id()), old);
         let other = plant(".a.png.tmp-notapid".to_string(), old);
         let user_file = plant("notes.tmp-1-2-3".to_string(), old);

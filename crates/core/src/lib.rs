@@ -163,8 +163,8 @@ pub use effects::sirds::{
 pub use files::{
     EXCERPT_CHARS, InputRoot, OutputSet, STALE_AFTER, StagingDir, UTF16_WITHOUT_BOM, check_input,
     check_output_path, excerpt, image_error, looks_like_utf16, open_image as open_image_within,
-    read_input, read_text, remove_stale_temporaries, remove_temporaries, without_bom,
-    write_atomic, write_bytes, write_png,
+    read_input, read_text, remove_stale_temporaries, remove_temporaries, without_bom, write_atomic,
+    write_bytes, write_png,
 };
 pub use simd::{avx2_available, uses_avx2};
 pub use text::{Align as TextAlign, caption, draw_rgba as draw_text_rgba, width as text_width};

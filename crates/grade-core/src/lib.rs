@@ -30,6 +30,10 @@ use score::TaskResult;
 use spec::TaskSpec;
 pub use stereolab_error::{Error, Result};
 
+/// The exit code of a grading run that finished with the verdict NOT PASSED, so that a script
+/// or a CI job can tell it from a pass (0), an error (1) and a usage error (2).
+pub const EXIT_NOT_PASSED: u8 = 3;
+
 /// The exercises of the course.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Exercise {

@@ -94,7 +94,9 @@ fn seconds(flag: &str, s: f64, range: std::ops::RangeInclusive<f64>) -> Result<D
     }
 }
 
-fn grade(args: GradeArgs) -> Result<()> {
+/// Grades as `args` say; returns whether the verdict is PASSED (`points` lists the points and
+/// counts as passed).
+fn grade(args: GradeArgs) -> Result<bool> {
     let started = Instant::now();
     if !data_dir().is_dir() {
         return Err(Error::invalid(
@@ -120,7 +122,7 @@ fn grade(args: GradeArgs) -> Result<()> {
     };
     if args.exercise == "points" {
         print!("{}", points_text(&points_of(&specs_of)));
-        return Ok(());
+        return Ok(true);
     }
     if !(64..=65536).contains(&args.memory_mb) {
         return Err(Error::invalid(
@@ -154,13 +156,22 @@ fn grade(args: GradeArgs) -> Result<()> {
             .map_err(|e| Error::io(&path, std::io::Error::other(e)))?;
         write_whole(&path, text.as_bytes())?;
     }
-    Ok(())
+    Ok(report.passed())
 }
 
 /// Writes `bytes` to `path` through a temporary file beside it: whole or not at all.
 fn write_whole(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension(format!("tmp-{}", std::process::id()));
-    std::fs::write(&tmp, bytes)
+    use std::io::Write as _;
+    let stamp = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let tmp = path.with_extension(format!("tmp-{}-{stamp:x}", std::process::id()));
+    // A new file (never one that exists, nor a link planted under that name).
+    std::fs::File::options()
+        .write(true)
+        .create_new(true)
+        .open(&tmp)
+        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
         .and_then(|()| std::fs::rename(&tmp, path))
         .map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
@@ -183,7 +194,8 @@ fn main() -> ExitCode {
         }
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(stereolab_grade_core::EXIT_NOT_PASSED),
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE

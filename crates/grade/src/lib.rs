@@ -26,9 +26,9 @@ use spec::TaskSpec;
 use stereolab::scene::Scene;
 use stereolab_core::{Error, Result};
 pub use stereolab_grade_core::{
-    Binary, BuildMode, Exercise, GradeOptions, Limits, NotBuilt, Policy, build, check_sandbox,
-    child, default_work_dir, exercises_dir, report, sandbox, score, stubs_candidates, stubs_path,
-    submission_binary,
+    Binary, BuildMode, EXIT_NOT_PASSED, Exercise, GradeOptions, Limits, NotBuilt, Policy, build,
+    check_sandbox, child, default_work_dir, exercises_dir, report, sandbox, score,
+    stubs_candidates, stubs_path, submission_binary,
 };
 
 /// The task specs: the shared ones with the pictures of this grader.

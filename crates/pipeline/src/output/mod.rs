@@ -15,9 +15,10 @@ use crate::render::Frame;
 use crate::scene::Scene;
 use stereo_photo::{PhotoFormat, RigMetadata, StereoPhoto};
 use stereolab_core::{
-    AnaglyphKind, Error, Framebuffer, Precision, Result, above_below, above_below_squashed,
-    anaglyph, calibration_screen, check_output_path, ghosted, interleave, occlusion_image,
-    parallax_image, rds_framebuffer, rds_left, rds_right, remap_color, side_by_side, OutputSet,
+    AnaglyphKind, Error, Framebuffer, OutputSet, Precision, Result, above_below,
+    above_below_squashed, anaglyph, calibration_screen, check_output_path, ghosted, interleave,
+    occlusion_image, parallax_image, rds_framebuffer, rds_left, rds_right, remap_color,
+    side_by_side,
 };
 
 /// One finished output image.

@@ -252,13 +252,18 @@ impl StillFormat {
 /// The error for an output name whose extension is not one of `accepted`: names `--out`, the
 /// extension (or its absence) and the accepted extensions.
 pub fn unsupported_extension(path: &Path, accepted: &[&str]) -> Error {
+    unsupported_extension_of("--out", path, accepted)
+}
+
+/// [`unsupported_extension`] of the file named by `flag`.
+pub fn unsupported_extension_of(flag: &str, path: &Path, accepted: &[&str]) -> Error {
     let what = match path.extension() {
         Some(e) => format!("unsupported extension .{}", e.to_string_lossy()),
         None => "no extension".to_string(),
     };
     let list: Vec<String> = accepted.iter().map(|e| format!(".{e}")).collect();
     Error::invalid(
-        "--out",
+        flag,
         path.display(),
         format!(
             "{what}; use {} (the file is written in the format its name says)",
