@@ -1,5 +1,8 @@
 //! Homogeneous clipping against the view frustum (Sutherland–Hodgman), as llvmpipe's draw
-//! module does: geometrically, against all six planes, no guard band.
+//! module does: geometrically, against all six planes, no guard band (`llvmpipe_create_context`
+//! sets `draw_set_driver_clipping(draw, false, false, false, true)`). llvmpipe clips in f32
+//! (`draw_pipe_clip.c`); this clipper works in f64, which places the new vertices within a
+//! subpixel step up to far larger coordinates ([`ClipRange`]).
 
 use glam::{DVec4, Vec4};
 
