@@ -118,7 +118,7 @@ pub fn clip_triangle(
 /// `p` with the coordinate that `plane` constrains set onto it: `x = −w` for `w + x = 0`, and
 /// so on (the order of [`plane_distance`]).
 fn on_plane(mut p: DVec4, plane: usize) -> DVec4 {
-    let side = if plane % 2 == 0 { -p.w } else { p.w };
+    let side = if plane.is_multiple_of(2) { -p.w } else { p.w };
     match plane / 2 {
         0 => p.x = side,
         1 => p.y = side,

@@ -148,7 +148,7 @@ fn clip(tri: [DVec4; 3]) -> Vec<DVec4> {
             }
             if (da >= 0.0) != (db >= 0.0) {
                 let mut p = a + (b - a) * (da / (da - db));
-                let on = if plane % 2 == 0 { -p.w } else { p.w };
+                let on = if plane.is_multiple_of(2) { -p.w } else { p.w };
                 p[plane / 2] = on;
                 out.push(p);
             }
