@@ -127,7 +127,7 @@ fn on_plane(mut p: DVec4, plane: usize) -> DVec4 {
     p
 }
 
-/// Clipped triangles with clip coordinates too large for [`clip_triangle`] to place their new
+/// Clipped triangles with clip coordinates too large for `clip_triangle` to place their new
 /// vertices within a subpixel step (1/256 px), and the worst of them (`RasterStats`).
 ///
 /// The f64 clipper's new vertices lie within a few roundings, `2⁻⁵⁰·|p|` here, of the exact
