@@ -143,6 +143,24 @@ pub fn run(args: RenderArgs) -> Result<()> {
              camera.far, each mesh's translate and scale)"
         );
     }
+    // Clipped triangles with coordinates past what the clipper places within a subpixel step
+    // (`ClipRange`, docs/reliability.md "Large coordinates").
+    let mut range = stereolab_core::ClipRange::default();
+    for p in frame.passes.iter().filter(|_| backend == Backend::Cpu) {
+        range.merge(p.stats.clip_range);
+    }
+    if range.triangles > 0 {
+        outln!(
+            "  warning: {} clipped triangles have clip coordinates beyond the clipper's range \
+             (largest {:e}, limit {:e} for that triangle: 2^43 times its nearest w over the \
+             image's larger side); their edges and depth may be off by more than 1/256 pixel \
+             or lost: bring the meshes' coordinates nearer the camera's scale (each mesh's \
+             scale and translate, camera.near)",
+            range.triangles,
+            range.coordinate,
+            range.limit
+        );
+    }
     if let Some(report) = info::frame_budget_report(&frame, &s)? {
         out!("{report}");
     }

@@ -777,3 +777,94 @@ fn cli_renders_on_the_gpu_and_compares_scenes_and_images() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A 64×48 scene whose only object is a triangle of extent `extent` in the plane z = 0 seen
+/// from 3 units (it covers the view), or with `ground`, a square of half-extent `extent` one
+/// unit under an eye looking at the horizon (`near = 0.1`, `far = 1000`).
+fn large_scene(ground: bool, extent: f32) -> Scene {
+    let camera = if ground {
+        "eye = [0, 1, 0]\ntarget = [0, 1, -1]\nnear = 0.1\nfar = 1000\n"
+    } else {
+        "eye = [0, 0, 3]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n"
+    };
+    let text = format!(
+        "outputs = [\"left\"]\n[image]\nwidth = 64\nheight = 48\n[camera]\n{camera}\
+         [[mesh]]\nkind = \"cube\"\n"
+    );
+    let mut s = Scene::from_toml(&text, Path::new("large.toml"), Path::new("."), &[])
+        .expect("built-in scene parses");
+    let e = extent;
+    let mut mesh = Mesh::default();
+    if ground {
+        mesh.positions = vec![
+            Vec3::new(-e, 0.0, e),
+            Vec3::new(e, 0.0, e),
+            Vec3::new(e, 0.0, -e),
+            Vec3::new(-e, 0.0, -e),
+        ];
+        mesh.triangles = vec![[0, 1, 2], [0, 2, 3]];
+    } else {
+        mesh.positions = vec![
+            Vec3::new(-e, -e, 0.0),
+            Vec3::new(e, -e, 0.0),
+            Vec3::new(0.0, e, 0.0),
+        ];
+        mesh.triangles = vec![[0, 1, 2]];
+    }
+    mesh.normals = vec![Vec3::Z; mesh.positions.len()];
+    mesh.uvs = vec![glam::Vec2::ZERO; mesh.positions.len()];
+    s.objects = vec![Object {
+        name: "large".into(),
+        mesh,
+        model: Mat4::IDENTITY,
+        color: Vec3::new(0.8, 0.6, 0.3),
+    }];
+    s
+}
+
+/// Large coordinates on both paths (docs/reliability.md "Large coordinates"). Measured here
+/// (64×48, pixels covered, CPU / lavapipe): ground of extent 1e6: 1536 / 1536, the same
+/// pixels (the lower half); grounds of 1e8 and 1e10: 0 / 0 (the f32 vertex stage rounds the
+/// near plane away on both; the CPU counts them in `clip_range`); covering triangles of extent
+/// 2e8, 1e10 and 1e30: 3072 / 1152 (lavapipe clips in f32, where `w + x` loses `w`, and draws
+/// 37.5% of the view; the CPU clips in f64 and counts the 1e30 one in `clip_range`). Every
+/// pixel lavapipe covers the CPU covers too. The bound for the ground is the measured 0
+/// pixels of difference.
+#[test]
+fn large_coordinates_cover_what_the_cpu_covers() {
+    let Some(r) = gpu() else { return };
+    let count = |v: &[bool]| v.iter().filter(|c| **c).count();
+    for (ground, extent, warned) in [
+        (true, 1e6, false),
+        (true, 1e8, true),
+        (true, 1e10, true),
+        (false, 2e8, false),
+        (false, 1e10, false),
+        (false, 1e30, true),
+    ] {
+        let scene = large_scene(ground, extent);
+        let eyes = scene.rig.eyes(&scene.camera, scene.aspect()).expect("rig");
+        let (cpu, gpu) = both(r, &scene, &eyes[0], Shading::DepthOnly).expect("both render");
+        let (_, stats) = render_view(&scene, &eyes[0], Shading::DepthOnly).expect("render");
+        let (c, g) = (coverage(&cpu), coverage(&gpu));
+        eprintln!(
+            "{} of extent {extent:e}: CPU covers {}, lavapipe {} of {} pixels; {:?}",
+            if ground {
+                "ground"
+            } else {
+                "covering triangle"
+            },
+            count(&c),
+            count(&g),
+            c.len(),
+            stats.clip_range
+        );
+        assert_eq!(stats.clip_range.triangles > 0, warned, "extent {extent:e}");
+        if ground {
+            assert_same_coverage(&format!("ground_{extent:e}"), &cpu, &gpu);
+        } else {
+            assert_eq!(count(&c), c.len(), "the CPU covers the view at {extent:e}");
+            assert!(c.iter().zip(&g).all(|(c, g)| *c || !*g));
+        }
+    }
+}

@@ -793,3 +793,36 @@ fn a_budget_read_from_a_too_coarse_depth_buffer_says_it_is_uncertain() {
     );
     assert_no_warning_naming(&out, "uncertain");
 }
+
+/// Catalogue, large coordinates (docs/reliability.md "Large coordinates"): a plane of extent
+/// 1e30 covering the view is drawn whole but its coordinates are beyond the clipper's range,
+/// and `render` says so with the largest coordinate and the limit; at 1e10 it is in range and
+/// nothing is said.
+#[test]
+fn coordinates_beyond_the_clippers_range_are_warned_about() {
+    let dir = out_dir("hard-large-coordinates");
+    std::fs::create_dir_all(&dir).expect("folder");
+    let scene = dir.join("large.toml");
+    let run = |scale: &str| {
+        let text = format!(
+            "outputs = [\"left\"]\n[image]\nwidth = 96\nheight = 64\n\
+             [camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n\
+             [[mesh]]\nkind = \"plane\"\nscale = {scale}\n"
+        );
+        std::fs::write(&scene, text).expect("scene written");
+        let (s, o) = (scene.to_string_lossy(), dir.join("out"));
+        stereolab(&["render", &s, "--out", &o.to_string_lossy()])
+    };
+    let out = run("1e30");
+    assert_warned(
+        &out,
+        &[
+            "beyond the clipper's range",
+            "largest 6.70",
+            "e28",
+            "limit 2.74",
+            "e11",
+        ],
+    );
+    assert_no_warning_naming(&run("1e10"), "clipper");
+}

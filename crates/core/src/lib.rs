@@ -49,7 +49,7 @@ pub use math::{
 
 // Shading and the fixed-point rasterizer (knows nothing of stereo).
 pub use raster::{
-    Band as RasterBand, DepthMode, DepthPlane, Plane, RasterOptions, RasterStats,
+    Band as RasterBand, ClipRange, DepthMode, DepthPlane, Plane, RasterOptions, RasterStats,
     Setup as TriangleSetup, SetupTriangle, Setups, SmallBox, WindowVertex, rasterize,
     rasterize_blinn_phong, setup_triangle, setup_triangles, traverse,
 };

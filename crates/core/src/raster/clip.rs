@@ -1,9 +1,12 @@
 //! Homogeneous clipping against the view frustum (Sutherland–Hodgman), as llvmpipe's draw
-//! module does: geometrically, against all six planes, no guard band.
+//! module does: geometrically, against all six planes, no guard band (`llvmpipe_create_context`
+//! sets `draw_set_driver_clipping(draw, false, false, false, true)`). llvmpipe clips in f32
+//! (`draw_pipe_clip.c`); this clipper works in f64, which places the new vertices within a
+//! subpixel step up to far larger coordinates ([`ClipRange`]).
 
-use glam::Vec4;
+use glam::{DVec4, Vec4};
 
-use crate::shade::Varyings;
+use crate::shade::{MAX_VARYINGS, Varyings};
 
 /// A vertex after the vertex stage: clip position and varyings.
 #[derive(Clone, Copy, Debug)]
@@ -17,7 +20,7 @@ pub struct ClipVertex {
 /// Distance of `p` to each of the six OpenGL clip planes (inside ≥ 0):
 /// w+x, w−x, w+y, w−y, w+z, w−z.
 #[inline]
-fn plane_distance(p: Vec4, plane: usize) -> f32 {
+fn plane_distance(p: DVec4, plane: usize) -> f64 {
     match plane {
         0 => p.w + p.x,
         1 => p.w - p.x,
@@ -28,9 +31,11 @@ fn plane_distance(p: Vec4, plane: usize) -> f32 {
     }
 }
 
-/// Bit i set when `p` is outside plane i.
+/// Bit i set when `p` is outside plane i. (The sign of `w ± x` is exact in any precision: a
+/// rounded sum is zero only when the exact one is.)
 #[inline]
 pub fn outcode(p: Vec4) -> u8 {
+    let p = p.as_dvec4();
     (0..6).fold(0, |code, i| {
         code | (((plane_distance(p, i) < 0.0) as u8) << i)
     })
@@ -41,13 +46,31 @@ pub const MAX_CLIPPED: usize = 9;
 
 /// Clips triangle `tri` against the frustum; writes the polygon into `out`, returns its length
 /// (0 when nothing remains). Only the first `nvar` varyings are interpolated.
+///
+/// Sutherland–Hodgman (Sutherland and Hodgman, "Reentrant polygon clipping", CACM 17(1),
+/// 1974) in homogeneous coordinates (Blinn and Newell, "Clipping using homogeneous
+/// coordinates", SIGGRAPH 1978), computed in f64 from the f32 vertices:
+/// - each intersection is interpolated from the edge's inside vertex, so that an edge shared
+///   by two triangles clips to the same point in both;
+/// - a clip distance `w ± x` of two f32 values is exact in f64 while `|x| / |w| < 2²⁹`, and
+///   the interpolated point is then within about `2⁻⁵²·|p|` of the exact intersection, `|p|`
+///   the largest coordinate (in f32 the same sum loses `w` entirely once `|x| > 2²⁴·|w|`,
+///   and a triangle of extent 1e8 was cut half a screen off);
+/// - the coordinate the plane constrains is then set exactly onto the plane (`x = −w` for
+///   `w + x = 0`), so the next planes see the vertex on it, not a rounding to either side.
+///
+/// How far that carries is [`ClipRange`]'s business.
 pub fn clip_triangle(
     tri: [ClipVertex; 3],
     nvar: usize,
     out: &mut [ClipVertex; MAX_CLIPPED + 3],
 ) -> usize {
-    let mut a = [tri[0]; MAX_CLIPPED + 3];
-    a[..3].copy_from_slice(&tri);
+    type Vertex = (DVec4, [f64; MAX_VARYINGS]);
+    let widen = |v: &ClipVertex| (v.pos.as_dvec4(), v.var.map(f64::from));
+    let mut a: [Vertex; MAX_CLIPPED + 3] = [widen(&tri[0]); MAX_CLIPPED + 3];
+    for (slot, v) in a.iter_mut().zip(&tri) {
+        *slot = widen(v);
+    }
     let mut n = 3;
     let mut b = a;
     for plane in 0..6 {
@@ -55,14 +78,12 @@ pub fn clip_triangle(
         for i in 0..n {
             let cur = a[i];
             let next = a[(i + 1) % n];
-            let dc = plane_distance(cur.pos, plane);
-            let dn = plane_distance(next.pos, plane);
+            let dc = plane_distance(cur.0, plane);
+            let dn = plane_distance(next.0, plane);
             if dc >= 0.0 {
                 b[m] = cur;
                 m += 1;
             }
-            // The edge crosses the plane: emit the intersection, interpolated from the inside
-            // vertex so that shared edges clip to the same point from both triangles.
             if (dc >= 0.0) != (dn >= 0.0) {
                 let (inside, outside, di, dout) = if dc >= 0.0 {
                     (cur, next, dc, dn)
@@ -71,9 +92,9 @@ pub fn clip_triangle(
                 };
                 let t = di / (di - dout);
                 let mut v = inside;
-                v.pos = inside.pos + (outside.pos - inside.pos) * t;
+                v.0 = on_plane(inside.0 + (outside.0 - inside.0) * t, plane);
                 for k in 0..nvar {
-                    v.var[k] = inside.var[k] + (outside.var[k] - inside.var[k]) * t;
+                    v.1[k] = inside.1[k] + (outside.1[k] - inside.1[k]) * t;
                 }
                 b[m] = v;
                 m += 1;
@@ -85,6 +106,270 @@ pub fn clip_triangle(
             return 0;
         }
     }
-    out[..n].copy_from_slice(&a[..n]);
+    for (slot, (pos, var)) in out.iter_mut().zip(&a[..n]) {
+        *slot = ClipVertex {
+            pos: pos.as_vec4(),
+            var: var.map(|x| x as f32),
+        };
+    }
     n
+}
+
+/// `p` with the coordinate that `plane` constrains set onto it: `x = −w` for `w + x = 0`, and
+/// so on (the order of [`plane_distance`]).
+fn on_plane(mut p: DVec4, plane: usize) -> DVec4 {
+    let side = if plane.is_multiple_of(2) { -p.w } else { p.w };
+    match plane / 2 {
+        0 => p.x = side,
+        1 => p.y = side,
+        _ => p.z = side,
+    }
+    p
+}
+
+/// Clipped triangles with clip coordinates too large for `clip_triangle` to place their new
+/// vertices within a subpixel step (1/256 px), and the worst of them (`RasterStats`).
+///
+/// The f64 clipper's new vertices lie within a few roundings, `2⁻⁵⁰·|p|` here, of the exact
+/// intersections, `|p|` the triangle's largest clip coordinate; at a new vertex of clip `w` on
+/// a target whose larger side is `side` pixels that is `2⁻⁵⁰·|p|·(side/2)/w` px. It stays
+/// below 1/256 px while `|p| ≤ 2⁴³·w/side`: a triangle of extent 1e10 seen from 3 units
+/// covers a 1024-pixel view as it should, one of extent 1e30 does not (nor would any f32 or
+/// f64 clipper).
+///
+/// `w` is the smallest of the clipped polygon's and of the points where the triangle's edges
+/// cross the near plane (`w + z = 0`). In a perspective view every point of the near plane has
+/// `w = near`; where the f32 vertex stage has rounded the near plane away (a ground of extent
+/// 1e8 under an eye with `near = 0.1`: `z = a·z_eye + b` loses `b`), they land on `w = 0`,
+/// the triangle clips to nothing, and the limit is 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ClipRange {
+    /// Clipped triangles beyond their limit.
+    pub triangles: usize,
+    /// The largest clip coordinate `|p|` of the worst of them (largest `|p|` / limit).
+    pub coordinate: f32,
+    /// Its limit `2⁴³·w/side`.
+    pub limit: f32,
+}
+
+impl ClipRange {
+    /// `2⁴³`: the clip coordinates up to `2⁴³·w/side` are clipped within 1/256 px.
+    pub const SCALE: f64 = (1u64 << 43) as f64;
+
+    /// The range of triangle `tri` clipped to `poly` on a `width`×`height` target: one
+    /// triangle beyond its limit, or nothing.
+    pub fn of(tri: &[ClipVertex; 3], poly: &[ClipVertex], width: u32, height: u32) -> ClipRange {
+        let coordinate = tri
+            .iter()
+            .map(|v| v.pos.abs().max_element())
+            .fold(0.0, f32::max);
+        // Where the edges cross the near plane (plane 4), interpolated as the clipper does.
+        let near = (0..3).filter_map(|i| {
+            let (a, b) = (tri[i].pos.as_dvec4(), tri[(i + 1) % 3].pos.as_dvec4());
+            let (da, db) = (plane_distance(a, 4), plane_distance(b, 4));
+            ((da >= 0.0) != (db >= 0.0)).then(|| (a.w + (b.w - a.w) * (da / (da - db))) as f32)
+        });
+        let w = poly
+            .iter()
+            .map(|v| v.pos.w)
+            .chain(near)
+            .fold(f32::INFINITY, f32::min);
+        if w == f32::INFINITY {
+            return ClipRange::default(); // nothing left and no edge through the near plane
+        }
+        let limit = (Self::SCALE * f64::from(w.max(0.0)) / f64::from(width.max(height))) as f32;
+        if coordinate <= limit {
+            return ClipRange::default();
+        }
+        ClipRange {
+            triangles: 1,
+            coordinate,
+            limit,
+        }
+    }
+
+    /// Adds `other`'s triangles and keeps the worse of the two.
+    pub fn merge(&mut self, other: ClipRange) {
+        let ratio = |r: &ClipRange| f64::from(r.coordinate) / f64::from(r.limit);
+        if other.triangles > 0 && (self.triangles == 0 || ratio(&other) > ratio(self)) {
+            (self.coordinate, self.limit) = (other.coordinate, other.limit);
+        }
+        self.triangles += other.triangles;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DMat4, DVec3, Vec3};
+
+    use super::ClipRange;
+    use crate::framebuffer::Framebuffer;
+    use crate::math::{look_at, perspective};
+    use crate::raster::{RasterOptions, RasterStats, rasterize};
+    use crate::reference::{self, IdShader, soup, visible};
+
+    const SIZE: (u32, u32) = (64, 48);
+
+    /// A view of `triangles` from `eye` towards `target`: the renderer's pass (an [`IdShader`]
+    /// pass, its covered pixels and stats) and the f64 reference's covered pixels.
+    fn both(
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        eye: Vec3,
+        target: Vec3,
+        (near, far): (f32, f32),
+    ) -> (Vec<bool>, Vec<bool>, RasterStats) {
+        let (w, h) = SIZE;
+        let aspect = w as f32 / h as f32;
+        let mvp = perspective(45.0, aspect, near, far) * look_at(eye, target, Vec3::Y);
+        let p = soup(positions, triangles);
+        let ids: Vec<[u32; 3]> = (0..triangles.len() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect();
+        let mut fb = Framebuffer::new(w, h, [0, 0, 0, 0]).unwrap();
+        let shader = IdShader { positions: &p, mvp };
+        let stats = rasterize(&ids, p.len(), &shader, &mut fb, &RasterOptions::default());
+        let drawn = (0..fb.color.len())
+            .map(|i| reference::drawn_id(&fb, i).is_some())
+            .collect();
+        let v64 = |v: Vec3| DVec3::from(v.to_array().map(f64::from));
+        let (n, f) = (f64::from(near), f64::from(far));
+        let half_h = n * (45f64.to_radians() * 0.5).tan();
+        let half_w = half_h * f64::from(w) / f64::from(h);
+        let mvp64: DMat4 = reference::frustum(-half_w, half_w, -half_h, half_h, n, f)
+            * reference::look_at(v64(eye), v64(target), DVec3::Y);
+        let p64: Vec<DVec3> = positions.iter().map(|v| v64(*v)).collect();
+        let r = visible(&p64, triangles, &mvp64, w, h);
+        (drawn, r.id.iter().map(Option::is_some).collect(), stats)
+    }
+
+    /// A triangle of extent `e` in the plane z = 0, seen from 3 units: it covers the view.
+    fn covering(e: f32) -> (Vec<bool>, Vec<bool>, RasterStats) {
+        let p = [
+            Vec3::new(-e, -e, 0.0),
+            Vec3::new(e, -e, 0.0),
+            Vec3::new(0.0, e, 0.0),
+        ];
+        both(
+            &p,
+            &[[0, 1, 2]],
+            Vec3::new(0.0, 0.0, 3.0),
+            Vec3::ZERO,
+            (1.0, 10.0),
+        )
+    }
+
+    /// A ground square of half-extent `e` one unit under an eye looking at the horizon.
+    fn ground(e: f32) -> (Vec<bool>, Vec<bool>, RasterStats) {
+        let p = [
+            Vec3::new(-e, 0.0, e),
+            Vec3::new(e, 0.0, e),
+            Vec3::new(e, 0.0, -e),
+            Vec3::new(-e, 0.0, -e),
+        ];
+        let eye = Vec3::new(0.0, 1.0, 0.0);
+        both(
+            &p,
+            &[[0, 1, 2], [0, 2, 3]],
+            eye,
+            Vec3::new(0.0, 1.0, -1.0),
+            (0.1, 1000.0),
+        )
+    }
+
+    fn count(v: &[bool]) -> usize {
+        v.iter().filter(|c| **c).count()
+    }
+
+    /// Triangles of extent 2e8 and 1e10 covering the view cover every pixel, as the f64
+    /// reference does, with no range warning (in f32 the clip distance `w + x` loses `w` and
+    /// the intersection lands half a screen off: 37.5% covered).
+    #[test]
+    fn huge_triangles_covering_the_view_cover_every_pixel() {
+        for e in [2e8, 1e10] {
+            let (drawn, reference, stats) = covering(e);
+            assert_eq!(count(&reference), drawn.len(), "reference at {e:e}");
+            assert_eq!(count(&drawn), drawn.len(), "extent {e:e}: {stats:?}");
+            assert_eq!(stats.clipped, 1);
+            assert_eq!(stats.clip_range, ClipRange::default(), "extent {e:e}");
+        }
+    }
+
+    /// A ground of extent 1e6 covers exactly the pixels the f64 reference covers (the rows
+    /// below the horizon; pixels the reference leaves open at an edge are not counted).
+    #[test]
+    fn a_huge_ground_covers_the_rows_the_reference_covers() {
+        let (drawn, reference, stats) = ground(1e6);
+        assert_eq!(count(&reference), drawn.len() / 2, "the lower half");
+        let differ: Vec<usize> = (0..drawn.len())
+            .filter(|&i| drawn[i] != reference[i])
+            .collect();
+        assert!(differ.is_empty(), "pixels that differ: {differ:?}");
+        assert_eq!(stats.clip_range, ClipRange::default());
+    }
+
+    /// Past the clipper's range the pass says so: a covering triangle of extent 1e30 (no f32
+    /// or f64 clipper places its edges within a pixel; here they lie outside the view, so it
+    /// still covers everything) and grounds of extent 1e8 and 1e10, whose near plane the f32
+    /// vertex stage has rounded away (`z = a·z_eye + b` loses `b`; the reference, in f64
+    /// from the scene, still covers the lower half, the renderer and lavapipe nothing).
+    #[test]
+    fn coordinates_beyond_the_clippers_range_are_counted() {
+        let (drawn, _, stats) = covering(1e30);
+        assert_eq!(count(&drawn), drawn.len());
+        let r = stats.clip_range;
+        assert_eq!(r.triangles, 1, "{stats:?}");
+        assert!(r.coordinate > 1e30 && r.coordinate > r.limit, "{r:?}");
+        // 2⁴³ · w / side with w = 3 (the plane's distance) and a 64-pixel side.
+        assert_eq!(r.limit, (ClipRange::SCALE * 3.0 / 64.0) as f32);
+        for e in [1e8, 1e10] {
+            let (drawn, reference, stats) = ground(e);
+            assert_eq!(count(&reference), drawn.len() / 2, "reference at {e:e}");
+            assert_eq!(count(&drawn), 0, "extent {e:e}");
+            let r = stats.clip_range;
+            assert_eq!(r.triangles, 2, "extent {e:e}: {stats:?}");
+            assert!(r.coordinate >= e && r.limit == 0.0, "extent {e:e}: {r:?}");
+        }
+    }
+
+    /// Ordinary clipped triangles stay in range: a ground of extent 100 and a triangle of
+    /// extent 1e4 through the near plane.
+    #[test]
+    fn ordinary_clipped_triangles_are_in_range() {
+        let (_, _, stats) = ground(100.0);
+        assert_eq!(stats.clipped, 2);
+        assert_eq!(stats.clip_range, ClipRange::default());
+        let p = [
+            Vec3::new(-1e4, -1.0, 1e4),
+            Vec3::new(1e4, -1.0, 1e4),
+            Vec3::new(0.0, 2.0, -1e4),
+        ];
+        let (_, _, stats) = both(&p, &[[0, 1, 2]], Vec3::ZERO, -Vec3::Z, (0.1, 100.0));
+        assert_eq!(stats.clipped, 1);
+        assert_eq!(stats.clip_range, ClipRange::default());
+    }
+
+    /// `merge` adds the counts and keeps the triangle furthest past its limit, also when a
+    /// limit is 0.
+    #[test]
+    fn merge_keeps_the_worst() {
+        let r = |coordinate, limit| ClipRange {
+            triangles: 1,
+            coordinate,
+            limit,
+        };
+        let mut m = ClipRange::default();
+        for x in [r(10.0, 5.0), r(1e9, 0.0), r(1e12, 1e3)] {
+            m.merge(x);
+        }
+        assert_eq!(
+            m,
+            ClipRange {
+                triangles: 3,
+                ..r(1e9, 0.0)
+            }
+        );
+        m.merge(ClipRange::default());
+        assert_eq!(m.triangles, 3);
+    }
 }

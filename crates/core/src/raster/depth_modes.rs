@@ -26,7 +26,7 @@
 
 use glam::Vec4;
 
-use super::clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
+use super::clip::{ClipRange, ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
 use super::setup::{DepthPlane, Setup, SetupTriangle, WindowVertex, setup_triangle};
 use super::{RasterOptions, RasterStats};
 use crate::framebuffer::Framebuffer;
@@ -181,7 +181,10 @@ pub(super) fn rasterize<S: Shader>(
             3
         } else {
             stats.clipped += 1;
-            clip_triangle([*a, *b, *c], nvar, &mut poly)
+            let n = clip_triangle([*a, *b, *c], nvar, &mut poly);
+            let range = ClipRange::of(&[*a, *b, *c], &poly[..n], width, height);
+            stats.clip_range.merge(range);
+            n
         };
         let mut culled = false;
         for k in 1..n.saturating_sub(1) {

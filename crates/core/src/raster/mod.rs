@@ -14,6 +14,7 @@ mod setup;
 mod shade_avx2;
 mod traverse;
 
+pub use clip::ClipRange;
 pub(crate) use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
 pub use depth_modes::DepthMode;
 pub use setup::{DepthPlane, Plane, Setup, SetupTriangle, WindowVertex, setup_triangle};
@@ -61,7 +62,7 @@ impl Default for RasterOptions {
 }
 
 /// Counts from one `rasterize` call.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RasterStats {
     /// Triangles submitted.
     pub triangles: usize,
@@ -69,6 +70,8 @@ pub struct RasterStats {
     pub non_finite: usize,
     /// Triangles that needed clipping.
     pub clipped: usize,
+    /// Clipped triangles whose coordinates are too large to clip within a subpixel step.
+    pub clip_range: ClipRange,
     /// Triangles removed by back-face culling.
     pub culled: usize,
     /// Fragments that passed the depth test.
@@ -265,6 +268,7 @@ pub fn setup_triangles<S: Shader>(
         setups.push(part);
         stats.non_finite += s.non_finite;
         stats.clipped += s.clipped;
+        stats.clip_range.merge(s.clip_range);
         stats.culled += s.culled;
     }
     (Setups(setups), stats)
@@ -351,7 +355,10 @@ fn setup_chunk(
             continue;
         }
         stats.clipped += 1;
-        let n = clip_triangle([a.clip, b.clip, c.clip], nvar, &mut poly);
+        let tri = [a.clip, b.clip, c.clip];
+        let n = clip_triangle(tri, nvar, &mut poly);
+        let range = ClipRange::of(&tri, &poly[..n], width, height);
+        stats.clip_range.merge(range);
         for k in 0..n {
             win[k] = WindowVertex::from_clip(&poly[k], width, height);
         }

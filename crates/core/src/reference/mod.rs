@@ -133,7 +133,9 @@ fn plane_distance(p: DVec4, plane: usize) -> f64 {
     }
 }
 
-/// Sutherland–Hodgman against the six planes, in f64.
+/// Sutherland–Hodgman against the six planes, in f64; each new vertex is set exactly onto its
+/// plane (`x = −w` on `w + x = 0`, ...), where `w ± x` may have lost `w` (coordinates past
+/// `2⁵³·w`).
 fn clip(tri: [DVec4; 3]) -> Vec<DVec4> {
     let mut poly = tri.to_vec();
     for plane in 0..6 {
@@ -145,7 +147,10 @@ fn clip(tri: [DVec4; 3]) -> Vec<DVec4> {
                 out.push(a);
             }
             if (da >= 0.0) != (db >= 0.0) {
-                out.push(a + (b - a) * (da / (da - db)));
+                let mut p = a + (b - a) * (da / (da - db));
+                let on = if plane.is_multiple_of(2) { -p.w } else { p.w };
+                p[plane / 2] = on;
+                out.push(p);
             }
         }
         poly = out;

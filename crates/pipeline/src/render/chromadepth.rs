@@ -224,6 +224,7 @@ fn draw_objects<'a, S: Shader>(
         total.triangles += s.triangles;
         total.non_finite += s.non_finite;
         total.clipped += s.clipped;
+        total.clip_range.merge(s.clip_range);
         total.culled += s.culled;
         total.fragments += s.fragments;
     }

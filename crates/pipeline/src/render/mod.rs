@@ -243,6 +243,7 @@ pub fn render_view(
         total.triangles += s.triangles;
         total.non_finite += s.non_finite;
         total.clipped += s.clipped;
+        total.clip_range.merge(s.clip_range);
         total.culled += s.culled;
         total.fragments += s.fragments;
     }
