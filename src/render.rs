@@ -27,9 +27,14 @@ pub struct RenderArgs {
     /// Override a scene field: --set stereo.eye_separation=0.2 (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub sets: Vec<String>,
-    /// Print the plan (which passes run for which outputs) and render nothing.
+    /// Print the plan (which passes run for which outputs) and the memory it needs, and render
+    /// nothing.
     #[arg(long)]
     pub explain: bool,
+    /// The most memory the render may need (estimated before it starts; `--explain` shows
+    /// it): a size such as 512M or 4G. Default: three quarters of this machine's memory.
+    #[arg(long, value_name = "SIZE")]
+    pub max_memory: Option<String>,
     /// Which path renders.
     #[arg(long, value_enum, default_value = "cpu")]
     pub backend: Backend,
@@ -56,11 +61,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
         size,
         sets,
         explain,
+        max_memory,
         backend,
         exercise,
         solution,
         exercises,
     } = args;
+    let budget = max_memory
+        .as_deref()
+        .map(stereolab::memory::parse_bytes)
+        .transpose()?;
     if out.is_file() {
         return Err(Error::invalid(
             "--out",
@@ -88,10 +98,22 @@ pub fn run(args: RenderArgs) -> Result<()> {
         return Ok(());
     }
     let plan = Plan::new(&s.outputs);
+    let needs = stereolab::memory::estimate(&s, &plan);
+    let limit = budget.unwrap_or_else(stereolab::memory::default_budget);
     if explain {
         out!("{}", plan.explain());
+        outln!(
+            "  memory: {needs}; budget {}{}",
+            stereolab::memory::human_bytes(limit),
+            if budget.is_none() {
+                " (three quarters of this machine's memory; --max-memory sets it)"
+            } else {
+                ""
+            }
+        );
         return Ok(());
     }
+    stereolab::memory::check_budget(&needs, limit, budget.is_none())?;
     let (frame, paths) = match backend {
         Backend::Cpu => {
             // Errors this late still name the scene they come from.

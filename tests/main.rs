@@ -29,6 +29,7 @@ mod hard_cases;
 mod image_shift;
 mod interruptions;
 mod layout;
+mod memory;
 mod obj_corpus;
 mod readme;
 mod reliability;

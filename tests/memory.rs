@@ -1,0 +1,115 @@
+//! The memory a render is estimated to need (`render --explain`, `--max-memory`) holds the
+//! peak it reaches: measured as the child process's peak resident size (`wait4`'s
+//! `ru_maxrss`), on scenes that stress each term of the estimate.
+
+use std::path::Path;
+use std::process::Command;
+
+use crate::common::{asset, out_dir};
+
+/// The estimate `render --explain` prints, in bytes (parsed from its MiB/GiB figure).
+fn estimate(scene: &Path, args: &[&str]) -> u64 {
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .arg("render")
+        .arg(scene)
+        .args(args)
+        .arg("--explain")
+        .output()
+        .expect("explain");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("memory: about "))
+        .unwrap_or_else(|| panic!("no memory line in {text}"));
+    let figure = line.split("about ").nth(1).expect("figure");
+    let mut words = figure.split_whitespace();
+    let value: f64 = words.next().expect("number").parse().expect("number");
+    let unit = words.next().expect("unit");
+    let scale = match unit {
+        "GiB" => (1u64 << 30) as f64,
+        "MiB" => (1u64 << 20) as f64,
+        other => panic!("unit {other}"),
+    };
+    (value * scale) as u64
+}
+
+/// The peak resident size of `stereolab render` of `scene` with `args`, in bytes.
+#[cfg(target_os = "linux")]
+fn peak(scene: &Path, args: &[&str], dir: &Path) -> u64 {
+    let child = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .arg("render")
+        .arg(scene)
+        .args(args)
+        .arg("--out")
+        .arg(dir)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("render");
+    let pid = libc::pid_t::try_from(child.id()).expect("pid");
+    let mut status = 0;
+    // SAFETY: an all-zero rusage is a valid value for wait4 to fill.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: waits for the child this test started, writing into the two locals.
+    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(r, pid, "wait4");
+    assert!(
+        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
+        "render failed"
+    );
+    u64::try_from(usage.ru_maxrss).expect("rss") * 1024
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn the_estimate_holds_the_measured_peak() {
+    let sphere = out_dir("memory-scenes").join("sphere.toml");
+    std::fs::write(
+        &sphere,
+        "outputs = [\"left\", \"right\"]\n[image]\nwidth = 64\nheight = 48\n[camera]\n\
+         eye = [0, 0, 5]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n[stereo]\n\
+         eye_separation = 0.2\nzero_parallax = 5\n[[mesh]]\nkind = \"sphere\"\ndetail = 700\n",
+    )
+    .expect("scene");
+    let cases: [(&Path, &[&str]); 5] = [
+        (&asset("scenes/anaglyph.toml"), &["--size", "2048x2048"]),
+        (&asset("scenes/wuson.toml"), &["--size", "2048x1536"]),
+        (&asset("scenes/sirds_fig5.toml"), &["--size", "2048x1024"]),
+        (
+            &asset("scenes/frame_sequential.toml"),
+            &["--size", "1024x768"],
+        ),
+        (&sphere, &[]),
+    ];
+    for (k, (scene, args)) in cases.into_iter().enumerate() {
+        let dir = out_dir(&format!("memory-{k}"));
+        let (est, got) = (estimate(scene, args), peak(scene, args, &dir));
+        let name = scene.file_name().expect("name").to_string_lossy();
+        eprintln!("{name} {args:?}: estimate {est} B, peak {got} B");
+        assert!(est >= got, "{name}: estimate {est} below the peak {got}");
+        // Not a wild overestimate either: within 1.6× and 64 MiB of the peak.
+        assert!(
+            est <= got + got / 5 * 3 + (64 << 20),
+            "{name}: estimate {est} far above the peak {got}"
+        );
+    }
+}
+
+#[test]
+fn a_render_over_the_budget_is_refused_before_it_starts() {
+    let dir = out_dir("memory-refused");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .arg("render")
+        .arg(asset("scenes/wuson.toml"))
+        .args(["--size", "8192x8192", "--max-memory", "64M", "--out"])
+        .arg(&dir)
+        .output()
+        .expect("render");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--max-memory = 64 MiB: this render needs about")
+            && err.contains("raise --max-memory"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(&dir).expect("dir").count(), 0);
+}
