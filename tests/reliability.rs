@@ -402,11 +402,35 @@ fn scenes_read_only_their_own_folder_tree_and_errors_quote_little() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{path}: {err}");
         assert!(
-            err.contains("outside the scene's folder") && err.contains("--allow-outside-paths"),
+            err.contains("names no file inside the scene's folder")
+                && err.contains("--allow-outside-paths"),
             "{path}: {err}"
         );
         assert!(!err.contains("SECRET"), "{path} leaked the file: {err}");
     }
+    // Whether a file outside exists cannot be told from the error: the same words, absolute,
+    // by `..` or through a link (dangling or not), for a file that exists and one that does not.
+    let missing = secret.with_file_name("missing.csv");
+    std::os::unix::fs::symlink(&missing, dir.join("dangling.csv")).unwrap();
+    let message = |path: &str| {
+        let scene = s(&scene_reading(&dir, "terrain", path, ""));
+        let err = String::from_utf8_lossy(&stereolab(&["info", &scene]).stderr).into_owned();
+        // The message quotes at most 40 characters of the path.
+        err.replace(&path.chars().take(40).collect::<String>(), "PATH")
+    };
+    for (exists, absent) in [
+        (s(&secret), s(&missing)),
+        (
+            "../reliability-confined-outside/secret.csv".to_string(),
+            "../reliability-confined-outside/missing.csv".to_string(),
+        ),
+        ("link.csv".to_string(), "dangling.csv".to_string()),
+    ] {
+        assert_eq!(message(&exists), message(&absent), "{exists} / {absent}");
+    }
+    // A file missing inside the tree is said to be missing.
+    let err = message("models/none.obj");
+    assert!(err.contains("No such file"), "{err}");
     // Inside the tree, the same scene loads.
     let inside = s(&scene_reading(&dir, "obj", "models/inside.obj", ""));
     assert!(stereolab(&["info", &inside]).status.success());

@@ -794,21 +794,58 @@ impl InputRoot {
             return Ok(joined);
         }
         let root = base.canonicalize().map_err(|e| Error::io(base, e))?;
-        let full = joined.canonicalize().map_err(|e| Error::io(&joined, e))?;
-        if full.starts_with(&root) {
-            Ok(full)
-        } else {
-            Err(Error::invalid(
+        // A file outside the tree gets the same answer whether or not it exists, so a scene
+        // cannot probe the machine's files by the wording of its errors.
+        let refused = || {
+            Error::invalid(
                 field,
-                format!("\"{}\"", path.escape_debug()),
+                format!("\"{}\"", excerpt(path)),
                 format!(
-                    "names a file outside the scene's folder {}: a scene may read only files \
-                     in its own folder tree (pass --allow-outside-paths to allow it)",
+                    "names no file inside the scene's folder {}: a scene may read only files \
+                     in its own folder tree (pass --allow-outside-paths to allow others)",
                     root.display()
                 ),
-            ))
+            )
+        };
+        let inside = |p: &Path| p.starts_with(&root);
+        match joined.canonicalize() {
+            Ok(full) if inside(&full) => Ok(full),
+            Ok(_) => Err(refused()),
+            // Missing: said as missing only when the deepest folder of the path that exists,
+            // links followed, is inside the tree (and the name is no dangling link).
+            Err(e) => {
+                let dangling = joined.symlink_metadata().is_ok();
+                let lexical = lexical(&root, path);
+                let existing = lexical
+                    .ancestors()
+                    .find(|a| a.symlink_metadata().is_ok())
+                    .and_then(|a| a.canonicalize().ok());
+                if !dangling && existing.is_some_and(|a| inside(&a)) && inside(&lexical) {
+                    Err(Error::io(&joined, e))
+                } else {
+                    Err(refused())
+                }
+            }
         }
     }
+}
+
+/// `path` joined onto `root` as written, `.` and `..` resolved without the file system (links
+/// are not followed: a link's target is judged once it exists).
+fn lexical(root: &Path, path: &str) -> PathBuf {
+    use std::path::Component;
+    let mut out = root.to_path_buf();
+    for c in Path::new(path).components() {
+        match c {
+            Component::RootDir | Component::Prefix(_) => out = PathBuf::from(c.as_os_str()),
+            Component::ParentDir => {
+                out.pop();
+            }
+            Component::CurDir => {}
+            Component::Normal(n) => out.push(n),
+        }
+    }
+    out
 }
 
 /// Longest excerpt of an input line an error message quotes.
