@@ -50,6 +50,46 @@ pub struct RenderArgs {
     pub exercises: Option<PathBuf>,
 }
 
+/// Writes every output of `frame`, with a progress bar on a terminal for the long ones (a
+/// frame-sequential animation's fields: count, elapsed time and an estimate of the rest).
+fn write_with_progress(frame: &Frame, scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut bar: Option<indicatif::ProgressBar> = None;
+    let mut progress = |name: &str, done: usize, of: usize| {
+        let bar = bar.get_or_insert_with(|| {
+            let b = indicatif::ProgressBar::new(of as u64).with_message(format!("writing {name}"));
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{msg} {bar:30} {pos}/{len} fields, {elapsed} (about {eta} left)",
+            ) {
+                b.set_style(style);
+            }
+            b
+        });
+        bar.set_position(done as u64);
+    };
+    let mut write = || {
+        output::write_all_reporting(
+            frame,
+            dir,
+            |o| output::produce(o, frame, scene),
+            &mut progress,
+        )
+    };
+    // The spinner for the outputs in general; the bar alone when one of them reports fields.
+    let paths = if frame
+        .plan
+        .outputs
+        .contains(&stereolab::plan::Output::FrameSequential)
+    {
+        write()
+    } else {
+        super::with_spinner("writing", write)
+    };
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    paths
+}
+
 /// Runs `stereolab render`.
 ///
 /// # Errors
@@ -119,7 +159,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             // Errors this late still name the scene they come from.
             let frame = super::with_spinner("rendering", || render::render(&s, &plan))
                 .map_err(|e| e.in_file(&scene))?;
-            let paths = super::with_spinner("writing", || output::write_all(&frame, &s, &out))?;
+            let paths = write_with_progress(&frame, &s, &out)?;
             (frame, paths)
         }
         Backend::Gpu => render_gpu(&s, &plan, &out)?,

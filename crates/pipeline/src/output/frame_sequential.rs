@@ -61,6 +61,21 @@ impl FrameSequence {
     /// # Errors
     /// Different eye sizes, no fields, or an encoder error.
     pub fn encode(&self) -> Result<Vec<u8>> {
+        let mut bytes = Vec::new();
+        self.encode_to(&mut bytes, &mut |_, _| {})?;
+        Ok(bytes)
+    }
+
+    /// [`encode`](FrameSequence::encode) into `out` as it goes (a long sequence is never held
+    /// whole in memory), calling `progress(fields written, fields)` after each field.
+    ///
+    /// # Errors
+    /// As [`encode`](FrameSequence::encode), or writing to `out` failed.
+    pub fn encode_to(
+        &self,
+        out: &mut dyn std::io::Write,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<()> {
         if self.left.dimensions() != self.right.dimensions() {
             return Err(Error::invalid(
                 "frame_sequential",
@@ -78,24 +93,24 @@ impl FrameSequence {
             .ok_or_else(|| Error::internal("frame_sequential", "no fields to write"))?;
         let png_err =
             |e: png::EncodingError| Error::internal("frame_sequential APNG", e.to_string());
-        let mut bytes = Vec::new();
         {
             let (w, h) = self.left.dimensions();
-            let mut enc = png::Encoder::new(&mut bytes, w, h);
+            let mut enc = png::Encoder::new(out, w, h);
             enc.set_color(png::ColorType::Rgba);
             enc.set_depth(png::BitDepth::Eight);
             enc.set_animated(n, 0).map_err(png_err)?;
             let mut writer = enc.write_header().map_err(png_err)?;
-            for field in &self.fields {
+            for (k, field) in self.fields.iter().enumerate() {
                 writer
                     .set_frame_delay(field.delay_num, field.delay_den)
                     .map_err(png_err)?;
                 writer
                     .write_image_data(self.image(field).as_raw())
                     .map_err(png_err)?;
+                progress(k + 1, self.fields.len());
             }
             writer.finish().map_err(png_err)?;
         }
-        Ok(bytes)
+        Ok(())
     }
 }

@@ -51,11 +51,25 @@ impl Image {
     /// # Errors
     /// As [`OutputSet::stage`].
     pub fn stage(&self, set: &mut OutputSet, path: &Path) -> Result<()> {
+        self.stage_reporting(set, path, &mut |_, _| {})
+    }
+
+    /// [`stage`](Image::stage), calling `progress(done, of)` as a long output (a
+    /// frame-sequential animation, field by field) is written.
+    ///
+    /// # Errors
+    /// As [`OutputSet::stage`].
+    pub fn stage_reporting(
+        &self,
+        set: &mut OutputSet,
+        path: &Path,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<()> {
         match self {
             Image::Rgba(i) => set.stage_png(path, i),
             Image::Gray16(i) => set.stage_png(path, i),
             Image::Stereo(photo) => set.stage_bytes(path, &photo.encode()?),
-            Image::Sequence(seq) => set.stage_bytes(path, &seq.encode()?),
+            Image::Sequence(seq) => set.stage(path, |w| seq.encode_to(w, progress)),
         }
     }
 
@@ -273,7 +287,20 @@ pub fn write_all(frame: &Frame, scene: &Scene, dir: &Path) -> Result<Vec<PathBuf
 pub fn write_all_with(
     frame: &Frame,
     dir: &Path,
+    make: impl FnMut(Output) -> Result<Image>,
+) -> Result<Vec<PathBuf>> {
+    write_all_reporting(frame, dir, make, &mut |_, _, _| {})
+}
+
+/// [`write_all_with`], calling `progress(file name, done, of)` as a long output is written.
+///
+/// # Errors
+/// As [`write_all_with`].
+pub fn write_all_reporting(
+    frame: &Frame,
+    dir: &Path,
     mut make: impl FnMut(Output) -> Result<Image>,
+    progress: &mut dyn FnMut(&str, usize, usize),
 ) -> Result<Vec<PathBuf>> {
     // Every output is made (and every final name checked) before any is written, and all are
     // written before any is renamed onto its name: an output that fails, a full disk or a
@@ -291,7 +318,11 @@ pub fn write_all_with(
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let mut set = OutputSet::new();
     for (path, image) in &outputs {
-        image.stage(&mut set, path)?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        image.stage_reporting(&mut set, path, &mut |done, of| progress(&name, done, of))?;
     }
     set.commit()
 }
