@@ -1,6 +1,8 @@
 //! The memory a render is estimated to need (`render --explain`, `--max-memory`) holds the
 //! peak it reaches: measured as the child process's peak resident size (`wait4`'s
-//! `ru_maxrss`), on scenes that stress each term of the estimate.
+//! `ru_maxrss`), on scenes that stress each term of the estimate. The image terms are tight;
+//! the geometry term is the measured worst case (every triangle keeping a set-up), so a
+//! scene of many triangles that cover few pixels is overestimated, which the margin allows.
 
 use std::path::Path;
 use std::process::Command;
@@ -66,7 +68,7 @@ fn the_estimate_holds_the_measured_peak() {
     std::fs::write(
         &sphere,
         "outputs = [\"left\", \"right\"]\n[image]\nwidth = 64\nheight = 48\n[camera]\n\
-         eye = [0, 0, 5]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n[stereo]\n\
+         eye = [0, 0, 3]\ntarget = [0, 0, 0]\nnear = 1\nfar = 10\n[stereo]\n\
          eye_separation = 0.2\nzero_parallax = 5\n[[mesh]]\nkind = \"sphere\"\ndetail = 700\n",
     )
     .expect("scene");
@@ -78,7 +80,7 @@ fn the_estimate_holds_the_measured_peak() {
             &asset("scenes/frame_sequential.toml"),
             &["--size", "1024x768"],
         ),
-        (&sphere, &[]),
+        (&sphere, &["--size", "2048x1536"]),
     ];
     for (k, (scene, args)) in cases.into_iter().enumerate() {
         let dir = out_dir(&format!("memory-{k}"));

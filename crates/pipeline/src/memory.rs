@@ -5,9 +5,10 @@
 //! depth: 8 bytes a pixel), every output image (they are all made before any is written), one
 //! output's working copy, and the geometry (the mesh, and each pass's transformed vertices and
 //! triangle set-ups). Its per-triangle bytes come from measuring peak resident memory on a
-//! 1.96 M-triangle sphere with one and two passes (about 24 bytes a triangle for the mesh and
-//! 55 a pass); `tests/interruptions.rs` holds the estimate above the measured peak of real
-//! renders and within a stated margin of it.
+//! 2 M-triangle sphere with one and two passes at 64×48 and at 4096×3072: about 24 bytes a
+//! triangle for the mesh, and per pass from 55 (at 64×48, where most triangles cover no pixel
+//! center and keep no set-up) to 254 (at 4096×3072, where most do); the estimate takes the
+//! larger. `tests/memory.rs` holds the estimate above the measured peak of real renders.
 
 use std::fmt;
 
@@ -19,8 +20,9 @@ use stereolab_core::{Error, Result};
 pub const FRAMEBUFFER_BYTES_PER_PIXEL: u64 = 8;
 /// Bytes a triangle's mesh takes (positions, normals, indices), measured.
 pub const MESH_BYTES_PER_TRIANGLE: u64 = 24;
-/// Bytes a triangle takes in each pass (clip-space vertices, set-ups), measured, rounded up.
-pub const PASS_BYTES_PER_TRIANGLE: u64 = 56;
+/// Bytes a triangle takes in each pass (clip-space vertices, its set-up), measured where every
+/// visible triangle keeps a set-up, rounded up.
+pub const PASS_BYTES_PER_TRIANGLE: u64 = 272;
 /// The process itself: code, the thread pool's stacks, the scene's text.
 pub const BASE_BYTES: u64 = 32 << 20;
 
