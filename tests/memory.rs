@@ -115,3 +115,36 @@ fn a_render_over_the_budget_is_refused_before_it_starts() {
     );
     assert_eq!(std::fs::read_dir(&dir).expect("dir").count(), 0);
 }
+
+/// `compare` reads every image `render` writes: a `side_by_side.png` is twice an eye's width,
+/// past the largest framebuffer side (16384) when the eye is at its widest.
+#[test]
+fn compare_reads_images_as_wide_as_the_widest_output() {
+    let dir = out_dir("compare-widest");
+    let width = 2 * stereolab_core::MAX_IMAGE_SIDE;
+    let img = image::RgbaImage::from_fn(width, 16, |x, y| {
+        image::Rgba([(x % 251) as u8, y as u8, 7, 255])
+    });
+    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+    img.save(&a).expect("a");
+    img.save(&b).expect("b");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .arg("compare")
+        .arg(&a)
+        .arg(&b)
+        .output()
+        .expect("compare");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    // One side past even that is still refused from the header.
+    let wider = image::RgbaImage::new(width + 1, 1);
+    wider.save(&a).expect("a");
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .arg("compare")
+        .arg(&a)
+        .arg(&b)
+        .output()
+        .expect("compare");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("32769x1"), "{err}");
+}

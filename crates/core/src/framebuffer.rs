@@ -12,9 +12,18 @@ pub const MAX_IMAGE_SIDE: u32 = 16384;
 /// before anything is allocated, so an absurd size never asks for gigabytes.
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 
+/// Largest side of an image file a command writes: two eye images beside each other
+/// (`side_by_side` of the widest framebuffer). What `compare` reads.
+pub const MAX_OUTPUT_SIDE: u32 = 2 * MAX_IMAGE_SIDE;
+
+/// Largest pixel count of an image file a command writes, with room to spare: two eye images
+/// and the rows between them (`above_below` of the largest framebuffer is twice its pixels).
+pub const MAX_OUTPUT_PIXELS: u64 = 3 * MAX_IMAGE_PIXELS;
+
 /// An RGBA8 color buffer and an f32 depth buffer in [0, 1] (1 = far plane), row 0 at the top.
 ///
-/// Valid by construction: its size is one [`check_size`] accepts, both buffers hold
+/// Valid by construction: its size is one [`check_size`] accepts (or, for buffers read from
+/// a file an output was written to, [`check_output_size`]), both buffers hold
 /// `width × height` values, and every depth is a window depth in [0, 1]. [`Framebuffer::new`]
 /// clears one, the rasterizer draws into it, [`Framebuffer::from_buffers`] checks buffers from
 /// elsewhere (files, the GPU's readback); nothing downstream checks them again.
@@ -93,9 +102,11 @@ impl Framebuffer {
     }
 
     /// A framebuffer of buffers made elsewhere (an image file, the GPU's readback), checked.
+    /// Its size may be any an output file has ([`check_output_size`]: a `side_by_side.png`
+    /// read back is twice an eye's width).
     ///
     /// # Errors
-    /// `Invalid` for a size [`check_size`] refuses, a buffer whose length is not
+    /// `Invalid` for a size [`check_output_size`] refuses, a buffer whose length is not
     /// `width × height`, or a depth that is not a number in [0, 1] (naming its pixel).
     pub fn from_buffers(
         width: u32,
@@ -103,7 +114,7 @@ impl Framebuffer {
         color: Vec<[u8; 4]>,
         depth: Vec<f32>,
     ) -> Result<Self> {
-        check_size(width, height)?;
+        check_output_size(width, height)?;
         let n = width as usize * height as usize;
         for (name, len) in [("color", color.len()), ("depth", depth.len())] {
             if len != n {
@@ -229,11 +240,34 @@ pub fn open_image(path: &std::path::Path, what: &str) -> Result<image::DynamicIm
     crate::files::open_image(path, what, MAX_IMAGE_SIDE, MAX_IMAGE_PIXELS)
 }
 
+/// Opens an image file as large as any a command writes ([`MAX_OUTPUT_SIDE`],
+/// [`MAX_OUTPUT_PIXELS`]): what `compare` reads, so every output `render` writes can be
+/// compared.
+///
+/// # Errors
+/// As [`crate::files::open_image`].
+pub fn open_output_image(path: &std::path::Path, what: &str) -> Result<image::DynamicImage> {
+    crate::files::open_image(path, what, MAX_OUTPUT_SIDE, MAX_OUTPUT_PIXELS)
+}
+
 /// Checks an image size before anything is allocated.
 ///
 /// # Errors
 /// `Invalid` for a zero side or a side above [`MAX_IMAGE_SIDE`].
 pub fn check_size(width: u32, height: u32) -> Result<()> {
+    check_size_within(width, height, MAX_IMAGE_SIDE, MAX_IMAGE_PIXELS)
+}
+
+/// Checks the size of an image an output file may have ([`MAX_OUTPUT_SIDE`],
+/// [`MAX_OUTPUT_PIXELS`]).
+///
+/// # Errors
+/// `Invalid` for a zero side, or a side or pixel count above those limits.
+pub fn check_output_size(width: u32, height: u32) -> Result<()> {
+    check_size_within(width, height, MAX_OUTPUT_SIDE, MAX_OUTPUT_PIXELS)
+}
+
+fn check_size_within(width: u32, height: u32, max_side: u32, max_pixels: u64) -> Result<()> {
     for (name, v) in [("width", width), ("height", height)] {
         if v == 0 {
             return Err(Error::invalid(
@@ -242,20 +276,20 @@ pub fn check_size(width: u32, height: u32) -> Result<()> {
                 "must be at least 1 pixel",
             ));
         }
-        if v > MAX_IMAGE_SIDE {
+        if v > max_side {
             return Err(Error::invalid(
                 format!("image.{name}"),
                 v,
-                format!("must be at most {MAX_IMAGE_SIDE} pixels"),
+                format!("must be at most {max_side} pixels"),
             ));
         }
     }
     let pixels = width as u64 * height as u64;
-    if pixels > MAX_IMAGE_PIXELS {
+    if pixels > max_pixels {
         return Err(Error::invalid(
             "image size",
             format!("{width}x{height}"),
-            format!("{pixels} pixels, more than the {MAX_IMAGE_PIXELS} accepted"),
+            format!("{pixels} pixels, more than the {max_pixels} accepted"),
         ));
     }
     Ok(())

@@ -32,7 +32,8 @@ pub use error::{Error, Result};
 pub use eye::Eye;
 pub use framebuffer::{
     BACK_LEFT, BACK_RIGHT, DrawBuffer, EyePair, Framebuffer, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE,
-    check_size, open_image,
+    MAX_OUTPUT_PIXELS, MAX_OUTPUT_SIDE, check_output_size, check_size, open_image,
+    open_output_image,
 };
 
 // The camera and the stereo rig: each formula a short function (`math::stereo`), the rig that

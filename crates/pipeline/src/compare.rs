@@ -393,8 +393,8 @@ pub fn compare_images(
     out: Option<&Path>,
 ) -> Result<Comparison> {
     let (de, da) = (
-        stereolab_core::open_image(expected, "image")?,
-        stereolab_core::open_image(actual, "image")?,
+        stereolab_core::open_output_image(expected, "image")?,
+        stereolab_core::open_output_image(actual, "image")?,
     );
     let to_fb = |img: &image::DynamicImage| -> Result<Framebuffer> {
         let img = img.to_rgba8();
