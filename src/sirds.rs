@@ -20,8 +20,9 @@ pub struct SirdsArgs {
     /// PNG, netpbm PGM/PPM/PAM (full scale: v / max), or float PFM (its own min..max).
     #[arg(long, conflicts_with = "scene")]
     pub depth: Option<PathBuf>,
-    /// With --depth only: which values are near, `white` (larger; netpbm, stereolab; the
-    /// default) or `black` (smaller; distance maps, Z-buffers).
+    /// With --depth only: which values are near, `white` (larger; netpbm, stereolab's
+    /// sirds_depth; the default unless the file says otherwise, as stereolab's left_depth.png
+    /// and right_depth.png do) or `black` (smaller; distance maps, Z-buffers).
     // No clap default, so that `report` sees whether it was given: clap drops `requires`
     // when the required argument conflicts with one present (a scene, --decode).
     #[arg(long, value_parser = ["white", "black"], requires = "depth")]
@@ -144,7 +145,13 @@ fn report(args: &SirdsArgs) -> Result<String> {
     }
     if let Some(path) = &args.depth {
         let settings = settings_from_sets(&args.sets)?;
-        let near = Near::parse(args.near.as_deref().unwrap_or("white"))?;
+        // `--near` when given; else what the file says (stereolab's own window depth: black
+        // is near); else white, netpbm's convention.
+        let told = stereolab_core::near_of_file(path).filter(|_| args.near.is_none());
+        let near = match &args.near {
+            Some(word) => Near::parse(word)?,
+            None => told.unwrap_or(Near::White),
+        };
         let d = settings.geometry.to_pixels()?;
         let netpbm = stereolab::output::sirds::Netpbm::of(&out).is_some();
         let (w, h, mapping) = super::with_spinner("making the autostereogram", || {
@@ -157,8 +164,13 @@ fn report(args: &SirdsArgs) -> Result<String> {
                 Ok((sirds.width, sirds.height, mapping))
             }
         })?;
+        let note = if told.is_some() {
+            "  the file is stereolab's window depth (black near): read as with --near black\n"
+        } else {
+            ""
+        };
         return Ok(format!(
-            "per-pixel SIRDS of {} ({w}x{h}), separations {:.1}..{:.1} px\n  depth map {mapping}\n  wrote {}\n",
+            "per-pixel SIRDS of {} ({w}x{h}), separations {:.1}..{:.1} px\n{note}  depth map {mapping}\n  wrote {}\n",
             path.display(),
             d.min_separation(),
             d.max_separation(),

@@ -503,3 +503,63 @@ fn cli_decodes_a_foreign_stereogram_into_a_pair() {
     );
     assert!(!depth.exists());
 }
+
+/// stereolab's own `left_depth.png` (window depth: black near) carries a PNG text chunk that
+/// ExifTool reads and `sirds --depth` follows: the SIRDS is the one `--near black` makes,
+/// not the inverted one `--near white` makes.
+#[test]
+fn stereolabs_window_depth_is_read_the_right_way_round() {
+    let dir = common::out_dir("sirds_window_depth");
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .args(args)
+            .output()
+            .expect("runs");
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let scene = common::asset("scenes/wuson.toml");
+    let d = dir.to_string_lossy().into_owned();
+    run(&[
+        "render",
+        &scene.to_string_lossy(),
+        "--size",
+        "320x240",
+        "--set",
+        "outputs=[\"left_depth\"]",
+        "--out",
+        &d,
+    ]);
+    let depth = dir.join("left_depth.png");
+    let exif = Command::new("exiftool")
+        .args(["-s", "-PNG:all"])
+        .arg(&depth)
+        .output()
+        .expect("exiftool (libimage-exiftool-perl) runs");
+    let tags = String::from_utf8_lossy(&exif.stdout);
+    assert!(
+        tags.contains("StereolabWindowDepth") && tags.contains("0 = near plane (black)"),
+        "{tags}"
+    );
+    let depth = depth.to_string_lossy().into_owned();
+    let sirds = |name: &str, near: Option<&str>| {
+        let out = dir.join(name).to_string_lossy().into_owned();
+        let mut args = vec!["sirds", "--depth", &depth, "-o", &out];
+        if let Some(n) = near {
+            args.extend(["--near", n]);
+        }
+        let report = run(&args);
+        (std::fs::read(&out).expect("sirds"), report)
+    };
+    let (found, report) = sirds("found.png", None);
+    assert!(
+        report.contains("stereolab's window depth (black near)"),
+        "{report}"
+    );
+    assert_eq!(found, sirds("black.png", Some("black")).0);
+    assert_ne!(found, sirds("white.png", Some("white")).0);
+}

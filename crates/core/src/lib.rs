@@ -134,7 +134,9 @@ pub use effects::sirds::decode::{
     decode_auto as decode_sirds_auto, depth_from_separation, matched_share_where_all_fit,
     nearness_linear, round_trip as sirds_round_trip,
 };
-pub use effects::sirds::depthfile::{DepthSamples, Near, PgmRows};
+pub use effects::sirds::depthfile::{
+    DepthSamples, Near, PgmRows, WINDOW_DEPTH_KEYWORD, WINDOW_DEPTH_TEXT, near_of_file,
+};
 pub use effects::sirds::depthmap::DepthMapping;
 pub use effects::sirds::disparity::{
     separation_eye_distance, separation_view_angle, tan_phi_eye_distance,

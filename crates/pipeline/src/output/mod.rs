@@ -269,6 +269,39 @@ pub fn rig_metadata(scene: &Scene) -> Result<RigMetadata> {
     })
 }
 
+/// Writes a window-depth image (`left_depth`, `right_depth`: 0 at the near plane, 65535 at
+/// the far plane) as a 16-bit gray PNG carrying the text chunk
+/// [`WINDOW_DEPTH_KEYWORD`](stereolab_core::WINDOW_DEPTH_KEYWORD), so that a reader (`sirds
+/// --depth`) knows that black is near.
+///
+/// # Errors
+/// As [`OutputSet::stage`], or the encoder failed.
+pub fn stage_window_depth(
+    set: &mut OutputSet,
+    path: &Path,
+    depth: &image::ImageBuffer<image::Luma<u16>, Vec<u16>>,
+) -> Result<()> {
+    let png_error = |e: png::EncodingError| Error::io(path, std::io::Error::other(e.to_string()));
+    set.stage(path, |w| {
+        let mut enc = png::Encoder::new(w, depth.width(), depth.height());
+        enc.set_color(png::ColorType::Grayscale);
+        enc.set_depth(png::BitDepth::Sixteen);
+        enc.add_text_chunk(
+            stereolab_core::WINDOW_DEPTH_KEYWORD.to_string(),
+            stereolab_core::WINDOW_DEPTH_TEXT.to_string(),
+        )
+        .map_err(png_error)?;
+        let mut writer = enc.write_header().map_err(png_error)?;
+        let bytes: Vec<u8> = depth
+            .as_raw()
+            .iter()
+            .flat_map(|v| v.to_be_bytes())
+            .collect();
+        writer.write_image_data(&bytes).map_err(png_error)?;
+        writer.finish().map_err(png_error)
+    })
+}
+
 /// Produces and writes every requested output as `DIR/<name>.png` (`.mpo`, `.jps`, `.pns` for
 /// the stereo photo formats); returns the paths.
 ///
@@ -312,17 +345,24 @@ pub fn write_all_reporting(
         .map(|&o| {
             let path = dir.join(o.file_name());
             check_output_path(&path)?;
-            Ok((path, make(o)?))
+            Ok((o, path, make(o)?))
         })
         .collect::<Result<Vec<_>>>()?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let mut set = OutputSet::new();
-    for (path, image) in &outputs {
+    for (o, path, image) in &outputs {
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        image.stage_reporting(&mut set, path, &mut |done, of| progress(&name, done, of))?;
+        match (o, image) {
+            (Output::LeftDepth | Output::RightDepth, Image::Gray16(depth)) => {
+                stage_window_depth(&mut set, path, depth)?;
+            }
+            _ => image.stage_reporting(&mut set, path, &mut |done, of| {
+                progress(&name, done, of);
+            })?,
+        }
     }
     set.commit()
 }

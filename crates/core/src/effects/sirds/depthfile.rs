@@ -64,6 +64,30 @@ impl Near {
     }
 }
 
+/// The keyword of the PNG text chunk in stereolab's window-depth outputs (`left_depth.png`,
+/// `right_depth.png`), whose values grow with distance: [`near_of_file`] finds it, so that
+/// `sirds --depth` reads them the right way round without `--near black`.
+pub const WINDOW_DEPTH_KEYWORD: &str = "stereolab window depth";
+
+/// The text of that chunk.
+pub const WINDOW_DEPTH_TEXT: &str = "0 = near plane (black) .. 65535 = far plane (white)";
+
+/// Which values a depth-map file itself says are near: [`Near::Black`] for a PNG holding
+/// stereolab's window-depth text chunk ([`WINDOW_DEPTH_KEYWORD`]), `None` when the file does
+/// not say (the reader then takes `--near`, white by default).
+pub fn near_of_file(path: &Path) -> Option<Near> {
+    let file = std::fs::File::open(path).ok()?;
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .ok()?;
+    let info = reader.info();
+    let says = info
+        .uncompressed_latin1_text
+        .iter()
+        .any(|t| t.keyword == WINDOW_DEPTH_KEYWORD);
+    says.then_some(Near::Black)
+}
+
 /// How a file's values became nearness: what `stereolab sirds --depth` prints.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DepthMapping {
