@@ -8,7 +8,7 @@ use stereolab::output::sirds::{from_frame, save, stream_depth_map};
 use stereolab::plan::{Output, Plan};
 use stereolab::render::render;
 use stereolab_core::{
-    DepthMap, Error, Near, Result, SirdsSettings, SirdsSpec, depth_from_separation, from_depth_map,
+    DepthMap, Error, Near, Result, SirdsSettings, depth_from_separation, from_depth_map,
 };
 
 /// Arguments of `stereolab sirds`.
@@ -58,25 +58,7 @@ pub struct SirdsArgs {
 
 /// Settings from `--set sirds.key=value` alone (no scene file).
 fn settings_from_sets(sets: &[String]) -> Result<SirdsSettings> {
-    let mut text = String::new();
-    for s in sets {
-        let (k, v) = s
-            .split_once('=')
-            .ok_or_else(|| Error::invalid("--set", s, "expected key=value"))?;
-        let k = k.trim().trim_start_matches("sirds.");
-        let v = v.trim();
-        // Bare words (nearest, color) become TOML strings.
-        let value = if toml::from_str::<toml::Table>(&format!("v = {v}")).is_ok() {
-            v.to_string()
-        } else {
-            format!("\"{v}\"")
-        };
-        text.push_str(&format!("{k} = {value}\n"));
-    }
-    let spec: SirdsSpec = toml::from_str(&text)
-        .map_err(|e| Error::invalid("--set", sets.join(" "), e.message().to_string()))?;
-    // Paths typed on the command line are the user's own: not confined.
-    SirdsSettings::from_spec(&spec, &stereolab_core::InputRoot::anywhere(Path::new(".")))
+    stereolab::scene::sirds_settings_from_sets(sets)
 }
 
 /// Whether `path` ends in one of `extensions` (ASCII case ignored).

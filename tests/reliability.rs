@@ -1004,6 +1004,48 @@ fn scene_type_errors_name_the_field_the_value_and_what_is_accepted() {
     assert!(!err.contains(&"w".repeat(41)), "{err}");
 }
 
+/// `--set` without a scene (`sirds --depth`, `--decode`) speaks as a scene's `--set` does, and
+/// a dots-per-inch past single precision is named, not reported as a NaN separation.
+#[test]
+fn sirds_sets_without_a_scene_name_the_key_the_value_and_what_is_accepted() {
+    let dir = out_dir("reliability-sirds-sets");
+    let map = dir.join("ramp.pgm");
+    let mut pgm = b"P5\n64 32\n255\n".to_vec();
+    pgm.extend((0..64 * 32).map(|i| (i % 64 * 4) as u8));
+    std::fs::write(&map, pgm).expect("pgm");
+    let (map, out) = (s(&map), s(&dir.join("o.png")));
+    let cases: [(&str, &[&str]); 6] = [
+        (
+            "sirds.dpi=abc",
+            &["--set sirds.dpi = abc: must be a number"],
+        ),
+        (
+            "sirds.dpi=",
+            &["--set sirds.dpi = \"\"", "empty", "must be a number"],
+        ),
+        (
+            "sirds.dpi=[1,2",
+            &["--set sirds.dpi = [1,2", "not a complete TOML value"],
+        ),
+        (
+            "sirds.nosuch=1",
+            &["--set sirds.nosuch = 1", "no such field in [sirds]", "dpi"],
+        ),
+        (
+            "camera.fov_y=40",
+            &["--set camera.fov_y = 40", "[sirds] fields only"],
+        ),
+        (
+            "sirds.dpi=1e38",
+            &["sirds.dpi = 1e38", "beyond single precision", "72 to 2400"],
+        ),
+    ];
+    for (set, says) in cases {
+        refused_with(&["sirds", "--depth", &map, "--set", set, "-o", &out], says);
+    }
+    assert!(!dir.join("o.png").exists());
+}
+
 #[test]
 fn set_errors_name_the_key_the_value_and_what_is_accepted() {
     let wuson = s(&asset("scenes/wuson.toml"));

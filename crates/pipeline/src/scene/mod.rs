@@ -682,6 +682,44 @@ fn set_value(raw: &str) -> String {
     }
 }
 
+/// `[sirds]` settings from `--set sirds.key=value` alone, without a scene (`stereolab sirds
+/// --depth`, `--decode`): each key must name a `[sirds]` field, and errors speak as a scene's
+/// do (the `--set`, the value as typed, what the field accepts).
+///
+/// # Errors
+/// `Invalid` naming the `--set` that does not apply.
+pub fn sirds_settings_from_sets(sets: &[String]) -> Result<stereolab_core::SirdsSettings> {
+    /// A scene file with nothing but its `[sirds]` table.
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct SirdsOnly {
+        #[serde(default)]
+        sirds: stereolab_core::SirdsSpec,
+    }
+    for set in sets {
+        let (key, raw) = set.split_once('=').unwrap_or((set.as_str(), ""));
+        let key = key.trim();
+        if !key.starts_with("sirds.") {
+            return Err(Error::invalid(
+                format!("--set {}", stereolab_core::excerpt(key)),
+                set_value(raw),
+                "without a scene, --set sets [sirds] fields only (e.g. sirds.dpi=100); give a \
+                 scene to set its other fields",
+            ));
+        }
+    }
+    let mut table = toml::Table::new();
+    apply_sets(&mut table, sets)?;
+    let only: SirdsOnly = toml::Value::Table(table.clone())
+        .try_into()
+        .map_err(|e| field_error(Path::new("--set"), "", &table, sets, &e))?;
+    // Paths typed on the command line are the user's own: not confined.
+    stereolab_core::SirdsSettings::from_spec(
+        &only.sirds,
+        &stereolab_core::InputRoot::anywhere(Path::new(".")),
+    )
+}
+
 /// Applies `--set key=value` overrides to a scene file's table, in order (what
 /// [`Scene::load`] does before it reads the table; `stereolab view` writes the result back).
 ///

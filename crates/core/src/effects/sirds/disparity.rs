@@ -157,14 +157,29 @@ impl Geometry {
             }
             None => tan_phi_eye_distance(t_far, a, f),
         };
-        Ok(Disparity {
+        let d = Disparity {
             model: self.model,
             eye_separation: a,
             viewing_distance: f,
             t_near: px(self.depth_near_in),
             t_far,
             tan_phi,
-        })
+        };
+        // Lengths in inches times the dots per inch: past single precision the separations
+        // come out infinite or NaN; name the field that scales them all.
+        let (front, back) = (d.min_separation(), d.max_separation());
+        if !(front.is_finite() && back.is_finite() && t_far.is_finite() && tan_phi.is_finite()) {
+            return Err(Error::invalid(
+                "sirds.dpi",
+                format!("{:?}", self.dpi),
+                format!(
+                    "with these lengths in inches the separations are beyond single precision \
+                     ({front} .. {back} px); give the dots per inch of a screen or a printer \
+                     (72 to 2400)"
+                ),
+            ));
+        }
+        Ok(d)
     }
 }
 
