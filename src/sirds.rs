@@ -202,10 +202,35 @@ fn report(args: &SirdsArgs) -> Result<String> {
     ))
 }
 
-/// `stereolab sirds --decode_sirds`: searches the full plausible separation range, decodes, writes
+/// Runs `work`, which reports `(bands done, bands)`, with a progress bar on a terminal's
+/// stderr once it has run a second: the share of the rows decoded, the time elapsed and an
+/// estimate of the rest (never into a pipe or a file).
+fn with_rows_bar<T>(what: &str, work: impl FnOnce(&(dyn Fn(usize, usize) + Sync)) -> T) -> T {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::hidden())
+        .with_message(what.to_string());
+    if let Ok(style) = ProgressStyle::with_template(
+        "{msg} {bar:30} {percent}% of the rows, {elapsed} (about {eta} left)",
+    ) {
+        bar.set_style(style);
+    }
+    let shown = std::sync::Once::new();
+    // Bands finish in any order: each call adds one.
+    let result = work(&|_, of| {
+        bar.set_length(of as u64);
+        bar.inc(1);
+        if bar.elapsed() > std::time::Duration::from_secs(1) {
+            shown.call_once(|| bar.set_draw_target(ProgressDrawTarget::stderr()));
+        }
+    });
+    bar.finish_and_clear();
+    result
+}
+
+/// `stereolab sirds --decode`: searches the full plausible separation range, decodes, writes
 /// the depth (and with `--pair` the two views and their anaglyph); returns the report.
 fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
-    use stereolab_core::{SeparationSearchOptions, decode_sirds_auto, nearness_linear};
+    use stereolab_core::{SeparationSearchOptions, decode_sirds_auto_reporting, nearness_linear};
 
     // Told the set-up: by the scene's [sirds] table (with --set applied), or by --set alone.
     let told = args.scene.is_some() || !args.sets.is_empty();
@@ -219,8 +244,8 @@ fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
     if told {
         return decode_told(args, path, out, &settings, &pixels, w, h);
     }
-    let auto = super::with_spinner(&format!("decoding {}", path.display()), || {
-        decode_sirds_auto(&pixels, w, h, &SeparationSearchOptions::default())
+    let auto = with_rows_bar(&format!("decoding {}", path.display()), |progress| {
+        decode_sirds_auto_reporting(&pixels, w, h, &SeparationSearchOptions::default(), progress)
     })
     .map_err(|e| e.in_file(path))?;
     let search = &auto.search;
@@ -279,7 +304,7 @@ fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
     Ok(report)
 }
 
-/// `--decode_sirds` told the viewing set-up (a scene or `--set sirds.*`): decodes over the
+/// `--decode` told the viewing set-up (a scene or `--set sirds.*`): decodes over the
 /// separations the model can produce ([`SirdsDecodeOptions::for_disparity`]), no search, and maps
 /// separation to depth through the model (eq. 1 or eq. 3; cross-eyed inverts depth).
 #[allow(clippy::too_many_arguments)]
@@ -293,12 +318,12 @@ fn decode_told(
     h: u32,
 ) -> Result<String> {
     use stereolab_core::{
-        DecodedSirds, SirdsDecodeOptions, decode_sirds, matched_share_where_all_fit,
+        DecodedSirds, SirdsDecodeOptions, decode_sirds_reporting, matched_share_where_all_fit,
     };
     let d = settings.geometry.to_pixels()?;
     let opts = SirdsDecodeOptions::for_disparity(&d);
-    let decoded = super::with_spinner(&format!("decoding {}", path.display()), || {
-        decode_sirds(pixels, w, h, &opts)
+    let decoded = with_rows_bar(&format!("decoding {}", path.display()), |progress| {
+        decode_sirds_reporting(pixels, w, h, &opts, progress)
     })
     .map_err(|e| e.in_file(path))?;
     let mut report = format!(

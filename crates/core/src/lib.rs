@@ -131,7 +131,8 @@ pub use effects::chromadepth::{
 pub use effects::sirds::decode::{
     AUTOSTEREOGRAM_SHARE, AutoDecoded as AutoDecodedSirds, DecodeOptions as SirdsDecodeOptions,
     Decoded as DecodedSirds, RoundTrip as SirdsRoundTrip, decode as decode_sirds,
-    decode_auto as decode_sirds_auto, depth_from_separation, matched_share_where_all_fit,
+    decode_auto as decode_sirds_auto, decode_auto_reporting as decode_sirds_auto_reporting,
+    decode_reporting as decode_sirds_reporting, depth_from_separation, matched_share_where_all_fit,
     nearness_linear, round_trip as sirds_round_trip,
 };
 pub use effects::sirds::depthfile::{

@@ -83,6 +83,21 @@ pub fn decode(
     height: u32,
     opts: &DecodeOptions,
 ) -> Result<Decoded> {
+    decode_reporting(pixels, width, height, opts, &|_, _| {})
+}
+
+/// [`decode`], calling `progress(bands done, bands)` as each band of rows is finished (from
+/// the worker threads, in any order): what a progress bar shows.
+///
+/// # Errors
+/// As [`decode`].
+pub fn decode_reporting(
+    pixels: &[[u8; 4]],
+    width: u32,
+    height: u32,
+    opts: &DecodeOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Decoded> {
     let (w, h) = (width as usize, height as usize);
     if w == 0 || h == 0 || pixels.len() != w * h {
         return Err(Error::invalid(
@@ -100,10 +115,21 @@ pub fn decode(
         ));
     }
     let mut separation = vec![f32::NAN; w * h];
+    let (bands, done) = (
+        h.div_ceil(BAND_ROWS),
+        std::sync::atomic::AtomicUsize::new(0),
+    );
     let tested: usize = separation
         .par_chunks_mut(w * BAND_ROWS)
         .enumerate()
-        .map(|(band, out)| decode_band(pixels, w, h, band * BAND_ROWS, out, lo, hi, opts))
+        .map(|(band, out)| {
+            let tested = decode_band(pixels, w, h, band * BAND_ROWS, out, lo, hi, opts);
+            progress(
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                bands,
+            );
+            tested
+        })
         .sum();
     let matched = separation.iter().filter(|s| s.is_finite()).count();
     Ok(Decoded {
@@ -344,6 +370,21 @@ pub fn decode_auto(
     height: u32,
     opts: &SearchOptions,
 ) -> Result<AutoDecoded> {
+    decode_auto_reporting(pixels, width, height, opts, &|_, _| {})
+}
+
+/// [`decode_auto`], reporting the decoding's progress as [`decode_reporting`] does (the
+/// search before it has a bounded cost).
+///
+/// # Errors
+/// As [`decode_auto`].
+pub fn decode_auto_reporting(
+    pixels: &[[u8; 4]],
+    width: u32,
+    height: u32,
+    opts: &SearchOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<AutoDecoded> {
     let search = super::search::search(pixels, width, height, opts)?;
     let Some((lo, hi)) = search.found else {
         return Ok(AutoDecoded {
@@ -360,7 +401,7 @@ pub fn decode_auto(
         half_height: 3,
         max_cost_ratio: opts.max_cost_ratio,
     };
-    let decoded = decode(pixels, width, height, &options)?;
+    let decoded = decode_reporting(pixels, width, height, &options, progress)?;
     Ok(AutoDecoded {
         search,
         options: Some(options),
