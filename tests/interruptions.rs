@@ -1,6 +1,7 @@
 //! Whatever ends a run, nothing is left half-written: Ctrl-C, SIGTERM, a file-size limit, a
 //! killed earlier run's leftovers, an output set that cannot be finished (render, figures,
-//! `sirds --decode --pair`, `exercises export`), and an unbounded thread count.
+//! `sirds --decode --pair`, `exercises export`), and an unbounded thread count; a long run
+//! says how far it is on a terminal.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -287,4 +288,47 @@ fn a_thread_count_beyond_the_cap_is_lowered_and_said() {
             "{n}"
         );
     }
+}
+
+/// A long run on a terminal (`script` from util-linux gives the command a pseudo-terminal)
+/// shows a bar with the fields written and an estimate; into a pipe it prints none.
+#[cfg(unix)]
+#[test]
+fn a_long_animation_shows_its_progress_on_a_terminal_only() {
+    let dir = out_dir("progress-bar");
+    let log = dir.join("terminal.log");
+    let command = format!(
+        "{} render {} --size 1024x768 --set frame_sequential.cycles=10 --out {}",
+        env!("CARGO_BIN_EXE_stereolab"),
+        asset("scenes/frame_sequential.toml").display(),
+        dir.join("out").display()
+    );
+    let out = Command::new("script")
+        .args(["-qec", &command])
+        .arg(&log)
+        .stdin(Stdio::null())
+        .output()
+        .expect("script (util-linux) runs");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let seen = String::from_utf8_lossy(&std::fs::read(&log).expect("log")).into_owned();
+    assert!(
+        seen.contains("writing frame_sequential.png") && seen.contains("/20 fields"),
+        "{seen}"
+    );
+    assert!(seen.contains("left)"), "no estimate: {seen}");
+    let piped = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .arg("render")
+        .arg(asset("scenes/frame_sequential.toml"))
+        .args([
+            "--size",
+            "1024x768",
+            "--set",
+            "frame_sequential.cycles=10",
+            "--out",
+        ])
+        .arg(dir.join("piped"))
+        .output()
+        .expect("render");
+    assert!(piped.status.success());
+    assert!(!stderr(&piped).contains("fields"), "{}", stderr(&piped));
 }
