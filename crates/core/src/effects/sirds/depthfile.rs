@@ -305,15 +305,18 @@ fn load_pfm(path: &Path, head: &[u8], near: Near) -> Result<DepthSamples> {
             f32::from_be_bytes(b)
         }
     };
-    // Rec. 709 luma, as the image crate weighs color.
-    let sample = |i: usize| {
+    // Rec. 709 luma, as the image crate weighs color. In f64: the luma of three samples near
+    // f32's largest value, and the span between −3e38 and 3e38, overflow f32.
+    let sample = |i: usize| -> f64 {
         if channels == 1 {
-            value(i)
+            f64::from(value(i))
         } else {
-            0.2126 * value(3 * i) + 0.7152 * value(3 * i + 1) + 0.0722 * value(3 * i + 2)
+            0.2126 * f64::from(value(3 * i))
+                + 0.7152 * f64::from(value(3 * i + 1))
+                + 0.0722 * f64::from(value(3 * i + 2))
         }
     };
-    let (mut lo, mut hi, mut non_finite) = (f32::INFINITY, f32::NEG_INFINITY, 0usize);
+    let (mut lo, mut hi, mut non_finite) = (f64::INFINITY, f64::NEG_INFINITY, 0usize);
     for i in 0..n {
         let v = sample(i);
         if v.is_finite() {
@@ -343,11 +346,7 @@ fn load_pfm(path: &Path, head: &[u8], near: Near) -> Result<DepthSamples> {
             *out = (z.clamp(0.0, 1.0) * 65535.0).round() as u16;
         }
     }
-    let (lo, hi) = if lo <= hi {
-        (f64::from(lo), f64::from(hi))
-    } else {
-        (0.0, 0.0)
-    };
+    let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 0.0) };
     let (far_value, near_value) = match near {
         Near::White => (lo, hi),
         Near::Black => (hi, lo),
@@ -623,6 +622,46 @@ mod tests {
                 "{} streamed",
                 path.display()
             );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A float PFM holding an 8-bit map's values scaled and shifted to f32's extremes
+    /// (`v · 2.6e36 − 3.3e38`, gray and as RGB) reads as the same nearness as the 8-bit PGM of
+    /// `v`: min..max in the one is 0..255 full scale in the other; the span (6.6e38, past f32's
+    /// largest value) is taken in f64.
+
+    #[test]
+    fn a_pfm_at_the_extremes_reads_as_the_8_bit_map_it_scales() {
+        let dir = std::env::temp_dir().join(format!("stereolab-pfm-ext-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let (w, h) = (16u32, 16u32);
+        let v: Vec<u8> = (0..w * h).map(|i| (i % 256) as u8).collect();
+        let pgm = dir.join("v.pgm");
+        let mut bytes = format!("P5\n{w} {h}\n255\n").into_bytes();
+        bytes.extend(&v);
+        std::fs::write(&pgm, bytes).expect("pgm");
+        let scaled = |b: u8| (f64::from(b) * 2.6e36 - 3.3e38) as f32;
+        // PFM rows run from the bottom up.
+        let rows_up = |channels: usize| -> Vec<u8> {
+            (0..h as usize)
+                .rev()
+                .flat_map(|y| v[y * w as usize..(y + 1) * w as usize].to_vec())
+                .flat_map(|b| std::iter::repeat_n(scaled(b).to_le_bytes(), channels))
+                .flatten()
+                .collect()
+        };
+        for (name, magic, channels) in [("g.pfm", "Pf", 1), ("c.pfm", "PF", 3)] {
+            let path = dir.join(name);
+            let mut bytes = format!("{magic}\n{w} {h}\n-1.0\n").into_bytes();
+            bytes.extend(rows_up(channels));
+            std::fs::write(&path, bytes).expect("pfm");
+            for near in [Near::White, Near::Black] {
+                let pfm = DepthSamples::load(&path, near).expect("pfm loads");
+                let reference = DepthSamples::load(&pgm, near).expect("pgm loads");
+                assert_eq!(pfm.mapping.non_finite, 0, "{name}");
+                assert!(pfm.samples == reference.samples, "{name} {near:?}");
+            }
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
