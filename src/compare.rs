@@ -131,7 +131,14 @@ pub fn run(args: CompareArgs) -> Result<()> {
         1 => "1 limit exceeded (a limit is set with --threshold KEY=VALUE)".to_string(),
         n => format!("{n} limits exceeded (a limit is set with --threshold KEY=VALUE)"),
     };
-    let lines: Vec<String> = violations.into_iter().chain(problems).collect();
+    let mut lines: Vec<String> = violations.into_iter().chain(problems).collect();
+    if out.is_none() {
+        lines.push(
+            "no difference image was written: add --out DIR for `expected | diff | actual` \
+             strips that show where"
+                .to_string(),
+        );
+    }
     Err(Error::parse(
         &judged,
         None,

@@ -778,6 +778,14 @@ fn a_failed_compare_names_each_exceeded_limit_and_by_how_much() {
         err.contains("(psnr=)") && !err.contains("(coverage=)"),
         "{err}"
     );
+    // Without --out no strip is written, and the failure says how to get one; with it, it is.
+    assert!(err.contains("add --out DIR"), "{err}");
+    let strips = dir.join("strips");
+    let out = stereolab(&["compare", &square, &blank, "--out", &s(&strips)]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("add --out DIR"), "{err}");
+    assert!(strips.join("blank-diff.png").is_file(), "{err}");
 }
 
 /// `--near` says which values of a depth map are near: without `--depth` there is no map, and
