@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use super::BenchOptions;
 use super::accuracy::{Scale, knobs};
 use stereolab::scene::Scene;
-use stereolab_core::{Error, Result, write_bytes};
+use stereolab_core::{Error, OutputSet, Result};
 use stereolab_figures::plot::{Knob, knob_plot, time_scale};
 
 /// The knobs whose plots the slides show (copied as `accuracy_<id>.png` into the slides'
@@ -427,27 +427,24 @@ pub fn write_report(bench: &BenchOptions, opts: &ReportOptions) -> Result<Writte
     let mut scene = Scene::load(&bench.scene, &[])?;
     scene.set_size(scale.width, scale.height)?;
     let knobs = knobs(&scene, scale)?;
-    let mut files = Vec::new();
+    // The plots, the slides' copies and the two pages: all written, or none.
+    let mut set = OutputSet::new();
     for k in &knobs {
         let png = knob_plot(k)?.png()?;
-        let path = opts.dir.join(format!("{}.png", k.id));
-        write_bytes(&path, &png)?;
-        files.push(path);
+        set.stage_bytes(&opts.dir.join(format!("{}.png", k.id)), &png)?;
         if let Some(slides) = &opts.slides
             && SLIDE_KNOBS.contains(&k.id.as_str())
         {
-            let path = slides.join(format!("accuracy_{}.png", k.id));
-            write_bytes(&path, &png)?;
-            files.push(path);
+            set.stage_bytes(&slides.join(format!("accuracy_{}.png", k.id)), &png)?;
         }
     }
     let pre = preamble(&bench.scene, opts.quick, scale);
-    let md = opts.dir.join("report.md");
-    write_bytes(&md, markdown(&knobs, &pre).as_bytes())?;
-    let page = opts.dir.join("report.html");
-    write_bytes(&page, html(&knobs, &pre).as_bytes())?;
-    files.push(md);
-    files.push(page);
+    set.stage_bytes(
+        &opts.dir.join("report.md"),
+        markdown(&knobs, &pre).as_bytes(),
+    )?;
+    set.stage_bytes(&opts.dir.join("report.html"), html(&knobs, &pre).as_bytes())?;
+    let files = set.commit()?;
     Ok(Written { knobs, files })
 }
 

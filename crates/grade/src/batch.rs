@@ -232,8 +232,11 @@ fn write_entry(out: &Path, entry: &BatchEntry, took: std::time::Duration) -> Res
     json["execution_time"] = took.as_secs().into();
     let json = serde_json::to_string_pretty(&json)
         .map_err(|e| Error::io(&dir, std::io::Error::other(e)))?;
-    stereolab_core::write_bytes(&dir.join("results.json"), json.as_bytes())?;
-    stereolab_core::write_bytes(&dir.join("report.txt"), text.as_bytes())
+    // The two files of one submission: both written, or neither.
+    let mut set = stereolab_core::OutputSet::new();
+    set.stage_bytes(&dir.join("results.json"), json.as_bytes())?;
+    set.stage_bytes(&dir.join("report.txt"), text.as_bytes())?;
+    set.commit().map(drop)
 }
 
 /// A CSV field: quoted when it holds a comma, quote or line break; a field a spreadsheet would
