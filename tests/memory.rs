@@ -72,7 +72,33 @@ fn the_estimate_holds_the_measured_peak() {
          eye_separation = 0.2\nzero_parallax = 5\n[[mesh]]\nkind = \"sphere\"\ndetail = 700\n",
     )
     .expect("scene");
-    let cases: [(&Path, &[&str]); 5] = [
+    // Separate triangles, three vertices each: the per-vertex term.
+    let soup = sphere.with_file_name("soup.toml");
+    let mut obj = String::new();
+    for i in 0..200_000u32 {
+        let (x, y) = (
+            f64::from(i % 450) / 225.0 - 1.0,
+            f64::from(i / 450) / 225.0 - 1.0,
+        );
+        obj += &format!(
+            "v {x} {y} 0\nv {} {y} 0\nv {x} {} 0\n",
+            x + 0.004,
+            y + 0.004
+        );
+    }
+    for i in 0..200_000u32 {
+        obj += &format!("f {} {} {}\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
+    }
+    std::fs::write(soup.with_file_name("soup.obj"), obj).expect("obj");
+    std::fs::write(
+        &soup,
+        std::fs::read_to_string(&sphere).expect("scene").replace(
+            "kind = \"sphere\"\ndetail = 700",
+            "kind = \"obj\"\npath = \"soup.obj\"",
+        ),
+    )
+    .expect("scene");
+    let cases: [(&Path, &[&str]); 6] = [
         (&asset("scenes/anaglyph.toml"), &["--size", "2048x2048"]),
         (&asset("scenes/wuson.toml"), &["--size", "2048x1536"]),
         (&asset("scenes/sirds_fig5.toml"), &["--size", "2048x1024"]),
@@ -81,6 +107,7 @@ fn the_estimate_holds_the_measured_peak() {
             &["--size", "1024x768"],
         ),
         (&sphere, &["--size", "2048x1536"]),
+        (&soup, &["--size", "1024x768"]),
     ];
     for (k, (scene, args)) in cases.into_iter().enumerate() {
         let dir = out_dir(&format!("memory-{k}"));

@@ -4,11 +4,13 @@
 //! The model counts what a render holds at once: one framebuffer a pass (8-bit RGBA and an f32
 //! depth: 8 bytes a pixel), every output image (they are all made before any is written), one
 //! output's working copy, and the geometry (the mesh, and each pass's transformed vertices and
-//! triangle set-ups). Its per-triangle bytes come from measuring peak resident memory on a
-//! 2 M-triangle sphere with one and two passes at 64×48 and at 4096×3072: about 24 bytes a
-//! triangle for the mesh, and per pass from 55 (at 64×48, where most triangles cover no pixel
-//! center and keep no set-up) to 254 (at 4096×3072, where most do); the estimate takes the
-//! larger. `tests/memory.rs` holds the estimate above the measured peak of real renders.
+//! triangle set-ups). Its per-vertex and per-triangle bytes come from measuring peak resident
+//! memory with one and two passes on two meshes: a 2 M-triangle sphere (half a vertex a
+//! triangle) at 4096×3072, where most triangles keep a set-up, and a 1 M-triangle OBJ of
+//! separate triangles (three vertices each). A pass took about 83 bytes a vertex and 213 a
+//! triangle; the estimate rounds them up, and counts every triangle as keeping a set-up (at
+//! 64×48 most cover no pixel center and keep none, so small images are overestimated).
+//! `tests/memory.rs` holds the estimate above the measured peak of real renders.
 
 use std::fmt;
 
@@ -18,11 +20,16 @@ use stereolab_core::{Error, Result};
 
 /// Bytes of one framebuffer pixel: RGBA8 color and f32 depth.
 pub const FRAMEBUFFER_BYTES_PER_PIXEL: u64 = 8;
-/// Bytes a triangle's mesh takes (positions, normals, indices), measured.
-pub const MESH_BYTES_PER_TRIANGLE: u64 = 24;
-/// Bytes a triangle takes in each pass (clip-space vertices, its set-up), measured where every
-/// visible triangle keeps a set-up, rounded up.
-pub const PASS_BYTES_PER_TRIANGLE: u64 = 272;
+/// Bytes a vertex of a mesh takes (position and normal).
+pub const MESH_BYTES_PER_VERTEX: u64 = 24;
+/// Bytes a triangle of a mesh takes (three indices).
+pub const MESH_BYTES_PER_TRIANGLE: u64 = 12;
+/// Bytes a vertex takes in each pass (its clip-space and window positions, its varyings),
+/// measured, rounded up.
+pub const PASS_BYTES_PER_VERTEX: u64 = 96;
+/// Bytes a triangle takes in each pass (its set-up), measured where most triangles keep one,
+/// rounded up.
+pub const PASS_BYTES_PER_TRIANGLE: u64 = 224;
 /// The process itself: code, the thread pool's stacks, the scene's text.
 pub const BASE_BYTES: u64 = 32 << 20;
 
@@ -67,12 +74,14 @@ pub fn estimate(scene: &Scene, plan: &Plan) -> MemoryEstimate {
     let held: f64 = plan.outputs.iter().map(|&o| images_held(o)).sum();
     let working = if plan.outputs.is_empty() { 0.0 } else { 1.0 };
     let outputs = ((held + working) * eye_image).ceil() as u64;
-    let triangles: u64 = scene
-        .objects
-        .iter()
-        .map(|o| o.mesh.triangles.len() as u64)
-        .sum();
-    let geometry = triangles * (MESH_BYTES_PER_TRIANGLE + passes * PASS_BYTES_PER_TRIANGLE);
+    let (vertices, triangles) = scene.objects.iter().fold((0u64, 0u64), |(v, t), o| {
+        (
+            v + o.mesh.positions.len() as u64,
+            t + o.mesh.triangles.len() as u64,
+        )
+    });
+    let geometry = vertices * (MESH_BYTES_PER_VERTEX + passes * PASS_BYTES_PER_VERTEX)
+        + triangles * (MESH_BYTES_PER_TRIANGLE + passes * PASS_BYTES_PER_TRIANGLE);
     let held = framebuffers + outputs + geometry;
     MemoryEstimate {
         framebuffers,
