@@ -365,8 +365,8 @@ const BUDGET_ADVICE: &str = "simplify the model, or raise the budget with --max-
 
 /// One pass over an OBJ file's lines: each is checked as it comes, what the budget allows is
 /// counted, and the lines tobj needs are kept in a checked form (coordinates as the numbers
-/// read, face indices resolved to absolute ones, names, comments, materials, points and
-/// polylines left out), so nothing past the budget or malformed is ever held.
+/// read, face indices resolved to absolute ones; names, comments, materials, points and
+/// two-point lines left out), so nothing past the budget or malformed is ever held.
 struct Reader<'p> {
     /// Named in messages.
     path: &'p Path,
@@ -408,6 +408,9 @@ impl<'p> Reader<'p> {
         match words.next() {
             Some(tag @ ("v" | "vt" | "vn")) => self.vertex(line, raw, tag, words),
             Some("f") => self.face(line, raw, words),
+            // A polyline of 3 or more points is read as a polygon, as tobj reads it; shorter
+            // ones (lines, points) draw nothing.
+            Some("l") if words.clone().nth(2).is_some() => self.face(line, raw, words),
             // A new object or group: tobj keeps the faces of each apart (their vertices are
             // not shared); the name is of no use here.
             Some("o" | "g") => {
@@ -863,6 +866,9 @@ mod tests {
         );
         let err = refusal(&format!("{SQUARE}l 1/2/3/4/5 2\nf 1 2 x\n"));
         assert_eq!(err, "t.obj:7: face vertex index 'x' is not an integer");
+        // A polyline of 3 or more points is a polygon.
+        let mesh = parse_obj(path(), format!("{SQUARE}l 9 9\nl 1 2 3\n")).unwrap();
+        assert_eq!(mesh.triangles.len(), 3);
     }
 
     #[test]
