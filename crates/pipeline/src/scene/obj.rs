@@ -112,7 +112,7 @@ pub fn load_obj_within(path: &Path, max_triangles: u64) -> Result<(Mesh, Vec<Str
 fn decode_utf16(path: &Path, bytes: &[u8]) -> Result<String> {
     let big_endian = bytes.starts_with(&[0xFE, 0xFF]);
     let body = &bytes[2..];
-    if body.len() % 2 != 0 {
+    if !body.len().is_multiple_of(2) {
         return Err(Error::parse(
             path,
             None,
