@@ -1175,3 +1175,103 @@ fn a_utf16_scene_without_a_byte_order_mark_is_named() {
         assert!(!err.contains("key with no value"), "{name}: {err}");
     }
 }
+
+/// A model file is held to the triangle budget while it is read: the line or row that passes
+/// it is named with the budget and the flag, whatever the rest of the file holds; a malformed
+/// OBJ line is named and quoted.
+#[test]
+fn model_files_are_refused_at_the_line_that_passes_the_budget_or_breaks_the_format() {
+    let dir = out_dir("reliability-reading");
+    let square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+    let faces = "f 1 2 3\n".repeat(11);
+    let cases: [(&str, &str, String, &[&str], &str); 6] = [
+        (
+            "obj",
+            "over.obj",
+            // The 11th face passes a budget of 10; line 16 is never read.
+            format!("{square}{faces}f 1 2 99\n"),
+            &["--max-triangles", "10"],
+            "over.obj:15: the faces so far make 11 triangles, more than the scene's budget of \
+             10: simplify the model, or raise the budget with --max-triangles",
+        ),
+        (
+            "obj",
+            "vertices.obj",
+            "v 0 0 0\n".repeat(31),
+            &["--max-triangles", "10"],
+            "vertices.obj:31: more than 30 'v' lines, 3 per triangle of the scene's budget of 10 \
+             triangles",
+        ),
+        (
+            "obj",
+            "seven.obj",
+            format!("{square}v 1 2 3 4 5 6 7\nf 1 2 3\n"),
+            &[],
+            "seven.obj:5: 'v' needs 3 coordinates (4 with a weight w, 6 with a color r g b), \
+             found more: 'v 1 2 3 4 5 6 7'",
+        ),
+        (
+            "obj",
+            "corner.obj",
+            format!("{square}vt 0 0\nvn 0 0 1\nf 1/1/1/1 2/1/1 3/1/1\n"),
+            &[],
+            "corner.obj:7: face corner '1/1/1/1' has 4 parts: a corner is v, v/vt, v//vn or \
+             v/vt/vn",
+        ),
+        (
+            "terrain",
+            "over.csv",
+            "x,y,height\n0,0,0\n1,0,0\n0,1,0\n1,1,0\n1,2,0\n2,2,x\n".to_string(),
+            &["--max-triangles", "8"],
+            "over.csv:6: more than 4 points, which could make more than the scene's budget of 8 \
+             triangles (up to 2 per point): thin the data, or raise the budget with \
+             --max-triangles",
+        ),
+        (
+            "obj",
+            "fine.obj",
+            format!("{square}{faces}"),
+            &["--max-triangles", "11"],
+            "",
+        ),
+    ];
+    for (kind, name, text, flags, says) in cases {
+        std::fs::write(dir.join(name), text).unwrap();
+        let scene = s(&scene_reading(&dir, kind, name, ""));
+        let mut args = vec!["info", &scene];
+        args.extend(flags);
+        let out = stereolab(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        if says.is_empty() {
+            assert!(out.status.success(), "{name}: {err}");
+            continue;
+        }
+        assert_eq!(out.status.code(), Some(1), "{name}: {err}");
+        assert!(err.contains(says), "{name}: {err}");
+    }
+}
+
+/// The largest DEM count is accepted with the budget its refusal names, and the default budget
+/// names the largest count it takes.
+#[test]
+fn the_largest_dem_count_names_the_budget_it_needs() {
+    let dir = out_dir("reliability-dem");
+    image::GrayImage::from_fn(4, 3, |x, _| image::Luma([(x * 80) as u8]))
+        .save(dir.join("ramp.png"))
+        .unwrap();
+    let extra = "";
+    let scene = scene_reading(&dir, "dem", "ramp.png", extra);
+    let text = std::fs::read_to_string(&scene).unwrap()
+        + "extent = [1, 1]\nheights = [0, 1]\ncount = 2000000\n";
+    std::fs::write(&scene, text).unwrap();
+    let out = stereolab(&["info", &s(&scene)]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("mesh[0].count")
+            && err.contains("up to 4005658 triangles")
+            && err.contains("the budget takes count = 1997173 at most")
+            && err.contains("--max-triangles 4005658"),
+        "{err}"
+    );
+}

@@ -19,8 +19,50 @@ use stereolab_core::{Error, Result};
 pub const MAX_DEM_SIDE: u32 = 8192;
 /// The most DEM pixels accepted.
 pub const MAX_DEM_PIXELS: u64 = 16 * 1024 * 1024;
-/// The most scattered points a DEM may be sampled at.
+/// The most scattered points a DEM may be sampled at. With the border points
+/// ([`sample_points`]) they make up to [`most_triangles`]`(2 000 000)` = 4 005 658 triangles,
+/// a little over the default budget: the default budget takes up to
+/// [`most_points_within`]`(4 000 000)` = 1 997 173 points, and `--max-triangles 4005658` takes
+/// the maximum.
 pub const MAX_DEM_POINTS: u32 = 2_000_000;
+
+/// The border points [`sample_points`] adds to `points` scattered ones: each edge of the
+/// rectangle split into `⌈√points⌉` steps.
+pub fn border_points(points: u32) -> u64 {
+    4 * u64::from((f64::from(points).sqrt().ceil() as u32).max(1))
+}
+
+/// The most triangles a DEM sampled at `points` scattered points makes: a Delaunay
+/// triangulation of `n` distinct points, `h` of them on the boundary of their convex hull, has
+/// `2n − 2 − h` triangles; the border points lie on that boundary, so with `b` of them (and
+/// scattered points that may fall on an edge too) there are at most
+/// `2 (points + b) − 2 − b = 2 · points + b − 2`.
+pub fn most_triangles(points: u32) -> u64 {
+    2 * u64::from(points) + border_points(points) - 2
+}
+
+/// The most scattered points whose [`most_triangles`] fit `max_triangles` (0 when not even one
+/// point does), at most [`MAX_DEM_POINTS`].
+pub fn most_points_within(max_triangles: u64) -> u32 {
+    let (mut lo, mut hi) = (0u32, MAX_DEM_POINTS);
+    if most_triangles(hi) <= max_triangles {
+        return hi;
+    }
+    // most_triangles grows with points: the last count that fits lies in [lo, hi).
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if most_triangles(mid) <= max_triangles {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    if lo == 0 || most_triangles(lo) > max_triangles {
+        0
+    } else {
+        lo
+    }
+}
 
 /// How a DEM image becomes points (the `[[mesh]] kind = "dem"` fields).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -165,28 +207,41 @@ pub fn check_options(field: &str, opts: &DemOptions) -> Result<()> {
     Ok(())
 }
 
-/// Reads a DEM image, samples it ([`sample_points`]) and triangulates the points
-/// ([`triangulate`]), refusing before the triangulation points that could make more than
-/// `max_triangles` triangles.
+/// Refuses `points` scattered points whose [`most_triangles`] pass `max_triangles`, naming
+/// `{field}.count`, the triangles, the budget, the most points it takes and the budget the
+/// count needs.
 ///
 /// # Errors
-/// As [`load_grid`], [`check_options`] and [`triangulate`]; `Invalid` over the budget.
+/// `Invalid` over the budget.
+pub fn check_budget(field: &str, points: u32, max_triangles: u64) -> Result<()> {
+    let most = most_triangles(points);
+    if most <= max_triangles {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        format!("{field}.count"),
+        points,
+        format!(
+            "{points} points and {} on the border make up to {most} triangles, over the \
+             scene's budget of {max_triangles}: the budget takes count = {} at most; lower the \
+             count, or raise the budget with --max-triangles {most}",
+            border_points(points),
+            most_points_within(max_triangles)
+        ),
+    ))
+}
+
+/// Reads a DEM image, samples it ([`sample_points`]) and triangulates the points
+/// ([`triangulate`]), refusing before the image is read a count of points that could make
+/// more than `max_triangles` triangles ([`check_budget`]).
+///
+/// # Errors
+/// As [`load_grid`], [`check_options`], [`check_budget`] and [`triangulate`].
 pub fn load_dem(path: &Path, opts: &DemOptions, max_triangles: u64) -> Result<Terrain> {
     check_options("dem", opts)?;
+    check_budget("dem", opts.points, max_triangles)?;
     let grid = load_grid(path)?;
     let points = sample_points(&grid, opts);
-    let most = 2 * points.len() as u64;
-    if most > max_triangles {
-        return Err(Error::invalid(
-            "mesh count",
-            points.len(),
-            format!(
-                "{} points make up to {most} triangles, over the scene's budget of \
-                 {max_triangles} (fewer points, or raise the budget with --max-triangles)",
-                points.len()
-            ),
-        ));
-    }
     triangulate(path, &points)
 }
 
@@ -235,5 +290,78 @@ mod tests {
         // Same seed, same points; another seed, others.
         assert_eq!(p, sample_points(&g, &opts));
         assert_ne!(p, sample_points(&g, &DemOptions { seed: 2, ..opts }));
+    }
+
+    #[test]
+    fn the_triangle_bound_is_what_the_triangulation_makes() {
+        let g = ramp(11, 7);
+        for points in [1, 2, 3, 10, 50, 400, 1000] {
+            let opts = DemOptions {
+                extent: [20.0, 10.0],
+                heights: [0.0, 1.0],
+                points,
+                seed: 3,
+            };
+            let t = triangulate(Path::new("t.png"), &sample_points(&g, &opts)).unwrap();
+            // No scattered point of these seeds lies on the border: the bound is met exactly.
+            assert_eq!(
+                t.mesh.triangles.len() as u64,
+                most_triangles(points),
+                "{points}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_largest_count_and_the_budget_agree() {
+        let default = crate::scene::DEFAULT_MAX_TRIANGLES;
+        assert_eq!(most_triangles(MAX_DEM_POINTS), 4_005_658);
+        assert_eq!(most_points_within(default), 1_997_173);
+        assert!(most_triangles(1_997_173) <= default && most_triangles(1_997_174) > default);
+        assert_eq!(most_points_within(4_005_658), MAX_DEM_POINTS);
+        assert_eq!(most_points_within(4_005_657), MAX_DEM_POINTS - 1);
+        assert_eq!(most_points_within(3), 0);
+        assert_eq!(most_points_within(4), 1);
+        let opts = |points| DemOptions {
+            extent: [1.0, 1.0],
+            heights: [0.0, 1.0],
+            points,
+            seed: 0,
+        };
+        check_options("mesh[0]", &opts(MAX_DEM_POINTS)).unwrap();
+        let over = check_options("mesh[0]", &opts(MAX_DEM_POINTS + 1)).unwrap_err();
+        assert!(over.to_string().contains("mesh[0].count"), "{over}");
+        check_budget("mesh[0]", 1_997_173, default).unwrap();
+        check_budget("mesh[0]", MAX_DEM_POINTS, 4_005_658).unwrap();
+        let err = check_budget("mesh[0]", MAX_DEM_POINTS, default)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(
+                "2000000 points and 5660 on the border make up to 4005658 triangles, over the \
+                 scene's budget of 4000000: the budget takes count = 1997173 at most; lower the \
+                 count, or raise the budget with --max-triangles 4005658"
+            ),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn the_largest_count_loads_with_the_budget_it_names() {
+        let dir = std::env::temp_dir().join(format!("stereolab-dem-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("ramp.png");
+        image::GrayImage::from_fn(4, 3, |x, _| image::Luma([(x * 80) as u8]))
+            .save(&path)
+            .unwrap();
+        let opts = DemOptions {
+            extent: [1.0, 1.0],
+            heights: [0.0, 1.0],
+            points: MAX_DEM_POINTS,
+            seed: 0,
+        };
+        let t = load_dem(&path, &opts, most_triangles(MAX_DEM_POINTS)).unwrap();
+        let n = t.mesh.triangles.len() as u64;
+        assert!(n <= most_triangles(MAX_DEM_POINTS) && n > 4_000_000, "{n}");
     }
 }

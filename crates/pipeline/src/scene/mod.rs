@@ -14,7 +14,10 @@ pub mod terrain_data;
 pub use checks::{DEPTH_RESOLUTION_WARN, ORIGIN_PRECISION_WARN, depth_resolution, resolution_of};
 pub(crate) use file::SceneFile;
 pub use mesh::Mesh;
-pub use obj::{load_obj, load_obj_with_notes, parse_obj, parse_obj_with_notes};
+pub use obj::{
+    load_obj, load_obj_with_notes, load_obj_within, parse_obj, parse_obj_with_notes,
+    parse_obj_within,
+};
 
 use std::path::Path;
 
@@ -476,12 +479,11 @@ fn load_object(
         "sphere" | "torus" => 2 * u64::from(detail) * u64::from(detail / 2),
         "plane" => 2 * u64::from(detail.min(512)).pow(2),
         "triangles" => u64::from(m.count.unwrap_or(1000)),
-        "dem" => 2 * u64::from(m.count.unwrap_or(DEFAULT_DEM_POINTS)),
         _ => 0,
     };
     if planned > max_triangles {
         return Err(over_budget(
-            &field(if m.kind == "triangles" || m.kind == "dem" {
+            &field(if m.kind == "triangles" {
                 "count"
             } else {
                 "detail"
@@ -495,7 +497,8 @@ fn load_object(
             let p = m.path.as_ref().ok_or_else(|| {
                 Error::invalid(field("path"), "missing", "an obj mesh needs a path")
             })?;
-            let (mesh, obj_notes) = load_obj_with_notes(&root.resolve(&field("path"), p)?)?;
+            let (mesh, obj_notes) =
+                load_obj_within(&root.resolve(&field("path"), p)?, max_triangles)?;
             notes.extend(obj_notes);
             mesh
         }
@@ -603,7 +606,10 @@ fn load_dem_mesh(
         points: m.count.unwrap_or(DEFAULT_DEM_POINTS),
         seed: m.seed.unwrap_or(0),
     };
-    dem::check_options(field("").trim_end_matches('.'), &opts)?;
+    let prefix = field("");
+    let prefix = prefix.trim_end_matches('.');
+    dem::check_options(prefix, &opts)?;
+    dem::check_budget(prefix, opts.points, max_triangles)?;
     Ok(dem::load_dem(&root.resolve(&field("path"), p)?, &opts, max_triangles)?.mesh)
 }
 

@@ -1,9 +1,13 @@
-//! OBJ loading: a line-by-line check that names the file, line and value, then tobj.
+//! OBJ loading: a pass over the file's lines that checks each one (naming the file, line and
+//! value), counts what the triangle budget allows as it goes, and hands tobj the checked lines.
 
+use std::borrow::Cow;
+use std::io::{BufRead, Read};
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
+use super::DEFAULT_MAX_TRIANGLES;
 use super::mesh::Mesh;
 use super::polygon;
 use stereolab_core::{Error, Result, excerpt};
@@ -12,19 +16,22 @@ use stereolab_core::{Error, Result, excerpt};
 const MAX_OBJ_BYTES: u64 = 512 * 1024 * 1024;
 
 /// Loads every object of an OBJ file as one mesh (polygons triangulated keeping their winding,
-/// single index, smooth normals computed where the file has none). Materials are ignored: the
-/// scene gives the color, so a missing, empty or unreadable material library is no error.
+/// single index, smooth normals computed where the file has none), with the default triangle
+/// budget ([`DEFAULT_MAX_TRIANGLES`]). Materials are ignored: the scene gives the color, so a
+/// missing, empty or unreadable material library is no error.
 ///
-/// The text is UTF-8 (a leading byte-order mark is dropped); UTF-16 with a byte-order mark is
-/// decoded; any other bytes are read as Latin-1 (ISO 8859-1, one byte per character), as OBJ
-/// only needs ASCII for its keywords and numbers and names or comments in an 8-bit encoding
-/// are common. Messages quote such text escaped.
+/// Each line is UTF-8 when it is valid UTF-8 (a leading byte-order mark is dropped), else
+/// Latin-1 (ISO 8859-1, one byte per character), as OBJ only needs ASCII for its keywords and
+/// numbers and names or comments in an 8-bit encoding are common; a file that starts with a
+/// UTF-16 byte-order mark is decoded as UTF-16. Messages quote such text escaped.
 ///
 /// # Errors
-/// Unreadable file, a vertex coordinate that is not a finite number, a face index out of range
-/// or malformed, or no triangles at all: each names the file and line.
+/// Unreadable file, a vertex coordinate that is not a finite number, a `v`, `vt` or `vn` line
+/// with a number of coordinates the format does not have, a face index out of range or
+/// malformed, more than the budget allows (see [`load_obj_within`]), or no triangles at all:
+/// each names the file and line.
 pub fn load_obj(path: &Path) -> Result<Mesh> {
-    load_obj_with_notes(path).map(|(mesh, _)| mesh)
+    load_obj_within(path, DEFAULT_MAX_TRIANGLES).map(|(mesh, _)| mesh)
 }
 
 /// [`load_obj`], and the notes on what was read in an unusual way: each names the file and
@@ -34,31 +41,78 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
 /// # Errors
 /// As [`load_obj`].
 pub fn load_obj_with_notes(path: &Path) -> Result<(Mesh, Vec<String>)> {
-    let bytes = stereolab_core::read_input(path, MAX_OBJ_BYTES)?;
-    let text = decode(path, bytes)?;
-    parse_obj_with_notes(path, stereolab_core::without_bom(text))
+    load_obj_within(path, DEFAULT_MAX_TRIANGLES)
 }
 
-/// Text of an OBJ file's bytes: UTF-8, else UTF-16 if it starts with a byte-order mark
-/// (FE FF big-endian, FF FE little-endian), else Latin-1.
+/// [`load_obj_with_notes`] with the triangle budget `max_triangles` (`--max-triangles`),
+/// enforced while the file is read, before anything is kept for a line past it: the faces'
+/// triangles (n − 2 for a face of n corners) may not pass `max_triangles`, nor the `v`, `vt`
+/// or `vn` lines each 3 × `max_triangles` (the most corners that many triangles have). The
+/// file is read line by line; only the checked lines are kept.
+///
+/// # Errors
+/// As [`load_obj`]; over the budget, the line that passed it, the budget and what to do.
+pub fn load_obj_within(path: &Path, max_triangles: u64) -> Result<(Mesh, Vec<String>)> {
+    let too_large = |size: u64| {
+        Error::parse(
+            path,
+            None,
+            format!("file is {size} bytes, more than the {MAX_OBJ_BYTES} accepted"),
+        )
+    };
+    let size = stereolab_core::check_input(path)?;
+    if size > MAX_OBJ_BYTES {
+        return Err(too_large(size));
+    }
+    let io = |e| Error::io(path, e);
+    let file = std::fs::File::open(path).map_err(io)?;
+    let mut input = std::io::BufReader::new(file.take(MAX_OBJ_BYTES + 1));
+    let head = input.fill_buf().map_err(io)?;
+    if head.starts_with(&[0xFE, 0xFF]) || head.starts_with(&[0xFF, 0xFE]) {
+        let mut bytes = Vec::new();
+        input.read_to_end(&mut bytes).map_err(io)?;
+        if bytes.len() as u64 > MAX_OBJ_BYTES {
+            return Err(too_large(bytes.len() as u64)); // it grew while being read
+        }
+        let text = decode_utf16(path, &bytes)?;
+        drop(bytes);
+        return parse_obj_within(path, stereolab_core::without_bom(text), max_triangles);
+    }
+    let mut reader = Reader::new(path, max_triangles);
+    let mut buf = Vec::new();
+    let mut read = 0u64;
+    for line in 1.. {
+        buf.clear();
+        let n = input.read_until(b'\n', &mut buf).map_err(io)?;
+        if n == 0 {
+            break;
+        }
+        read += n as u64;
+        if read > MAX_OBJ_BYTES {
+            return Err(too_large(read)); // it grew while being read
+        }
+        let mut bytes = buf.strip_suffix(b"\n").unwrap_or(&buf);
+        bytes = bytes.strip_suffix(b"\r").unwrap_or(bytes);
+        if line == 1 {
+            bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+        }
+        let text = match std::str::from_utf8(bytes) {
+            Ok(text) => Cow::Borrowed(text),
+            Err(_) => Cow::Owned(bytes.iter().map(|&b| char::from(b)).collect()),
+        };
+        reader.line(line, &text)?;
+    }
+    reader.finish()
+}
+
+/// Text of UTF-16 bytes after their byte-order mark (FE FF big-endian, FF FE little-endian).
 ///
 /// # Errors
 /// UTF-16 that is cut off or holds an unpaired surrogate.
-fn decode(path: &Path, bytes: Vec<u8>) -> Result<String> {
-    let bytes = match String::from_utf8(bytes) {
-        Ok(text) => return Ok(text),
-        Err(e) => e.into_bytes(),
-    };
-    let big_endian = match bytes.get(..2) {
-        Some([0xFE, 0xFF]) => Some(true),
-        Some([0xFF, 0xFE]) => Some(false),
-        _ => None,
-    };
-    let Some(big_endian) = big_endian else {
-        return Ok(bytes.iter().map(|&b| char::from(b)).collect());
-    };
+fn decode_utf16(path: &Path, bytes: &[u8]) -> Result<String> {
+    let big_endian = bytes.starts_with(&[0xFE, 0xFF]);
     let body = &bytes[2..];
-    if body.len() % 2 != 0 {
+    if !body.len().is_multiple_of(2) {
         return Err(Error::parse(
             path,
             None,
@@ -95,7 +149,7 @@ fn decode(path: &Path, bytes: Vec<u8>) -> Result<String> {
 /// # Errors
 /// As [`load_obj`], but for reading the file.
 pub fn parse_obj(path: &Path, text: String) -> Result<Mesh> {
-    parse_obj_with_notes(path, text).map(|(mesh, _)| mesh)
+    parse_obj_within(path, text, DEFAULT_MAX_TRIANGLES).map(|(mesh, _)| mesh)
 }
 
 /// [`load_obj_with_notes`] on text already read.
@@ -103,9 +157,28 @@ pub fn parse_obj(path: &Path, text: String) -> Result<Mesh> {
 /// # Errors
 /// As [`load_obj`], but for reading the file.
 pub fn parse_obj_with_notes(path: &Path, text: String) -> Result<(Mesh, Vec<String>)> {
-    let checked = check_lines(path, &text)?;
-    let text = with_lines_replaced(&text, &checked.replaced);
+    parse_obj_within(path, text, DEFAULT_MAX_TRIANGLES)
+}
 
+/// [`load_obj_within`] on text already read.
+///
+/// # Errors
+/// As [`load_obj_within`], but for reading the file.
+pub fn parse_obj_within(
+    path: &Path,
+    text: String,
+    max_triangles: u64,
+) -> Result<(Mesh, Vec<String>)> {
+    let mut reader = Reader::new(path, max_triangles);
+    for (i, raw) in text.lines().enumerate() {
+        reader.line(i + 1, raw)?;
+    }
+    drop(text);
+    reader.finish()
+}
+
+/// The mesh of the lines a [`Reader`] kept, read by tobj and triangulated.
+fn mesh_of(path: &Path, kept: &str) -> Result<Mesh> {
     let opts = tobj::LoadOptions {
         // Polygons come back whole and are triangulated below, keeping concave faces right.
         triangulate: false,
@@ -113,11 +186,10 @@ pub fn parse_obj_with_notes(path: &Path, text: String) -> Result<(Mesh, Vec<Stri
         ignore_points: true,
         ignore_lines: true,
     };
-    let mut reader = std::io::BufReader::new(text.as_bytes());
-    // Missing material libraries are not an error for us: colors come from the scene.
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &opts, |_| Ok(Default::default()))
+    let mut lines = kept.as_bytes();
+    // The kept lines name no material library; colors come from the scene.
+    let (models, _materials) = tobj::load_obj_buf(&mut lines, &opts, |_| Ok(Default::default()))
         .map_err(|e| Error::parse(path, None, format!("OBJ: {e}")))?;
-
     let mut mesh = Mesh::default();
     let mut has_normals = true;
     for model in &models {
@@ -178,7 +250,7 @@ pub fn parse_obj_with_notes(path: &Path, text: String) -> Result<(Mesh, Vec<Stri
         ));
     }
     mesh.validate(&path.display().to_string())?;
-    Ok((mesh, checked.notes))
+    Ok(mesh)
 }
 
 /// How much of a coordinate word assimp's OBJ reader uses, and where it stops.
@@ -288,160 +360,255 @@ fn unusual_number_note(path: &Path, line: usize, tag: &str, word: &str, value: f
     note
 }
 
-/// The text with the given lines (0-based, sorted) replaced, line numbers and line endings
-/// kept: what tobj reads after [`check_lines`].
-fn with_lines_replaced<'a>(
-    text: &'a str,
-    replaced: &[(usize, String)],
-) -> std::borrow::Cow<'a, str> {
-    if replaced.is_empty() {
-        return std::borrow::Cow::Borrowed(text);
-    }
-    let mut out = String::with_capacity(text.len());
-    let mut next = replaced.iter().peekable();
-    for (i, line) in text.split_inclusive('\n').enumerate() {
-        match next.next_if(|(k, _)| *k == i) {
-            Some((_, new)) => {
-                out.push_str(new);
-                let body = line.trim_end_matches(['\n', '\r']);
-                out.push_str(&line[body.len()..]);
-            }
-            None => out.push_str(line),
-        }
-    }
-    std::borrow::Cow::Owned(out)
-}
+/// The budget's advice, in every message that refuses a file for its size.
+const BUDGET_ADVICE: &str = "simplify the model, or raise the budget with --max-triangles";
 
-/// What [`check_lines`] found: lines to give tobj in another form, and notes for the user.
-#[derive(Debug, Default)]
-struct Checked {
-    /// (0-based line, its new text without the line ending), in line order: a `usemtl` that
-    /// names no material becomes empty (tobj refuses it with "material parse error", and
-    /// materials are ignored here anyway); a coordinate read in part, as assimp does, is
-    /// written as the number read.
-    replaced: Vec<(usize, String)>,
-    /// One per coordinate read in part.
+/// One pass over an OBJ file's lines: each is checked as it comes, what the budget allows is
+/// counted, and the lines tobj needs are kept in a checked form (coordinates as the numbers
+/// read, face indices resolved to absolute ones; names, comments, materials, points and
+/// two-point lines left out), so nothing past the budget or malformed is ever held.
+struct Reader<'p> {
+    /// Named in messages.
+    path: &'p Path,
+    /// The most triangles the faces may make.
+    max_triangles: u64,
+    /// `v`, `vt` and `vn` lines so far.
+    nv: u64,
+    nvt: u64,
+    nvn: u64,
+    /// Triangles the faces so far make (n − 2 for n corners).
+    triangles: u64,
+    /// The lines kept for tobj, each ending in `\n`.
+    kept: String,
+    /// One per coordinate read in an unusual way.
     notes: Vec<String>,
 }
 
-/// Checks what tobj would accept silently or report without a line: coordinates that are not
-/// finite numbers, and face indices that are malformed or out of range. Coordinates are read
-/// as assimp reads them ([`read_coordinate`]); those it reads only in part are noted and
-/// handed to tobj as the number read.
-fn check_lines(path: &Path, text: &str) -> Result<Checked> {
-    let mut checked = Checked::default();
-    let (mut nv, mut nvt, mut nvn) = (0i64, 0i64, 0i64);
-    for (i, raw) in text.lines().enumerate() {
-        let line = i + 1;
-        let mut words = raw.split_whitespace();
-        let Some(tag) = words.next() else { continue };
-        match tag {
-            "usemtl" if words.clone().next().is_none() => {
-                checked.replaced.push((i, String::new()));
-            }
-            "v" | "vt" | "vn" => {
-                let need = if tag == "vt" { 1 } else { 3 };
-                let mut count = 0;
-                let mut read = vec![tag.to_string()];
-                let mut partial = false;
-                for w in words.by_ref().take(3) {
-                    match read_coordinate(w) {
-                        Ok((_, false)) => read.push(w.to_string()),
-                        Ok((value, true)) => {
-                            checked
-                                .notes
-                                .push(unusual_number_note(path, line, tag, w, value));
-                            read.push(value.to_string());
-                            partial = true;
-                        }
-                        Err(why) => {
-                            return Err(Error::parse(
-                                path,
-                                Some(line),
-                                format!(
-                                    "'{tag}' coordinate '{}' is not a finite number{why}",
-                                    excerpt(w)
-                                ),
-                            ));
-                        }
-                    }
-                    count += 1;
-                }
-                // A comment after the coordinates (assimp stops there) would be read by tobj
-                // as more components.
-                let comment = words.clone().any(|w| w.starts_with('#'));
-                if partial || comment {
-                    read.extend(
-                        words
-                            .clone()
-                            .take_while(|w| !w.starts_with('#'))
-                            .map(str::to_string),
-                    );
-                    checked.replaced.push((i, read.join(" ")));
-                }
-                if count < need {
-                    return Err(Error::parse(
-                        path,
-                        Some(line),
-                        format!(
-                            "'{tag}' needs {need} coordinates, found {count}: '{}'",
-                            excerpt(raw)
-                        ),
-                    ));
-                }
-                match tag {
-                    "v" => nv += 1,
-                    "vt" => nvt += 1,
-                    _ => nvn += 1,
-                }
-            }
-            "f" => {
-                let corners: Vec<&str> = words.collect();
-                if corners.len() < 3 {
-                    return Err(Error::parse(
-                        path,
-                        Some(line),
-                        format!(
-                            "face needs at least 3 corners, found {}: '{}'",
-                            corners.len(),
-                            excerpt(raw)
-                        ),
-                    ));
-                }
-                for corner in corners {
-                    for (k, part) in corner.split('/').enumerate() {
-                        if part.is_empty() && k > 0 {
-                            continue;
-                        }
-                        let (what, count) = match k {
-                            0 => ("vertex", nv),
-                            1 => ("texture", nvt),
-                            _ => ("normal", nvn),
-                        };
-                        let idx: i64 = part.parse().map_err(|_| {
-                            Error::parse(
-                                path,
-                                Some(line),
-                                format!("face {what} index '{}' is not an integer", excerpt(part)),
-                            )
-                        })?;
-                        let resolved = if idx < 0 { count + idx + 1 } else { idx };
-                        if idx == 0 || resolved < 1 || resolved > count {
-                            return Err(Error::parse(
-                                path,
-                                Some(line),
-                                format!(
-                                    "face {what} index {idx} out of range (1..={count} defined so far)"
-                                ),
-                            ));
-                        }
-                    }
-                }
-            }
-            _ => {}
+impl<'p> Reader<'p> {
+    fn new(path: &'p Path, max_triangles: u64) -> Self {
+        Reader {
+            path,
+            max_triangles,
+            nv: 0,
+            nvt: 0,
+            nvn: 0,
+            triangles: 0,
+            kept: String::new(),
+            notes: Vec::new(),
         }
     }
-    Ok(checked)
+
+    fn error(&self, line: usize, message: impl Into<String>) -> Error {
+        Error::parse(self.path, Some(line), message)
+    }
+
+    /// Checks the 1-based line `line`, its text `raw` without the line ending.
+    fn line(&mut self, line: usize, raw: &str) -> Result<()> {
+        let mut words = raw.split_whitespace();
+        match words.next() {
+            Some(tag @ ("v" | "vt" | "vn")) => self.vertex(line, raw, tag, words),
+            Some("f") => self.face(line, raw, words),
+            // A polyline of 3 or more points is read as a polygon, as tobj reads it; shorter
+            // ones (lines, points) draw nothing.
+            Some("l") if words.clone().nth(2).is_some() => self.face(line, raw, words),
+            // A new object or group: tobj keeps the faces of each apart (their vertices are
+            // not shared); the name is of no use here.
+            Some("o" | "g") => {
+                self.kept.push_str("g\n");
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// A `v`, `vt` or `vn` line: coordinates read as assimp reads them ([`read_coordinate`]),
+    /// as many as the keyword has (`v`: x y z, x y z w, or x y z r g b; `vt`: u v or u v w;
+    /// `vn`: x y z), up to a comment.
+    fn vertex<'a>(
+        &mut self,
+        line: usize,
+        raw: &str,
+        tag: &str,
+        words: impl Iterator<Item = &'a str>,
+    ) -> Result<()> {
+        let mut values = Vec::with_capacity(6);
+        // A comment after the coordinates ends the line, as in assimp.
+        for w in words.take_while(|w| !w.starts_with('#')) {
+            if values.len() == 7 {
+                break; // too many, whatever follows
+            }
+            match read_coordinate(w) {
+                Ok((value, unusual)) => {
+                    if unusual {
+                        let note = unusual_number_note(self.path, line, tag, w, value);
+                        self.notes.push(note);
+                    }
+                    values.push(value);
+                }
+                Err(why) => {
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "'{tag}' coordinate '{}' is not a finite number{why}",
+                            excerpt(w)
+                        ),
+                    ));
+                }
+            }
+        }
+        let (allowed, what): (&[usize], &str) = match tag {
+            "v" => (
+                &[3, 4, 6],
+                "3 coordinates (4 with a weight w, 6 with a color r g b)",
+            ),
+            "vt" => (&[2, 3], "2 or 3 coordinates"),
+            _ => (&[3], "3 coordinates"),
+        };
+        if !allowed.contains(&values.len()) {
+            let found = if values.len() == 7 {
+                "more".to_string()
+            } else {
+                values.len().to_string()
+            };
+            return Err(self.error(
+                line,
+                format!("'{tag}' needs {what}, found {found}: '{}'", excerpt(raw)),
+            ));
+        }
+        let count = match tag {
+            "v" => &mut self.nv,
+            "vt" => &mut self.nvt,
+            _ => &mut self.nvn,
+        };
+        *count += 1;
+        let (count, most) = (*count, self.max_triangles.saturating_mul(3));
+        if count > most {
+            return Err(self.error(
+                line,
+                format!(
+                    "more than {most} '{tag}' lines, 3 per triangle of the scene's budget of {} \
+                     triangles (a model within the budget needs no more): {BUDGET_ADVICE}",
+                    self.max_triangles
+                ),
+            ));
+        }
+        let mut xyz = [values[0], values.get(1).copied().unwrap_or(0.0), 0.0];
+        let n = if tag == "vt" { 2 } else { 3 };
+        if n == 3 {
+            xyz[2] = values[2];
+        }
+        if tag == "v" && values.len() == 4 {
+            // A weight: the point is (x/w, y/w, z/w), as assimp and tobj read it.
+            let w = values[3];
+            let divided = xyz.map(|c| c / w);
+            if w == 0.0 || !divided.iter().all(|c| c.is_finite()) {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "'v' weight w = {w} makes the point x/w, y/w, z/w undefined or not a \
+                         finite number: '{}'",
+                        excerpt(raw)
+                    ),
+                ));
+            }
+            xyz = divided;
+        }
+        // Colors are left out: the scene gives the color.
+        self.kept.push_str(tag);
+        for c in &xyz[..n] {
+            self.kept.push_str(&format!(" {c}"));
+        }
+        self.kept.push('\n');
+        Ok(())
+    }
+
+    /// An `f` line: at least 3 corners, each `v`, `v/vt`, `v//vn` or `v/vt/vn` with indices
+    /// defined so far (negative ones count back from the last), and the budget.
+    fn face<'a>(
+        &mut self,
+        line: usize,
+        raw: &str,
+        words: impl Iterator<Item = &'a str>,
+    ) -> Result<()> {
+        let corners: Vec<&str> = words.collect();
+        if corners.len() < 3 {
+            return Err(self.error(
+                line,
+                format!(
+                    "face needs at least 3 corners, found {}: '{}'",
+                    corners.len(),
+                    excerpt(raw)
+                ),
+            ));
+        }
+        self.triangles += corners.len() as u64 - 2;
+        if self.triangles > self.max_triangles {
+            return Err(self.error(
+                line,
+                format!(
+                    "the faces so far make {} triangles, more than the scene's budget of {}: \
+                     {BUDGET_ADVICE}",
+                    self.triangles, self.max_triangles
+                ),
+            ));
+        }
+        self.kept.push('f');
+        for corner in corners {
+            let parts: Vec<&str> = corner.split('/').collect();
+            if parts.len() > 3 {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "face corner '{}' has {} parts: a corner is v, v/vt, v//vn or v/vt/vn",
+                        excerpt(corner),
+                        parts.len()
+                    ),
+                ));
+            }
+            self.kept.push(' ');
+            for (k, part) in parts.into_iter().enumerate() {
+                if k > 0 {
+                    self.kept.push('/');
+                }
+                if part.is_empty() && k > 0 {
+                    continue;
+                }
+                let (what, count) = match k {
+                    0 => ("vertex", self.nv),
+                    1 => ("texture", self.nvt),
+                    _ => ("normal", self.nvn),
+                };
+                let idx: i64 = part.parse().map_err(|_| {
+                    self.error(
+                        line,
+                        format!("face {what} index '{}' is not an integer", excerpt(part)),
+                    )
+                })?;
+                let count = count as i64;
+                let resolved = if idx < 0 { count + idx + 1 } else { idx };
+                if idx == 0 || resolved < 1 || resolved > count {
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "face {what} index {idx} out of range (1..={count} defined so far)"
+                        ),
+                    ));
+                }
+                self.kept.push_str(&resolved.to_string());
+            }
+        }
+        self.kept.push('\n');
+        Ok(())
+    }
+
+    /// The mesh of the lines kept, and the notes.
+    ///
+    /// # Errors
+    /// No triangles, or a mesh [`Mesh::validate`] refuses.
+    fn finish(self) -> Result<(Mesh, Vec<String>)> {
+        let mesh = mesh_of(self.path, &self.kept)?;
+        Ok((mesh, self.notes))
+    }
 }
 
 #[cfg(test)]
@@ -454,14 +621,36 @@ mod tests {
         Path::new("t.obj")
     }
 
+    /// A fresh file under the system's temporary folder holding `bytes`.
+    fn file(name: &str, bytes: &[u8]) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("stereolab-obj-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        path
+    }
+
     #[test]
     fn latin1_names_are_read_byte_for_byte() {
         let mut bytes = b"# Terraind".to_vec();
         bytes.extend([0xE6, b'k', b'\n']); // "æ" in Latin-1, not valid UTF-8
         bytes.extend(SQUARE.bytes());
-        let text = decode(path(), bytes).unwrap();
-        assert!(text.starts_with("# Terraindæk\n"), "{text:?}");
-        assert_eq!(parse_obj(path(), text).unwrap().triangles.len(), 2);
+        bytes.extend(b"f 1 2 \xE6\n");
+        let err = load_obj(&file("latin1.obj", &bytes))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.ends_with("latin1.obj:7: face vertex index 'æ' is not an integer"),
+            "{err}"
+        );
+        bytes.truncate(bytes.len() - 8);
+        assert_eq!(
+            load_obj(&file("latin1.obj", &bytes))
+                .unwrap()
+                .triangles
+                .len(),
+            2
+        );
     }
 
     #[test]
@@ -473,18 +662,24 @@ mod tests {
         let be: Vec<u8> = units.iter().flat_map(|u| u.to_be_bytes()).collect();
         let le: Vec<u8> = units.iter().flat_map(|u| u.to_le_bytes()).collect();
         for bytes in [be, le] {
-            let text = stereolab_core::without_bom(decode(path(), bytes).unwrap());
+            let text = decode_utf16(path(), &bytes).unwrap();
             assert!(text.starts_with("# ä\n"), "{text:?}");
-            assert_eq!(parse_obj(path(), text).unwrap().triangles.len(), 2);
+            assert_eq!(
+                load_obj(&file("utf16.obj", &bytes))
+                    .unwrap()
+                    .triangles
+                    .len(),
+                2
+            );
         }
     }
 
     #[test]
     fn broken_utf16_is_refused_with_the_reason() {
-        let odd = decode(path(), vec![0xFE, 0xFF, 0x00, 0x23, 0x00]).unwrap_err();
+        let odd = decode_utf16(path(), &[0xFE, 0xFF, 0x00, 0x23, 0x00]).unwrap_err();
         assert!(odd.to_string().contains("odd number of bytes (5)"), "{odd}");
         let lone =
-            decode(path(), vec![0xFF, 0xFE, 0x23, 0x00, 0x00, 0xD8, 0x23, 0x00]).unwrap_err();
+            decode_utf16(path(), &[0xFF, 0xFE, 0x23, 0x00, 0x00, 0xD8, 0x23, 0x00]).unwrap_err();
         assert!(
             lone.to_string()
                 .contains("unpaired surrogate 0xD800 (byte 4)"),
@@ -495,10 +690,6 @@ mod tests {
     #[test]
     fn a_usemtl_without_a_name_is_ignored_like_any_material() {
         let text = format!("mtllib missing.mtl\nusemtl \r\n{SQUARE}usemtl\n");
-        let checked = check_lines(path(), &text).unwrap();
-        assert_eq!(checked.replaced, [(1, String::new()), (7, String::new())]);
-        let stripped = with_lines_replaced(&text, &checked.replaced);
-        assert_eq!(stripped, format!("mtllib missing.mtl\n\r\n{SQUARE}\n"));
         assert_eq!(parse_obj(path(), text).unwrap().triangles.len(), 2);
     }
 
@@ -611,5 +802,149 @@ mod tests {
         }
         let area: f32 = tris.iter().map(|&[a, b, c]| twice(a, b, c) / 2.0).sum();
         assert!((area - 3.0).abs() < 1e-6, "{area}");
+    }
+
+    fn refusal(text: &str) -> String {
+        parse_obj(path(), text.into()).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn a_vertex_line_with_a_count_the_format_lacks_is_refused_with_its_line() {
+        for (text, says) in [
+            (
+                "v 0 0 0\nv 1 2 3 4 5 6 7\n",
+                "t.obj:2: 'v' needs 3 coordinates (4 with a weight w, 6 with a color r g b), found more: 'v 1 2 3 4 5 6 7'",
+            ),
+            (
+                "v 1 2 3 4 5\n",
+                "t.obj:1: 'v' needs 3 coordinates (4 with a weight w, 6 with a color r g b), found 5: 'v 1 2 3 4 5'",
+            ),
+            (
+                "v 1 2\n",
+                "t.obj:1: 'v' needs 3 coordinates (4 with a weight w, 6 with a color r g b), found 2: 'v 1 2'",
+            ),
+            (
+                "vt 0.5\n",
+                "t.obj:1: 'vt' needs 2 or 3 coordinates, found 1: 'vt 0.5'",
+            ),
+            (
+                "vn 0 0 1 1\n",
+                "t.obj:1: 'vn' needs 3 coordinates, found 4: 'vn 0 0 1 1'",
+            ),
+            (
+                "v 1 2 3 0\n",
+                "t.obj:1: 'v' weight w = 0 makes the point x/w, y/w, z/w undefined or not a finite number: 'v 1 2 3 0'",
+            ),
+            (
+                "v 1e30 2 3 1e-30\n",
+                "t.obj:1: 'v' weight w = 0.000000000000000000000000000001 makes",
+            ),
+        ] {
+            let err = refusal(text);
+            assert!(err.starts_with(says), "{err}");
+        }
+        // A long line is quoted in part.
+        let long = format!("v {}\n", "1 ".repeat(40));
+        assert!(
+            refusal(&long).ends_with("found more: 'v 1 1 1 1 1 1 1 1 1 1 1 1 1 1 1 1 1 1 1 …'")
+        );
+    }
+
+    #[test]
+    fn a_weight_divides_and_a_color_is_left_out() {
+        let text = "v 2 4 6 2\nv 1 0 0 0.5 0.5 0.5\nv 0 1 0 # c\nf 1 2 3\n";
+        let mesh = parse_obj(path(), text.into()).unwrap();
+        assert_eq!(mesh.positions, [Vec3::new(1.0, 2.0, 3.0), Vec3::X, Vec3::Y]);
+    }
+
+    #[test]
+    fn a_face_corner_of_more_than_three_parts_is_refused_with_its_line() {
+        let err = refusal("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/1 2/1/1 3/1/1\n");
+        assert_eq!(
+            err,
+            "t.obj:6: face corner '1/1/1/1' has 4 parts: a corner is v, v/vt, v//vn or v/vt/vn"
+        );
+        let err = refusal(&format!("{SQUARE}l 1/2/3/4/5 2\nf 1 2 x\n"));
+        assert_eq!(err, "t.obj:7: face vertex index 'x' is not an integer");
+        // A polyline of 3 or more points is a polygon.
+        let mesh = parse_obj(path(), format!("{SQUARE}l 9 9\nl 1 2 3\n")).unwrap();
+        assert_eq!(mesh.triangles.len(), 3);
+    }
+
+    #[test]
+    fn indices_in_every_form_are_kept_resolved() {
+        let mut reader = Reader::new(path(), 10);
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\ng a b\nf -3/1/-1 2//1 3/1/ \n";
+        for (i, line) in text.lines().enumerate() {
+            reader.line(i + 1, line).unwrap();
+        }
+        assert_eq!(
+            reader.kept,
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\ng\nf 1/1/1 2//1 3/1/\n"
+        );
+    }
+
+    #[test]
+    fn the_budget_is_kept_while_reading() {
+        // Two squares: 4 triangles.
+        let two = format!("{SQUARE}f 4 3 2 1\n");
+        let (mesh, _) = parse_obj_within(path(), two.clone(), 4).unwrap();
+        assert_eq!(mesh.triangles.len(), 4);
+        let err = parse_obj_within(path(), two, 3).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            "t.obj:6: the faces so far make 4 triangles, more than the scene's budget of 3: \
+             simplify the model, or raise the budget with --max-triangles"
+        );
+        // A 1024-gon is 1022 triangles.
+        let gon: String = (0..1024)
+            .map(|i| {
+                let a = i as f32 * std::f32::consts::TAU / 1024.0;
+                format!("v {} {} 0\n", a.cos(), a.sin())
+            })
+            .chain(std::iter::once(format!(
+                "f {}\n",
+                (1..=1024)
+                    .map(|i| i.to_string())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            )))
+            .collect();
+        assert_eq!(
+            parse_obj_within(path(), gon.clone(), 1022)
+                .unwrap()
+                .0
+                .triangles
+                .len(),
+            1022
+        );
+        let err = parse_obj_within(path(), gon, 1021).unwrap_err().to_string();
+        assert!(
+            err.starts_with("t.obj:1025: the faces so far make 1022 triangles"),
+            "{err}"
+        );
+        // Vertices: 3 per triangle of the budget, for each kind.
+        for tag in ["v 0 0 0", "vt 0 0", "vn 0 0 1"] {
+            let lines = format!("{tag}\n").repeat(7);
+            let err = parse_obj_within(path(), lines, 2).unwrap_err().to_string();
+            let word = tag.split(' ').next().unwrap();
+            assert_eq!(
+                err,
+                format!(
+                    "t.obj:7: more than 6 '{word}' lines, 3 per triangle of the scene's budget of \
+                     2 triangles (a model within the budget needs no more): simplify the model, \
+                     or raise the budget with --max-triangles"
+                )
+            );
+        }
+    }
+
+    #[test]
+    fn a_file_over_the_budget_is_refused_at_the_line_that_passes_it() {
+        // The refusal comes from the line, whatever follows (here: a face out of range).
+        let text = format!("{SQUARE}f 1 2 3\nf 1 2 99\n");
+        let path = file("over.obj", text.as_bytes());
+        let err = load_obj_within(&path, 2).unwrap_err().to_string();
+        assert!(err.ends_with("over.obj:6: the faces so far make 3 triangles, more than the scene's budget of 2: simplify the model, or raise the budget with --max-triangles"), "{err}");
     }
 }

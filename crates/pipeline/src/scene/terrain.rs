@@ -55,27 +55,16 @@ pub fn load_terrain_csv(path: &Path) -> Result<Terrain> {
     load_terrain_csv_within(path, u64::MAX)
 }
 
-/// [`load_terrain_csv`] refusing, before the triangulation, a file whose points would make more
-/// than `max_triangles` triangles (a Delaunay triangulation of n points has fewer than 2n).
+/// [`load_terrain_csv`] refusing, while the rows are read, a file whose points would make more
+/// than `max_triangles` triangles (a Delaunay triangulation of n points has fewer than 2n):
+/// [`parse_csv_within`].
 ///
 /// # Errors
-/// As [`load_terrain_csv`], and `Invalid` naming the point count and the budget.
+/// As [`load_terrain_csv`], and the row that passed the budget.
 pub fn load_terrain_csv_within(path: &Path, max_triangles: u64) -> Result<Terrain> {
     let text = stereolab_core::read_text(path, MAX_CSV_BYTES)?;
-    let points = parse_csv(path, &text)?;
+    let points = parse_csv_within(path, &text, max_triangles)?;
     drop(text);
-    let most = 2 * points.len() as u64;
-    if most > max_triangles {
-        return Err(Error::invalid(
-            "mesh path",
-            path.display(),
-            format!(
-                "{} points make up to {most} triangles, over the scene's budget of \
-                 {max_triangles} (thin the data, or raise the budget with --max-triangles)",
-                points.len()
-            ),
-        ));
-    }
     triangulate(path, &points)
 }
 
@@ -88,6 +77,16 @@ pub fn load_terrain_csv_within(path: &Path, max_triangles: u64) -> Result<Terrai
 /// `Parse` naming `path` and the line: a header without one of the columns, a row with too few
 /// fields, a field that is not a number, or a NaN/infinite value.
 pub fn parse_csv(path: &Path, text: &str) -> Result<Vec<TerrainPoint>> {
+    parse_csv_within(path, text, u64::MAX)
+}
+
+/// [`parse_csv`] refusing the row that makes more points than `max_triangles / 2` (whose
+/// triangulation could pass `max_triangles` triangles), before it is kept.
+///
+/// # Errors
+/// As [`parse_csv`]; over the budget, the row, the budget and what to do.
+pub fn parse_csv_within(path: &Path, text: &str, max_triangles: u64) -> Result<Vec<TerrainPoint>> {
+    let most_points = max_triangles / 2;
     let mut columns: Option<[usize; 3]> = None;
     let mut points = Vec::new();
     for (i, raw) in text.lines().enumerate() {
@@ -143,6 +142,17 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<Vec<TerrainPoint>> {
                 ));
             }
             v[k] = value;
+        }
+        if points.len() as u64 == most_points {
+            return Err(Error::parse(
+                path,
+                Some(line),
+                format!(
+                    "more than {most_points} points, which could make more than the scene's \
+                     budget of {max_triangles} triangles (up to 2 per point): thin the data, or \
+                     raise the budget with --max-triangles"
+                ),
+            ));
         }
         points.push(TerrainPoint {
             x: v[0],
@@ -276,4 +286,22 @@ pub fn triangulate(path: &Path, points: &[TerrainPoint]) -> Result<Terrain> {
         duplicates: points.len() - sums.len(),
         vertex_of_point,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_csv_over_the_budget_is_refused_at_the_row_that_passes_it() {
+        let path = Path::new("t.csv");
+        let text = "x,y,height\n0,0,0\n1,0,0\n# a comment\n0,1,0\n1,1,0\n";
+        assert_eq!(parse_csv_within(path, text, 8).unwrap().len(), 4);
+        assert_eq!(
+            parse_csv_within(path, text, 7).unwrap_err().to_string(),
+            "t.csv:6: more than 3 points, which could make more than the scene's budget of 7 \
+             triangles (up to 2 per point): thin the data, or raise the budget with \
+             --max-triangles"
+        );
+    }
 }
