@@ -147,15 +147,15 @@ fn write_task_data(root: &Path, data: &Path) -> Result<()> {
 /// Unreadable sources, the instructor's solution not building, `dir` holding something else,
 /// or an unwritable `dir`.
 pub fn export(root: &Path, dir: &Path, documents: Option<&Path>) -> Result<()> {
-    if let Some(docs) = documents {
-        if !docs.is_dir() {
-            return Err(Error::invalid(
-                "--documents",
-                docs.display(),
-                "not a folder: name the folder holding the course's copies of the documents \
-                 listed in docs/sources.md",
-            ));
-        }
+    if let Some(docs) = documents
+        && !docs.is_dir()
+    {
+        return Err(Error::invalid(
+            "--documents",
+            docs.display(),
+            "not a folder: name the folder holding the course's copies of the documents \
+             listed in docs/sources.md",
+        ));
     }
     if !replaceable(dir) {
         return Err(Error::invalid(
