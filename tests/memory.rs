@@ -100,7 +100,27 @@ fn the_estimate_holds_the_measured_peak() {
         ),
     )
     .expect("scene");
-    let cases: [(&Path, &[&str]); 6] = [
+    // Slivers: 1024-corner stars ear-clipped, 1 024 vertices for 400 000 triangles.
+    let star = sphere.with_file_name("star.toml");
+    let mut obj = String::new();
+    for k in 0..1024 {
+        let (r, a) = (
+            if k % 2 == 0 { 1.0 } else { 0.5 },
+            std::f64::consts::TAU * f64::from(k) / 1024.0,
+        );
+        obj += &format!("v {} {} 0\n", r * a.cos(), r * a.sin());
+    }
+    let face: Vec<String> = (1..=1024).map(|i| i.to_string()).collect();
+    obj += &format!("f {}\n", face.join(" ")).repeat(392);
+    std::fs::write(star.with_file_name("star.obj"), obj).expect("obj");
+    std::fs::write(
+        &star,
+        std::fs::read_to_string(&soup)
+            .expect("scene")
+            .replace("soup.obj", "star.obj"),
+    )
+    .expect("scene");
+    let cases: [(&Path, &[&str]); 7] = [
         (&asset("scenes/anaglyph.toml"), &["--size", "2048x2048"]),
         (&asset("scenes/wuson.toml"), &["--size", "2048x1536"]),
         (&asset("scenes/sirds_fig5.toml"), &["--size", "2048x1024"]),
@@ -110,6 +130,7 @@ fn the_estimate_holds_the_measured_peak() {
         ),
         (&sphere, &["--size", "2048x1536"]),
         (&soup, &["--size", "1024x768"]),
+        (&star, &["--size", "1024x768"]),
     ];
     for (k, (scene, args)) in cases.into_iter().enumerate() {
         let dir = out_dir(&format!("memory-{k}"));

@@ -5,11 +5,13 @@
 //! depth: 8 bytes a pixel), every output image (they are all made before any is written), one
 //! output's working copy, and the geometry (the mesh, and each pass's transformed vertices and
 //! triangle set-ups). Its per-vertex and per-triangle bytes come from measuring peak resident
-//! memory with one and two passes on two meshes: a 2 M-triangle sphere (half a vertex a
-//! triangle) at 4096×3072, where most triangles keep a set-up, and a 1 M-triangle OBJ of
-//! separate triangles (three vertices each). A pass took about 83 bytes a vertex and 213 a
-//! triangle; the estimate rounds them up, and counts every triangle as keeping a set-up (at
-//! 64×48 most cover no pixel center and keep none, so small images are overestimated).
+//! memory with one and two passes on three meshes: a 2 M-triangle sphere (half a vertex a
+//! triangle) at 4096×3072, where most triangles keep a set-up, a 1 M-triangle OBJ of separate
+//! triangles (three vertices each), and 4 M slivers ear-clipped from 1024-corner stars (1 024
+//! vertices in all). A pass took about 83 bytes a vertex, and from 175 to 285 bytes a
+//! triangle; the estimate takes the most, rounded up, for every triangle (at 64×48 most cover
+//! no pixel center and keep no set-up, so small images are overestimated, up to about 3× for
+//! a 4 M-triangle sphere at 1024×768).
 //! `tests/memory.rs` holds the estimate above the measured peak of real renders.
 
 use std::fmt;
@@ -27,9 +29,9 @@ pub const MESH_BYTES_PER_TRIANGLE: u64 = 12;
 /// Bytes a vertex takes in each pass (its clip-space and window positions, its varyings),
 /// measured, rounded up.
 pub const PASS_BYTES_PER_VERTEX: u64 = 96;
-/// Bytes a triangle takes in each pass (its set-up), measured where most triangles keep one,
-/// rounded up.
-pub const PASS_BYTES_PER_TRIANGLE: u64 = 224;
+/// Bytes a triangle takes in each pass (its set-up and its places in the bands' lists), the
+/// most measured, rounded up.
+pub const PASS_BYTES_PER_TRIANGLE: u64 = 288;
 /// The process itself: code, the thread pool's stacks, the scene's text.
 pub const BASE_BYTES: u64 = 32 << 20;
 
