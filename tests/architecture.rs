@@ -48,7 +48,7 @@ const CRATES: &[(&str, &[&[&str]])] = &[
             &["fixtures"],
             &["render"],
             &["output"],
-            &["info", "compare"],
+            &["info", "compare", "memory"],
         ],
     ),
 ];
