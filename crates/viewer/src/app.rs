@@ -553,8 +553,11 @@ impl App {
             .ok_or_else(|| Error::invalid("screenshot", dir.display(), "10 000 shots already"))?;
         let (png, toml) = (base.with_extension("png"), base.with_extension("toml"));
         let text = self.session.scene_toml(&shown.params, &dir)?;
-        stereolab_core::write_bytes(&toml, text.as_bytes())?;
-        shown.image.save_png(&png)?;
+        // The picture and the scene that remakes it: both written, or neither.
+        let mut set = stereolab_core::OutputSet::new();
+        set.stage_bytes(&toml, text.as_bytes())?;
+        shown.image.stage(&mut set, &png)?;
+        set.commit()?;
         self.shots.push(png.clone());
         let outside = text.contains("path = \"/") || text.contains("pattern_image = \"/");
         Ok(format!(
