@@ -622,10 +622,9 @@ mod tests {
     }
 
     /// A fresh file under the system's temporary folder holding `bytes`.
+    /// `bytes` saved in the temporary folder, its name this process's and `name`.
     fn file(name: &str, bytes: &[u8]) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("stereolab-obj-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(name);
+        let path = std::env::temp_dir().join(format!("stereolab-obj-{}-{name}", std::process::id()));
         std::fs::write(&path, bytes).unwrap();
         path
     }
