@@ -165,6 +165,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
         Backend::Gpu => render_gpu(&s, &plan, &out)?,
     };
     outln!("rendered {} ({}x{})", scene.display(), s.width, s.height);
+    if let Some(peak) = stereolab::memory::peak_resident() {
+        outln!(
+            "  memory: peak {} resident, estimated {} before the render",
+            stereolab::memory::human_bytes(peak),
+            stereolab::memory::human_bytes(needs.total)
+        );
+    }
     for note in &s.notes {
         if note.starts_with("warning:") {
             outln!("  {note}");

@@ -4,6 +4,7 @@ mod accuracy_report;
 mod architecture;
 mod chromadepth;
 mod cli;
+mod clipping;
 mod common;
 mod conformance;
 mod coverage;

@@ -1,6 +1,6 @@
 //! The memory a render is estimated to need (`render --explain`, `--max-memory`) holds the
-//! peak it reaches: measured as the child process's peak resident size (`wait4`'s
-//! `ru_maxrss`), on scenes that stress each term of the estimate. The image terms are tight;
+//! peak it reaches: the peak resident size the render reports of itself (`VmHWM`), on scenes
+//! that stress each term of the estimate. The image terms are tight;
 //! the geometry term is the measured worst case (every triangle keeping a set-up), so a
 //! scene of many triangles that cover few pixels is overestimated, which the margin allows.
 
@@ -23,11 +23,14 @@ fn estimate(scene: &Path, args: &[&str]) -> u64 {
         .lines()
         .find(|l| l.trim_start().starts_with("memory: about "))
         .unwrap_or_else(|| panic!("no memory line in {text}"));
-    let figure = line.split("about ").nth(1).expect("figure");
+    bytes_of(line.split("about ").nth(1).expect("figure"))
+}
+
+/// A size as `human_bytes` writes it (`157 MiB`, `1.5 GiB`), in bytes.
+fn bytes_of(figure: &str) -> u64 {
     let mut words = figure.split_whitespace();
     let value: f64 = words.next().expect("number").parse().expect("number");
-    let unit = words.next().expect("unit");
-    let scale = match unit {
+    let scale = match words.next().expect("unit") {
         "GiB" => (1u64 << 30) as f64,
         "MiB" => (1u64 << 20) as f64,
         other => panic!("unit {other}"),
@@ -35,32 +38,30 @@ fn estimate(scene: &Path, args: &[&str]) -> u64 {
     (value * scale) as u64
 }
 
-/// The peak resident size of `stereolab render` of `scene` with `args`, in bytes.
-/// The child is reaped by `wait4`, which also gives its peak; `Child::wait` would not.
+/// The peak resident memory `stereolab render` of `scene` with `args` reports of itself
+/// (`VmHWM`: its own address space's, after `exec`; a parent's resource usage of the child
+/// would count the test process's pages it was forked with).
 #[cfg(target_os = "linux")]
-#[allow(clippy::zombie_processes)]
 fn peak(scene: &Path, args: &[&str], dir: &Path) -> u64 {
-    let child = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
         .arg("render")
         .arg(scene)
         .args(args)
         .arg("--out")
         .arg(dir)
-        .stdout(std::process::Stdio::null())
-        .spawn()
+        .output()
         .expect("render");
-    let pid = libc::pid_t::try_from(child.id()).expect("pid");
-    let mut status = 0;
-    // SAFETY: an all-zero rusage is a valid value for wait4 to fill.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: waits for the child this test started, writing into the two locals.
-    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    assert_eq!(r, pid, "wait4");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(
-        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        "render failed"
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
-    u64::try_from(usage.ru_maxrss).expect("rss") * 1024
+    let figure = text
+        .lines()
+        .find_map(|l| l.trim_start().strip_prefix("memory: peak "))
+        .unwrap_or_else(|| panic!("no peak in {text}"));
+    bytes_of(figure.split(" resident").next().expect("figure"))
 }
 
 #[cfg(target_os = "linux")]

@@ -58,9 +58,9 @@ pub use shade::{BlinnPhong, DepthOnly, Fragment, Light, MAX_VARYINGS, Shader, Va
 
 // The f64 reference the hard cases are measured against.
 pub use reference::{
-    IdShader, Mismatch, Visible, compare as compare_with_reference, eye as eye_matrices_f64,
-    frustum as frustum_f64, look_at as look_at_f64, soup as triangle_soup, visible as visible_f64,
-    zero_parallax as zero_parallax_f64,
+    IdShader, Mismatch, Visible, compare as compare_with_reference, drawn_id,
+    eye as eye_matrices_f64, frustum as frustum_f64, look_at as look_at_f64, soup as triangle_soup,
+    visible as visible_f64, zero_parallax as zero_parallax_f64,
 };
 
 // Anaglyphs and layouts.

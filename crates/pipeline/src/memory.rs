@@ -120,6 +120,15 @@ impl fmt::Display for MemoryEstimate {
     }
 }
 
+/// This process's peak resident memory so far (`VmHWM` of `/proc/self/status`; Linux only),
+/// what `render` reports beside its estimate.
+pub fn peak_resident() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
 /// The machine's memory: the smaller of its RAM (`/proc/meminfo`'s `MemTotal`) and the
 /// cgroup's limit (`memory.max`), when they can be read.
 pub fn machine_memory() -> Option<u64> {

@@ -624,7 +624,8 @@ mod tests {
     /// A fresh file under the system's temporary folder holding `bytes`.
     /// `bytes` saved in the temporary folder, its name this process's and `name`.
     fn file(name: &str, bytes: &[u8]) -> std::path::PathBuf {
-        let path = std::env::temp_dir().join(format!("stereolab-obj-{}-{name}", std::process::id()));
+        let path =
+            std::env::temp_dir().join(format!("stereolab-obj-{}-{name}", std::process::id()));
         std::fs::write(&path, bytes).unwrap();
         path
     }
