@@ -134,7 +134,10 @@ fn the_report_says_how_far_black_was_lifted() {
 #[test]
 fn cancel_outside_zero_to_one_is_refused_naming_the_field() {
     for bad in ["ghosting.cancel=1.5", "ghosting.cancel=-0.1"] {
-        let e = ghosting_scene(&[bad]).err().expect(bad).to_string();
+        let Err(e) = ghosting_scene(&[bad]) else {
+            panic!("{bad} accepted")
+        };
+        let e = e.to_string();
         assert!(e.contains("ghosting.cancel") && e.contains("0 (no"), "{e}");
     }
 }
