@@ -2,6 +2,7 @@
 //! parallax as color and the StereoGraphics guide's budget. Helpers here; tests in `tests/finalize/`.
 
 mod anaglyph;
+mod crosstalk;
 mod inputs;
 mod occlusion;
 mod parallax;

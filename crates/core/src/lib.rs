@@ -78,9 +78,13 @@ pub use effects::frame_sequential::{
 };
 pub use effects::ghosting::{
     BRIGHT as GHOST_BRIGHT, DARK as GHOST_DARK, DEFAULT_LEAK as DEFAULT_GHOSTING_LEAK, GhostRisk,
-    GhostingSettings, contrast_warning, ghost_risk, ghosted,
+    GhostingSettings, cancel_pixel, cancel_value, cancelled, contrast_warning, ghost_pixel,
+    ghost_risk, ghosted,
 };
-pub use effects::layout::{above_below, above_below_squashed, interleave, side_by_side};
+pub use effects::layout::{
+    above_below, above_below_squashed, frame_packing, frame_packing_active_space, half_above_below,
+    half_side_by_side, interleave, side_by_side,
+};
 
 // Remapping, the visibility check, random-dot pairs.
 pub use effects::occlusion::{

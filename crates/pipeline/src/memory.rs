@@ -61,6 +61,8 @@ pub fn images_held(output: Output) -> f64 {
         | Output::Mpo
         | Output::Jps
         | Output::Pns => 2.0,
+        // Both views and the active space between them (H/24 rows).
+        Output::FramePacking => 2.0 + 1.0 / 24.0,
         Output::ShearVsRotate => 3.0,
         Output::SirdsFig5 => 6.0,
         _ => 1.0,

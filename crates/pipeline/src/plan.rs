@@ -25,6 +25,15 @@ pub enum Output {
     /// The StereoGraphics guide's sync-doubling format: both eyes squashed 1:2 into one frame, left on top,
     /// separated by a black blank interval.
     AboveBelowSquashed,
+    /// Frame-compatible half side by side (3D TVs, projectors, Bino): both views squeezed to
+    /// half the width in one eye-sized frame, left on the left (box filter in linear light).
+    HalfSideBySide,
+    /// Frame-compatible half above-below (top-and-bottom): both views squeezed to half the
+    /// height in one eye-sized frame, left on top (box filter in linear light).
+    HalfAboveBelow,
+    /// HDMI 1.4a frame packing: left view, active space (black: 45 rows at 1080p, 30 at 720p),
+    /// right view, full size (1920×2205 for 1080p).
+    FramePacking,
     /// Even rows left, odd rows right (row-interleaved polarized displays).
     InterlacedRows,
     /// Even columns left, odd columns right (column-interleaved displays).
@@ -82,6 +91,11 @@ pub enum Output {
     GhostingLeft,
     /// The right eye with a share of the left eye leaking in.
     GhostingRight,
+    /// The left eye corrected for crosstalk (`ghosting.cancel`), as sent to the display:
+    /// crosstalk cancellation by subtraction with black lifted (Bino's ghostbusting).
+    CancelledLeft,
+    /// The right eye corrected for crosstalk, as sent to the display.
+    CancelledRight,
     /// The StereoGraphics guide's above-below calibration screen: two arrows that line up when
     /// `layout.blank_interval` matches the display's blank interval. Needs no pass.
     AboveBelowCalibration,
@@ -147,6 +161,9 @@ impl Output {
         Output::CrossEyed,
         Output::AboveBelow,
         Output::AboveBelowSquashed,
+        Output::HalfSideBySide,
+        Output::HalfAboveBelow,
+        Output::FramePacking,
         Output::InterlacedRows,
         Output::InterlacedColumns,
         Output::Checkerboard,
@@ -180,6 +197,8 @@ impl Output {
         Output::FrameSequential,
         Output::GhostingLeft,
         Output::GhostingRight,
+        Output::CancelledLeft,
+        Output::CancelledRight,
         Output::AboveBelowCalibration,
     ];
 
@@ -208,6 +227,9 @@ impl Output {
             Output::CrossEyed => png("cross_eyed", PAIR),
             Output::AboveBelow => png("above_below", PAIR),
             Output::AboveBelowSquashed => png("above_below_squashed", PAIR),
+            Output::HalfSideBySide => png("half_side_by_side", PAIR),
+            Output::HalfAboveBelow => png("half_above_below", PAIR),
+            Output::FramePacking => png("frame_packing", PAIR),
             Output::InterlacedRows => png("interlaced_rows", PAIR),
             Output::InterlacedColumns => png("interlaced_columns", PAIR),
             Output::Checkerboard => png("checkerboard", PAIR),
@@ -263,6 +285,8 @@ impl Output {
             Output::FrameSequential => png("frame_sequential", PAIR),
             Output::GhostingLeft => png("ghosting_left", PAIR),
             Output::GhostingRight => png("ghosting_right", PAIR),
+            Output::CancelledLeft => png("cancelled_left", PAIR),
+            Output::CancelledRight => png("cancelled_right", PAIR),
             // A test pattern of the layout alone: no pass at all.
             Output::AboveBelowCalibration => png("above_below_calibration", &[]),
         }

@@ -183,6 +183,24 @@ impl Shown {
             Output::AboveBelow => (if y < h { View::Left } else { View::Right }, x, y % h),
             // Both views squashed 1:2, the left on top: a rough pick in the top view.
             Output::AboveBelowSquashed => (View::Left, x, (y * 2).min(h - 1)),
+            // Each view squeezed 2:1: a pixel covers two of its view's.
+            Output::HalfSideBySide => {
+                let view = if x < w / 2 { View::Left } else { View::Right };
+                (view, (x % (w / 2).max(1)) * 2, y)
+            }
+            Output::HalfAboveBelow => {
+                let view = if y < h / 2 { View::Left } else { View::Right };
+                (view, x, (y % (h / 2).max(1)) * 2)
+            }
+            // Left, the black active space (nothing to pick), right.
+            Output::FramePacking => {
+                let below = h + stereolab_core::frame_packing_active_space(h);
+                match y {
+                    y if y < h => (View::Left, x, y),
+                    y if y >= below => (View::Right, x, y - below),
+                    _ => return None,
+                }
+            }
             _ => {
                 let view = [View::Left, View::Center, View::Right]
                     .into_iter()

@@ -17,6 +17,14 @@
 //! glows with a share `leak_c` of its brightness. The guide gives no numbers, only the order
 //! (green worst); the defaults [`DEFAULT_LEAK`] are illustrative values in that order, not
 //! measurements.
+//!
+//! Cancellation (Bino's `--ghostbust`; crosstalk cancellation by subtraction, Lipscomb &
+//! Wooten 1994, Konrad, Lacotte & Dubois 2000) sends each eye a corrected image so that after
+//! the leak above each eye sees its own image and none of the other's. With both eyes
+//! corrected, the sent pair `s` must solve `s_this + k·s_other = target_this` for both eyes, and
+//! since no display emits less than black, the target is the original with black lifted to `k`:
+//! `target = k + (1 − k)·this` is the widest range whose solution stays within [0, 1]. Solving
+//! the 2×2 system gives [`cancel_value`]; `cancel` scales `k` (1: full, 0: none).
 
 use image::RgbaImage;
 use serde::Deserialize;
@@ -37,11 +45,17 @@ pub const DEFAULT_LEAK: [f32; 3] = [0.03, 0.06, 0.01];
 pub struct GhostingSettings {
     /// Share of the other eye's linear light leaking in, per channel R, G, B, each 0 to 1.
     pub leak: [f32; 3],
+    /// How much of the leak to cancel, 0 (none) to 1 (all, black lifted to `leak`): the
+    /// `cancelled_*` outputs are the images sent, and `ghosting_*` show them after the leak.
+    pub cancel: f32,
 }
 
 impl Default for GhostingSettings {
     fn default() -> Self {
-        GhostingSettings { leak: DEFAULT_LEAK }
+        GhostingSettings {
+            leak: DEFAULT_LEAK,
+            cancel: 0.0,
+        }
     }
 }
 
@@ -56,8 +70,77 @@ impl GhostingSettings {
                 "each channel's share must be 0 to 1 (e.g. [0.03, 0.06, 0.01])",
             ));
         }
+        if !(0.0..=1.0).contains(&self.cancel) {
+            return Err(Error::invalid(
+                "ghosting.cancel",
+                self.cancel,
+                "must be 0 (no cancellation) to 1 (cancel the whole leak)",
+            ));
+        }
         Ok(())
     }
+
+    /// The leak the cancellation corrects for, per channel: `cancel · leak`. It is also how far
+    /// black is lifted, in linear light: a cancelled pair is seen as `k + (1 − k)·original`.
+    pub fn cancelled_leak(&self) -> [f32; 3] {
+        self.leak.map(|l| self.cancel * l)
+    }
+}
+
+/// One channel of crosstalk cancellation in linear light: the value to send for `this` so that,
+/// with `other` sent as `cancel_value(other, this, k)`, the eye sees `k + (1 − k)·this` under
+/// [`ghost_pixel`]'s leak `k`:
+///
+/// ```text
+/// sent = (this − k·other + k) / (1 + k)
+/// ```
+///
+/// From `s_t + k·s_o = k + (1 − k)·t` and `s_o + k·s_t = k + (1 − k)·o` (both eyes corrected):
+/// `s_t = (target_t − k·target_o)/(1 − k²)`, which simplifies to the above and lies in [0, 1]
+/// for all `t`, `o` in [0, 1] (0 at `t = 0, o = 1`; 1 at `t = 1, o = 0`). The subtraction is
+/// the crosstalk cancellation of Lipscomb & Wooten (1994) and Bino's `--ghostbust`; the black
+/// lift `k` is what keeps it from clipping.
+#[inline]
+pub fn cancel_value(this: f32, other: f32, k: f32) -> f32 {
+    ((this - k * other + k) / (1.0 + k)).clamp(0.0, 1.0)
+}
+
+/// One pixel of [`cancelled`]: [`cancel_value`] per channel in linear light, encoded back to
+/// 8-bit sRGB (rounded). Alpha stays `this`'s; `k = 0` returns `this` unchanged.
+#[inline]
+pub fn cancel_pixel(this: [u8; 4], other: [u8; 4], k: [f32; 3]) -> [u8; 4] {
+    let mut out = this;
+    for c in 0..3 {
+        if k[c] == 0.0 {
+            continue;
+        }
+        let t = srgb_to_linear(this[c] as f32 / 255.0);
+        let o = srgb_to_linear(other[c] as f32 / 255.0);
+        out[c] = (linear_to_srgb(cancel_value(t, o, k[c])) * 255.0).round() as u8;
+    }
+    out
+}
+
+/// `this` eye's image corrected for crosstalk from `other` (`s.cancel · s.leak` per channel),
+/// as it is sent to the display.
+///
+/// # Errors
+/// Different sizes, or a leak or cancel outside 0 to 1.
+pub fn cancelled(
+    this: &Framebuffer,
+    other: &Framebuffer,
+    s: &GhostingSettings,
+) -> Result<RgbaImage> {
+    s.validate()?;
+    check_same_size(this, other)?;
+    let k = s.cancelled_leak();
+    let bytes = this
+        .color
+        .iter()
+        .zip(&other.color)
+        .flat_map(|(t, o)| cancel_pixel(*t, *o, k))
+        .collect();
+    Ok(RgbaImage::from_raw(this.width, this.height, bytes).expect("4 bytes per pixel"))
 }
 
 /// One pixel of [`ghosted`]: `this` with `leak` of `other` added in linear light, encoded back
@@ -74,18 +157,27 @@ pub fn ghost_pixel(this: [u8; 4], other: [u8; 4], leak: [f32; 3]) -> [u8; 4] {
     out
 }
 
-/// `this` eye's image as it is seen with crosstalk from `other`.
+/// `this` eye's image as it is seen with crosstalk from `other`: the pair sent is the
+/// [`cancelled`] one (the originals when `s.cancel` is 0), and `s.leak` leaks in.
 ///
 /// # Errors
-/// Different sizes, or a leak outside 0 to 1.
+/// Different sizes, or a leak or cancel outside 0 to 1.
 pub fn ghosted(this: &Framebuffer, other: &Framebuffer, s: &GhostingSettings) -> Result<RgbaImage> {
     s.validate()?;
     check_same_size(this, other)?;
+    let k = s.cancelled_leak();
     let bytes = this
         .color
         .iter()
         .zip(&other.color)
-        .flat_map(|(t, o)| ghost_pixel(*t, *o, s.leak))
+        .flat_map(|(t, o)| {
+            let (sent_t, sent_o) = if s.cancel == 0.0 {
+                (*t, *o)
+            } else {
+                (cancel_pixel(*t, *o, k), cancel_pixel(*o, *t, k))
+            };
+            ghost_pixel(sent_t, sent_o, s.leak)
+        })
         .collect();
     Ok(RgbaImage::from_raw(this.width, this.height, bytes).expect("4 bytes per pixel"))
 }
@@ -196,11 +288,46 @@ mod tests {
     #[test]
     fn leak_outside_zero_to_one_is_refused() {
         for bad in [[-0.1, 0.0, 0.0], [0.0, 1.5, 0.0], [0.0, 0.0, f32::NAN]] {
-            let e = GhostingSettings { leak: bad }
-                .validate()
-                .unwrap_err()
-                .to_string();
+            let e = GhostingSettings {
+                leak: bad,
+                cancel: 0.0,
+            }
+            .validate()
+            .unwrap_err()
+            .to_string();
             assert!(e.contains("ghosting.leak"), "{e}");
+        }
+        for bad in [-0.5, 1.01, f32::NAN] {
+            let e = GhostingSettings {
+                leak: DEFAULT_LEAK,
+                cancel: bad,
+            }
+            .validate()
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("ghosting.cancel") && e.contains("0 (no"), "{e}");
+        }
+    }
+
+    #[test]
+    fn cancelled_pair_is_seen_as_the_lifted_original() {
+        // The 2×2 system solved exactly, in real numbers: each eye sees k + (1 − k)·own.
+        for k in [0.0f32, 0.01, 0.06, 0.3, 1.0] {
+            for (t, o) in [
+                (0.0f32, 1.0f32),
+                (1.0, 0.0),
+                (0.2, 0.7),
+                (0.5, 0.5),
+                (1.0, 1.0),
+            ] {
+                let (st, so) = (cancel_value(t, o, k), cancel_value(o, t, k));
+                assert!((0.0..=1.0).contains(&st) && (0.0..=1.0).contains(&so));
+                let seen = st + k * so;
+                assert!(
+                    (seen - (k + (1.0 - k) * t)).abs() < 1e-6,
+                    "k {k} t {t} o {o}"
+                );
+            }
         }
     }
 }

@@ -2,6 +2,7 @@
 
 use image::{Rgba, RgbaImage};
 
+use super::anaglyph::{linear_to_srgb, srgb_to_linear};
 use crate::error::{Error, Result};
 use crate::framebuffer::Framebuffer;
 
@@ -116,6 +117,127 @@ pub fn interleave(
             left.pixel(x, y)
         } else {
             right.pixel(x, y)
+        })
+    }))
+}
+
+/// The mean of `n` pixels' linear light in one channel, encoded back to 8-bit sRGB: the box
+/// filter of the frame-compatible formats. `weights` pair each pixel with its share of the
+/// output pixel's footprint (they sum to 1). Color channels are decoded (IEC 61966-2-1) before
+/// averaging, so the squeezed pixel emits the light of the pixels it replaces (a black and a
+/// white pixel make sRGB 188, not 128); alpha is averaged as stored.
+fn box_filter_linear(samples: &[([u8; 4], f64)]) -> [u8; 4] {
+    let mut acc = [0f64; 4];
+    for (p, weight) in samples {
+        for c in 0..3 {
+            acc[c] += weight * f64::from(srgb_to_linear(f32::from(p[c]) / 255.0));
+        }
+        acc[3] += weight * f64::from(p[3]);
+    }
+    let encode = |l: f64| (linear_to_srgb(l.clamp(0.0, 1.0) as f32) * 255.0).round() as u8;
+    [
+        encode(acc[0]),
+        encode(acc[1]),
+        encode(acc[2]),
+        acc[3].round().clamp(0.0, 255.0) as u8,
+    ]
+}
+
+/// Source pixels `[i·n/out, (i+1)·n/out)` of a line of `n` pixels squeezed to `out`, each with
+/// its share of the footprint (partial pixels weighted): for `n = 2·out`, pixels `2i` and
+/// `2i + 1` at ½ each.
+fn footprint(i: u32, out: u32, n: u32) -> Vec<(u32, f64)> {
+    let scale = f64::from(n) / f64::from(out);
+    let (a, b) = (f64::from(i) * scale, f64::from(i + 1) * scale);
+    (a.floor() as u32..n)
+        .take_while(|&s| f64::from(s) < b)
+        .map(|s| (s, (b.min(f64::from(s) + 1.0) - a.max(f64::from(s))) / scale))
+        .filter(|&(_, w)| w > 0.0)
+        .collect()
+}
+
+/// Frame-compatible half side by side (HDMI 1.4a's "Side-by-Side (Half)", what 3D TVs and
+/// projectors and Bino call half-width side by side): in a frame of one eye's size W×H, each
+/// view squeezed to `⌊W/2⌋` columns, left view on the left. Squeezing is a box filter in linear
+/// light (pixels `2i` and `2i + 1` averaged; an odd W averages each `W/⌊W/2⌋`-pixel footprint,
+/// partial pixels weighted, and leaves the last column black).
+///
+/// # Errors
+/// Different sizes.
+pub fn half_side_by_side(left: &Framebuffer, right: &Framebuffer) -> Result<RgbaImage> {
+    same_size(left, right)?;
+    let (w, h) = (left.width, left.height);
+    let half = w / 2;
+    let mut out = RgbaImage::from_pixel(w, h, Rgba([0, 0, 0, 255]));
+    if half == 0 {
+        return Ok(out);
+    }
+    let spans: Vec<Vec<(u32, f64)>> = (0..half).map(|i| footprint(i, half, w)).collect();
+    for (fb, x0) in [(left, 0), (right, half)] {
+        for y in 0..h {
+            for (i, span) in spans.iter().enumerate() {
+                let samples: Vec<_> = span.iter().map(|&(x, wt)| (fb.pixel(x, y), wt)).collect();
+                out.put_pixel(x0 + i as u32, y, Rgba(box_filter_linear(&samples)));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Frame-compatible half above-below (HDMI 1.4a's "Top-and-Bottom"): in a frame of one eye's
+/// size W×H, each view squeezed to `⌊H/2⌋` rows, left view on top. Squeezing is
+/// [`half_side_by_side`]'s box filter in linear light, along columns (rows `2j` and `2j + 1`
+/// averaged).
+///
+/// # Errors
+/// Different sizes.
+pub fn half_above_below(left: &Framebuffer, right: &Framebuffer) -> Result<RgbaImage> {
+    same_size(left, right)?;
+    let (w, h) = (left.width, left.height);
+    let half = h / 2;
+    let mut out = RgbaImage::from_pixel(w, h, Rgba([0, 0, 0, 255]));
+    if half == 0 {
+        return Ok(out);
+    }
+    let spans: Vec<Vec<(u32, f64)>> = (0..half).map(|j| footprint(j, half, h)).collect();
+    for (fb, y0) in [(left, 0), (right, half)] {
+        for (j, span) in spans.iter().enumerate() {
+            for x in 0..w {
+                let samples: Vec<_> = span.iter().map(|&(y, wt)| (fb.pixel(x, y), wt)).collect();
+                out.put_pixel(x, y0 + j as u32, Rgba(box_filter_linear(&samples)));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The active space of HDMI 1.4a frame packing for views `height` rows tall: the vertical
+/// blanking of the 2D timing the packed frame replaces, 45 lines for 1080p (1125 − 1080) and
+/// 30 for 720p (750 − 720). Both are `height / 24` (CEA-861's 1080p and 720p timings have
+/// 25/24 as many total lines as active ones); other heights, which no HDMI timing has, get the
+/// same rule rounded to the nearest line.
+pub fn frame_packing_active_space(height: u32) -> u32 {
+    (height + 12) / 24
+}
+
+/// HDMI 1.4a frame packing (progressive): one frame of W × (2H + active space), the left
+/// view's H rows on top, [`frame_packing_active_space`] rows of black, the right view's H rows
+/// below; no resampling. 1920×1080 views make the 1920×2205 frame, 1280×720 views 1280×1470.
+/// Other sizes are packed by the same rule: a valid picture, but not a timing a TV recognizes.
+///
+/// # Errors
+/// Different sizes.
+pub fn frame_packing(left: &Framebuffer, right: &Framebuffer) -> Result<RgbaImage> {
+    same_size(left, right)?;
+    let (w, h) = (left.width, left.height);
+    let gap = frame_packing_active_space(h);
+    Ok(RgbaImage::from_fn(w, 2 * h + gap, |x, y| {
+        Rgba(if y < h {
+            left.pixel(x, y)
+        } else if y < h + gap {
+            [0, 0, 0, 255]
+        } else {
+            right.pixel(x, y - h - gap)
         })
     }))
 }

@@ -16,9 +16,9 @@ use crate::scene::Scene;
 use stereo_photo::{PhotoFormat, RigMetadata, StereoPhoto};
 use stereolab_core::{
     AnaglyphKind, Error, Framebuffer, OutputSet, Precision, Result, above_below,
-    above_below_squashed, anaglyph, calibration_screen, check_output_path, ghosted, interleave,
-    occlusion_image, parallax_image, rds_framebuffer, rds_left, rds_right, remap_color,
-    side_by_side,
+    above_below_squashed, anaglyph, calibration_screen, cancelled, check_output_path,
+    frame_packing, ghosted, half_above_below, half_side_by_side, interleave, occlusion_image,
+    parallax_image, rds_framebuffer, rds_left, rds_right, remap_color, side_by_side,
 };
 
 /// One finished output image.
@@ -140,6 +140,13 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             eye(View::Right)?,
             scene.blank_interval,
         )?),
+        Output::HalfSideBySide => {
+            Image::Rgba(half_side_by_side(eye(View::Left)?, eye(View::Right)?)?)
+        }
+        Output::HalfAboveBelow => {
+            Image::Rgba(half_above_below(eye(View::Left)?, eye(View::Right)?)?)
+        }
+        Output::FramePacking => Image::Rgba(frame_packing(eye(View::Left)?, eye(View::Right)?)?),
         Output::InterlacedRows => {
             Image::Rgba(interleave(eye(View::Left)?, eye(View::Right)?, |_, y| {
                 y % 2 == 0
@@ -205,6 +212,16 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             &scene.ghosting,
         )?),
         Output::GhostingRight => Image::Rgba(ghosted(
+            eye(View::Right)?,
+            eye(View::Left)?,
+            &scene.ghosting,
+        )?),
+        Output::CancelledLeft => Image::Rgba(cancelled(
+            eye(View::Left)?,
+            eye(View::Right)?,
+            &scene.ghosting,
+        )?),
+        Output::CancelledRight => Image::Rgba(cancelled(
             eye(View::Right)?,
             eye(View::Left)?,
             &scene.ghosting,
