@@ -7,19 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 
-use crate::common::{asset, out_dir};
+use crate::common::{asset, names, out_dir};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_stereolab"))
-}
-
-fn names(dir: &Path) -> Vec<String> {
-    let mut n: Vec<String> = std::fs::read_dir(dir)
-        .expect("read dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    n.sort();
-    n
 }
 
 fn temporaries(dir: &Path) -> Vec<String> {
@@ -169,13 +160,16 @@ fn a_killed_runs_leftovers_are_removed_only_when_provably_stale() {
 #[test]
 fn figures_are_written_all_or_none() {
     let dir = out_dir("figures-all-or-none");
-    let first = bin()
-        .arg("figures")
-        .arg(asset("scenes/wuson.toml"))
-        .arg("--out")
-        .arg(&dir)
-        .output()
-        .expect("figures");
+    let figures = || {
+        bin()
+            .arg("figures")
+            .arg(asset("scenes/wuson.toml"))
+            .arg("--out")
+            .arg(&dir)
+            .output()
+            .expect("figures")
+    };
+    let first = figures();
     assert!(first.status.success(), "{}", stderr(&first));
     let written = names(&dir);
     assert!(written.len() > 4, "{written:?}");
@@ -186,13 +180,7 @@ fn figures_are_written_all_or_none() {
     let last = written.last().expect("a figure");
     std::fs::remove_file(dir.join(last)).expect("remove");
     std::fs::create_dir(dir.join(last)).expect("folder");
-    let out = bin()
-        .arg("figures")
-        .arg(asset("scenes/wuson.toml"))
-        .arg("--out")
-        .arg(&dir)
-        .output()
-        .expect("figures");
+    let out = figures();
     let err = stderr(&out);
     assert!(!out.status.success());
     assert!(

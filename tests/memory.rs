@@ -179,23 +179,22 @@ fn compare_reads_images_as_wide_as_the_widest_output() {
     let (a, b) = (dir.join("a.png"), dir.join("b.png"));
     img.save(&a).expect("a");
     img.save(&b).expect("b");
-    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
-        .arg("compare")
-        .arg(&a)
-        .arg(&b)
-        .output()
-        .expect("compare");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
+    let compare = || {
+        let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .arg("compare")
+            .arg(&a)
+            .arg(&b)
+            .output()
+            .expect("compare");
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (ok, err) = compare();
+    assert!(ok, "{err}");
     // One side past even that is still refused from the header.
-    let wider = image::RgbaImage::new(width + 1, 1);
-    wider.save(&a).expect("a");
-    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
-        .arg("compare")
-        .arg(&a)
-        .arg(&b)
-        .output()
-        .expect("compare");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && err.contains("32769x1"), "{err}");
+    image::RgbaImage::new(width + 1, 1).save(&a).expect("a");
+    let (ok, err) = compare();
+    assert!(!ok && err.contains("32769x1"), "{err}");
 }

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use crate::common::{asset, out_dir};
+use crate::common::{asset, names, out_dir};
 
 fn stereolab(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_stereolab"))
@@ -28,15 +28,6 @@ fn render_small(dir: &Path, sets: &[&str]) -> Output {
         args.extend(["--set", set]);
     }
     stereolab(&args)
-}
-
-fn names(dir: &Path) -> Vec<String> {
-    let mut n: Vec<String> = std::fs::read_dir(dir)
-        .expect("read dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    n.sort();
-    n
 }
 
 /// A 1×1 depth map: too narrow for any SIRDS, so `sirds --depth` fails after reading it.
