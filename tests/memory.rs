@@ -121,7 +121,7 @@ fn the_estimate_holds_the_measured_peak() {
             .replace("soup.obj", "star.obj"),
     )
     .expect("scene");
-    let cases: [(&Path, &[&str]); 7] = [
+    let cases: [(&Path, &[&str]); 8] = [
         (&asset("scenes/anaglyph.toml"), &["--size", "2048x2048"]),
         (&asset("scenes/wuson.toml"), &["--size", "2048x1536"]),
         (&asset("scenes/sirds_fig5.toml"), &["--size", "2048x1024"]),
@@ -132,6 +132,8 @@ fn the_estimate_holds_the_measured_peak() {
         (&sphere, &["--size", "2048x1536"]),
         (&soup, &["--size", "1024x768"]),
         (&star, &["--size", "1024x768"]),
+        // The stars past the view: clipped into fans, each sliver across many bands.
+        (&star, &["--size", "1024x768", "--set", "mesh.0.scale=4"]),
     ];
     for (k, (scene, args)) in cases.into_iter().enumerate() {
         let dir = out_dir(&format!("memory-{k}"));
@@ -139,9 +141,10 @@ fn the_estimate_holds_the_measured_peak() {
         let name = scene.file_name().expect("name").to_string_lossy();
         eprintln!("{name} {args:?}: estimate {est} B, peak {got} B");
         assert!(est >= got, "{name}: estimate {est} below the peak {got}");
-        // Not a wild overestimate either: within 1.6× and 64 MiB of the peak.
+        // Not a wild overestimate either: within twice the peak and 64 MiB (the system allocator's
+        // peaks are lower than mimalloc's, for which the estimate is made).
         assert!(
-            est <= got + got / 5 * 3 + (64 << 20),
+            est <= 2 * got + (64 << 20),
             "{name}: estimate {est} far above the peak {got}"
         );
     }

@@ -12,7 +12,10 @@
 //! triangle; the estimate takes the most, rounded up, for every triangle (at 64×48 most cover
 //! no pixel center and keep no set-up, so small images are overestimated, up to about 3× for
 //! a 4 M-triangle sphere at 1024×768).
-//! `tests/memory.rs` holds the estimate above the measured peak of real renders.
+//! Two terms look at the geometry through each pass's matrices first: the bands' lists (a
+//! triangle is listed in every 32-row band its projected rows cross, 8 bytes each) and a
+//! second set-up for every triangle that reaches past the frustum's sides (clipping turns it
+//! into a fan). `tests/memory.rs` holds the estimate above the measured peak of real renders.
 
 use std::fmt;
 
@@ -32,6 +35,11 @@ pub const PASS_BYTES_PER_VERTEX: u64 = 96;
 /// Bytes a triangle takes in each pass (its set-up and its places in the bands' lists), the
 /// most measured, rounded up.
 pub const PASS_BYTES_PER_TRIANGLE: u64 = 288;
+/// Bytes of one entry in a band's list of triangles (a reference to the triangle's set-up).
+pub const BAND_ENTRY_BYTES: u64 = 8;
+/// Rows in a band of the rasterizer (each band lists the triangles that cross its rows).
+pub const BAND_ROWS: u32 = 32;
+
 /// The process itself: code, the thread pool's stacks, the scene's text.
 pub const BASE_BYTES: u64 = 32 << 20;
 
@@ -84,8 +92,19 @@ pub fn estimate(scene: &Scene, plan: &Plan) -> MemoryEstimate {
             t + o.mesh.triangles.len() as u64,
         )
     });
+    // The bands' lists (each triangle once in every band its projected rows cross), and a
+    // second set-up for each triangle the frustum clips (its polygon becomes a fan).
+    let (bands, clipped) = crate::render::ViewMatrices::new(scene, plan).map_or((0, 0), |views| {
+        plan.passes
+            .iter()
+            .filter_map(|p| views.get(p.view))
+            .map(|m| pass_geometry(scene, &m.mvp))
+            .fold((0, 0), |(b, c), (pb, pc)| (b + pb, c + pc))
+    });
     let geometry = vertices * (MESH_BYTES_PER_VERTEX + passes * PASS_BYTES_PER_VERTEX)
-        + triangles * (MESH_BYTES_PER_TRIANGLE + passes * PASS_BYTES_PER_TRIANGLE);
+        + triangles * (MESH_BYTES_PER_TRIANGLE + passes * PASS_BYTES_PER_TRIANGLE)
+        + bands * BAND_ENTRY_BYTES
+        + clipped * PASS_BYTES_PER_TRIANGLE;
     let held = framebuffers + outputs + geometry;
     MemoryEstimate {
         framebuffers,
@@ -96,6 +115,50 @@ pub fn estimate(scene: &Scene, plan: &Plan) -> MemoryEstimate {
         // 2048²; the system allocator's within 1% of it at 8192²).
         total: BASE_BYTES + held + held / 4,
     }
+}
+
+/// For a pass through `view_projection`: how many entries the rasterizer's bands' lists get
+/// (every triangle once for each band of [`BAND_ROWS`] rows its vertices' projected rows
+/// span; all bands when a vertex is behind the eye, none when the triangle lies wholly above
+/// or below the image), and how many triangles reach past the frustum's sides (clipped into
+/// a fan). A triangle that culling drops still counts: an upper bound.
+pub fn pass_geometry(scene: &Scene, view_projection: &glam::Mat4) -> (u64, u64) {
+    let h = f64::from(scene.height);
+    let all = u64::from(scene.height.div_ceil(BAND_ROWS));
+    let mut rows: Vec<Option<f64>> = Vec::new();
+    let mut outside: Vec<bool> = Vec::new();
+    let (mut entries, mut clipped) = (0u64, 0u64);
+    for o in &scene.objects {
+        let mvp = *view_projection * o.model;
+        rows.clear();
+        outside.clear();
+        for p in &o.mesh.positions {
+            let c = mvp * p.extend(1.0);
+            // Window row of the vertex: y = −1 is the bottom row.
+            rows.push((c.w > 0.0).then(|| (1.0 - f64::from(c.y) / f64::from(c.w)) * 0.5 * h));
+            outside.push(!(c.x.abs() <= c.w && c.y.abs() <= c.w));
+        }
+        for t in &o.mesh.triangles {
+            let out = t
+                .iter()
+                .any(|&i| outside.get(i as usize).copied().unwrap_or(true));
+            clipped += u64::from(out);
+            let corners = t.map(|i| rows.get(i as usize).copied().flatten());
+            let [Some(a), Some(b), Some(c)] = corners else {
+                entries += all;
+                continue;
+            };
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            if !(lo.is_finite() && hi.is_finite()) {
+                entries += all;
+            } else if hi >= 0.0 && lo < h {
+                let first = (lo.max(0.0) as u64) / u64::from(BAND_ROWS);
+                let last = (hi.min(h - 1.0) as u64) / u64::from(BAND_ROWS);
+                entries += last - first + 1;
+            }
+        }
+    }
+    (entries, clipped)
 }
 
 /// Bytes as a person reads them: `512 MiB`, `10.4 GiB`.
