@@ -302,7 +302,7 @@ fn end_cleanly_on_signals() {
     };
     std::thread::spawn(move || {
         if let Some(sig) = signals.forever().next() {
-            let removed = stereolab_core::remove_temporaries(true);
+            let removed = stereolab_core::remove_temporaries();
             let name = match sig {
                 SIGINT => "SIGINT (Ctrl-C)",
                 SIGTERM => "SIGTERM",

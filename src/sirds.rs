@@ -56,11 +56,6 @@ pub struct SirdsArgs {
     pub pair: Option<PathBuf>,
 }
 
-/// Settings from `--set sirds.key=value` alone (no scene file).
-fn settings_from_sets(sets: &[String]) -> Result<SirdsSettings> {
-    stereolab::scene::sirds_settings_from_sets(sets)
-}
-
 /// Whether `path` ends in one of `extensions` (ASCII case ignored).
 fn has_extension(path: &Path, extensions: &[&str]) -> bool {
     path.extension()
@@ -126,7 +121,7 @@ fn report(args: &SirdsArgs) -> Result<String> {
         return decode_report(args, path, &out);
     }
     if let Some(path) = &args.depth {
-        let settings = settings_from_sets(&args.sets)?;
+        let settings = stereolab::scene::sirds_settings_from_sets(&args.sets)?;
         // `--near` when given; else what the file says (stereolab's own window depth: black
         // is near); else white, netpbm's convention.
         let told = stereolab_core::near_of_file(path).filter(|_| args.near.is_none());
@@ -236,7 +231,7 @@ fn decode_report(args: &SirdsArgs, path: &Path, out: &Path) -> Result<String> {
     let told = args.scene.is_some() || !args.sets.is_empty();
     let settings = match &args.scene {
         Some(scene) => super::load_scene(scene, &args.sets, None)?.sirds,
-        None => settings_from_sets(&args.sets)?,
+        None => stereolab::scene::sirds_settings_from_sets(&args.sets)?,
     };
     let img = stereolab_core::open_image(path, "image")?.to_rgba8();
     let (w, h) = img.dimensions();

@@ -32,7 +32,7 @@ fn image_hash(img: &Image) -> (u32, u32, u64) {
             i.height(),
             fnv1a(i.as_raw().iter().copied(), seed),
         ),
-        Image::Gray16(i) => (
+        Image::Gray16(i) | Image::WindowDepth(i) => (
             i.width(),
             i.height(),
             fnv1a(i.as_raw().iter().flat_map(|v| v.to_le_bytes()), seed),

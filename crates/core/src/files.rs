@@ -154,17 +154,15 @@ fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 /// Removes every temporary file this process is writing and returns how many there were; any
 /// write still under way then fails instead of renaming. A signal handler calls it before the
 /// process exits (`stereolab`'s SIGINT, SIGTERM and SIGHUP), so that an interrupted run leaves
-/// nothing behind. The list stays locked until the process ends when `hold` is set, so that
-/// no new temporary file can start.
-pub fn remove_temporaries(hold: bool) -> usize {
+/// nothing behind. The list then stays locked until the process ends, so that no new
+/// temporary file can start.
+pub fn remove_temporaries() -> usize {
     let mut files = live();
     let n = files.len();
     for f in files.drain(..) {
         let _ = remove_temporary(&f);
     }
-    if hold {
-        std::mem::forget(files);
-    }
+    std::mem::forget(files);
     n
 }
 

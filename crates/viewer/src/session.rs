@@ -543,7 +543,9 @@ mod tests {
     fn raw(i: &Image) -> Vec<u8> {
         match i {
             Image::Rgba(i) => i.as_raw().clone(),
-            Image::Gray16(i) => i.as_raw().iter().flat_map(|v| v.to_le_bytes()).collect(),
+            Image::Gray16(i) | Image::WindowDepth(i) => {
+                i.as_raw().iter().flat_map(|v| v.to_le_bytes()).collect()
+            }
             Image::Stereo(p) => [p.left.as_raw().as_slice(), p.right.as_raw()].concat(),
             Image::Sequence(_) => i.to_display_rgba().into_raw(),
         }

@@ -131,14 +131,24 @@ pub fn cancelled(
     other: &Framebuffer,
     s: &GhostingSettings,
 ) -> Result<RgbaImage> {
+    let k = s.cancelled_leak();
+    pixel_pairs(this, other, s, |t, o| cancel_pixel(t, o, k))
+}
+
+/// `pixel(this, other)` at every pixel of a pair, after checking the settings and the sizes.
+fn pixel_pairs(
+    this: &Framebuffer,
+    other: &Framebuffer,
+    s: &GhostingSettings,
+    pixel: impl Fn([u8; 4], [u8; 4]) -> [u8; 4],
+) -> Result<RgbaImage> {
     s.validate()?;
     check_same_size(this, other)?;
-    let k = s.cancelled_leak();
     let bytes = this
         .color
         .iter()
         .zip(&other.color)
-        .flat_map(|(t, o)| cancel_pixel(*t, *o, k))
+        .flat_map(|(t, o)| pixel(*t, *o))
         .collect();
     Ok(RgbaImage::from_raw(this.width, this.height, bytes).expect("4 bytes per pixel"))
 }
@@ -163,23 +173,15 @@ pub fn ghost_pixel(this: [u8; 4], other: [u8; 4], leak: [f32; 3]) -> [u8; 4] {
 /// # Errors
 /// Different sizes, or a leak or cancel outside 0 to 1.
 pub fn ghosted(this: &Framebuffer, other: &Framebuffer, s: &GhostingSettings) -> Result<RgbaImage> {
-    s.validate()?;
-    check_same_size(this, other)?;
     let k = s.cancelled_leak();
-    let bytes = this
-        .color
-        .iter()
-        .zip(&other.color)
-        .flat_map(|(t, o)| {
-            let (sent_t, sent_o) = if s.cancel == 0.0 {
-                (*t, *o)
-            } else {
-                (cancel_pixel(*t, *o, k), cancel_pixel(*o, *t, k))
-            };
-            ghost_pixel(sent_t, sent_o, s.leak)
-        })
-        .collect();
-    Ok(RgbaImage::from_raw(this.width, this.height, bytes).expect("4 bytes per pixel"))
+    pixel_pairs(this, other, s, |t, o| {
+        let (sent_t, sent_o) = if s.cancel == 0.0 {
+            (t, o)
+        } else {
+            (cancel_pixel(t, o, k), cancel_pixel(o, t, k))
+        };
+        ghost_pixel(sent_t, sent_o, s.leak)
+    })
 }
 
 /// Relative luminance of an 8-bit sRGB color in linear light (ITU-R BT.709 weights).

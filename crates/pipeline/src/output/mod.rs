@@ -25,8 +25,11 @@ use stereolab_core::{
 pub enum Image {
     /// 8-bit RGBA.
     Rgba(image::RgbaImage),
-    /// 16-bit grayscale (depth).
+    /// 16-bit grayscale (a SIRDS depth map: white near).
     Gray16(image::ImageBuffer<image::Luma<u16>, Vec<u16>>),
+    /// 16-bit window depth (`left_depth`, `right_depth`: 0 at the near plane, 65535 at the
+    /// far plane), saved with the text chunk that says so ([`stage_window_depth`]).
+    WindowDepth(image::ImageBuffer<image::Luma<u16>, Vec<u16>>),
     /// Both eyes in a stereo photo format (MPO, JPS, PNS), encoded when saved.
     Stereo(stereo_photo::StereoPhoto),
     /// Both eyes alternating in time (`frame_sequential`), an animated PNG when saved.
@@ -68,6 +71,7 @@ impl Image {
         match self {
             Image::Rgba(i) => set.stage_png(path, i),
             Image::Gray16(i) => set.stage_png(path, i),
+            Image::WindowDepth(i) => stage_window_depth(set, path, i),
             Image::Stereo(photo) => set.stage_bytes(path, &photo.encode()?),
             Image::Sequence(seq) => set.stage(path, |w| seq.encode_to(w, progress)),
         }
@@ -78,10 +82,12 @@ impl Image {
     pub fn to_display_rgba(&self) -> image::RgbaImage {
         match self {
             Image::Rgba(i) => i.clone(),
-            Image::Gray16(g) => image::RgbaImage::from_fn(g.width(), g.height(), |x, y| {
-                let v = (g.get_pixel(x, y).0[0] >> 8) as u8;
-                image::Rgba([v, v, v, 255])
-            }),
+            Image::Gray16(g) | Image::WindowDepth(g) => {
+                image::RgbaImage::from_fn(g.width(), g.height(), |x, y| {
+                    let v = (g.get_pixel(x, y).0[0] >> 8) as u8;
+                    image::Rgba([v, v, v, 255])
+                })
+            }
             Image::Stereo(p) => {
                 let w = p.left.width();
                 let mut out = image::RgbaImage::new(2 * w, p.left.height());
@@ -105,7 +111,7 @@ impl Image {
     pub fn display_size(&self) -> (u32, u32) {
         match self {
             Image::Rgba(i) => i.dimensions(),
-            Image::Gray16(i) => i.dimensions(),
+            Image::Gray16(i) | Image::WindowDepth(i) => i.dimensions(),
             Image::Stereo(p) => (2 * p.left.width(), p.left.height()),
             Image::Sequence(s) => (s.left.width() * s.fields.len() as u32, s.left.height()),
         }
@@ -130,8 +136,8 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
     Ok(match output {
         Output::Left => Image::Rgba(eye(View::Left)?.to_rgba_image()),
         Output::Right => Image::Rgba(eye(View::Right)?.to_rgba_image()),
-        Output::LeftDepth => Image::Gray16(eye(View::Left)?.depth_image()),
-        Output::RightDepth => Image::Gray16(eye(View::Right)?.depth_image()),
+        Output::LeftDepth => Image::WindowDepth(eye(View::Left)?.depth_image()),
+        Output::RightDepth => Image::WindowDepth(eye(View::Right)?.depth_image()),
         Output::SideBySide => Image::Rgba(side_by_side(eye(View::Left)?, eye(View::Right)?)?),
         Output::CrossEyed => Image::Rgba(side_by_side(eye(View::Right)?, eye(View::Left)?)?),
         Output::AboveBelow => Image::Rgba(above_below(eye(View::Left)?, eye(View::Right)?)?),
@@ -362,24 +368,17 @@ pub fn write_all_reporting(
         .map(|&o| {
             let path = dir.join(o.file_name());
             check_output_path(&path)?;
-            Ok((o, path, make(o)?))
+            Ok((path, make(o)?))
         })
         .collect::<Result<Vec<_>>>()?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let mut set = OutputSet::new();
-    for (o, path, image) in &outputs {
+    for (path, image) in &outputs {
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        match (o, image) {
-            (Output::LeftDepth | Output::RightDepth, Image::Gray16(depth)) => {
-                stage_window_depth(&mut set, path, depth)?;
-            }
-            _ => image.stage_reporting(&mut set, path, &mut |done, of| {
-                progress(&name, done, of);
-            })?,
-        }
+        image.stage_reporting(&mut set, path, &mut |done, of| progress(&name, done, of))?;
     }
     set.commit()
 }
