@@ -7,6 +7,7 @@ mod inputs;
 mod occlusion;
 mod parallax;
 mod remap;
+mod threejs;
 
 use std::path::Path;
 

@@ -86,12 +86,13 @@ fn wgsl_anaglyphs_match_the_cpu_within_one_step_on_identical_eyes() {
     for (name, [left, right]) in
         [("wuson", &wuson), ("noise", &noise)].map(|(n, e)| (n, [&e[0], &e[1]]))
     {
-        for kind in AnaglyphKind::ALL {
+        for kind in AnaglyphKind::ALL.into_iter().chain(AnaglyphKind::THREE_JS) {
             for linear_light in [false, true] {
                 for swap_eyes in [false, true] {
                     let options = AnaglyphOptions {
                         linear_light,
                         swap_eyes,
+                        anti_rivalry: false,
                     };
                     let cpu = anaglyph(left, right, kind, options).expect("cpu");
                     let gpu = fin.anaglyph(r, left, right, kind, options).expect("gpu");
@@ -435,4 +436,45 @@ fn resident_frames_equal_the_host_route_byte_for_byte() {
             .expect_err("needs the host");
         assert!(e.to_string().contains(o.name()), "{e}");
     }
+}
+
+/// Rendepth's gamma stage has no WGSL mirror: on the GPU path the CPU mixes the GPU's eyes,
+/// and the WGSL anaglyph refuses the option by name instead of ignoring it.
+#[test]
+fn anti_rivalry_on_the_gpu_path_is_mixed_by_the_cpu() {
+    use stereolab::plan::{Output, Plan};
+    use stereolab_gpu::{GpuScene, effects::produce_wgsl};
+    let Some(r) = gpu() else { return };
+    let mut scene =
+        Scene::load(&common::asset("scenes/anaglyph_rendepth.toml"), &[]).expect("scene");
+    scene.set_size(160, 120).expect("size");
+    assert!(scene.finalize.anti_rivalry);
+    let o = Output::Anaglyph(AnaglyphKind::DuboisRedCyan);
+    let frame = r
+        .render(
+            &GpuScene::upload(r, &scene).expect("upload"),
+            &Plan::new(&[o]),
+        )
+        .expect("gpu frame");
+    let fin = GpuFinalize::new(r).expect("compiles");
+    assert!(
+        produce_wgsl(r, &fin, o, &frame, &scene)
+            .expect("wgsl")
+            .is_none()
+    );
+    let dir = common::out_dir("gpu_anti_rivalry");
+    stereolab_gpu::output::write_all(r, &frame, &scene, &dir).expect("writes");
+    let written = image::open(dir.join("anaglyph_dubois.png"))
+        .expect("png")
+        .to_rgba8();
+    let (left, right) = (
+        frame.view(stereolab::plan::View::Left).expect("left"),
+        frame.view(stereolab::plan::View::Right).expect("right"),
+    );
+    let cpu = anaglyph(left, right, AnaglyphKind::DuboisRedCyan, scene.finalize).expect("cpu");
+    assert_eq!(written, cpu);
+    let err = fin
+        .anaglyph(r, left, right, AnaglyphKind::DuboisRedCyan, scene.finalize)
+        .expect_err("no WGSL stage");
+    assert!(err.to_string().contains("finalize.anti_rivalry"), "{err}");
 }

@@ -59,6 +59,7 @@ fn source(kind: Kind) -> (ColorMatrix, ColorMatrix) {
                 1.2264,
             ]),
         ),
+        Kind::ThreeJs(..) => unreachable!("three.js's table: tests/finalize/threejs.rs"),
         // dolphin-emu dubois.glsl (2009 LCD values).
         Kind::DuboisRedCyanLcd => (
             [
@@ -234,6 +235,7 @@ fn gray_in_gives_gray_red_and_cyan_out() {
                 assert!(left_only[0] > 150 && left_only[1] > 100 && left_only[2] == 0);
                 assert!(right_only[2] > 150 && right_only[0] == 0 && right_only[1] < 20);
             }
+            Kind::ThreeJs(..) => unreachable!("three.js's table: tests/finalize/threejs.rs"),
         }
     }
 }
@@ -311,6 +313,7 @@ fn image_loop_matches_the_per_pixel_function() {
                 AnaglyphOptions {
                     linear_light,
                     swap_eyes: false,
+                    anti_rivalry: false,
                 },
             )
             .expect("anaglyph");

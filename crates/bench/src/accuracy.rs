@@ -466,6 +466,7 @@ fn anaglyph_light(scene: &Scene, iters: usize) -> Result<Knob> {
                 AnaglyphOptions {
                     linear_light,
                     swap_eyes: false,
+                    anti_rivalry: false,
                 },
             )
         };

@@ -235,6 +235,7 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
                 AnaglyphOptions {
                     linear_light,
                     swap_eyes: false,
+                    anti_rivalry: false,
                 },
             )
         };

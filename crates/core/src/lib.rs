@@ -65,8 +65,10 @@ pub use reference::{
 
 // Anaglyphs and layouts.
 pub use effects::anaglyph::{
-    AnaglyphKind, AnaglyphMatrices, AnaglyphOptions, ColorMatrix, anaglyph, anaglyph_pixel,
-    anaglyph_reference, linear_to_srgb, mix as anaglyph_mix, srgb_to_linear,
+    ANTI_RIVALRY_GAMMA, AnaglyphGlasses, AnaglyphKind, AnaglyphMatrices, AnaglyphMethod,
+    AnaglyphOptions, ColorMatrix, anaglyph, anaglyph_pixel, anaglyph_pixel_with,
+    anaglyph_reference, anti_rivalry, linear_to_srgb, mix as anaglyph_mix, srgb_to_linear,
+    threejs_anaglyph,
 };
 pub use effects::calibration::{
     ARROW_COLOR as CALIBRATION_ARROW_COLOR, BLANK_COLOR as CALIBRATION_BLANK_COLOR,

@@ -74,7 +74,8 @@ impl GpuFinalize {
     /// request (the host swaps the inputs, as the CPU function does).
     ///
     /// # Errors
-    /// Eyes of different sizes, or a GPU failure.
+    /// Eyes of different sizes, `options.anti_rivalry` (Rendepth's gamma stage has no WGSL
+    /// mirror: [`produce_wgsl`] leaves it to the CPU), or a GPU failure.
     pub fn anaglyph(
         &self,
         r: &GpuRenderer,
@@ -84,6 +85,13 @@ impl GpuFinalize {
         options: AnaglyphOptions,
     ) -> Result<RgbaImage> {
         check_same_size(left, right)?;
+        if options.anti_rivalry {
+            return Err(Error::invalid(
+                "finalize.anti_rivalry",
+                "true",
+                "the WGSL anaglyph has no anti-rivalry stage; mix on the CPU",
+            ));
+        }
         let (left, right) = options.eyes(left, right);
         let params = anaglyph_params(kind);
         let pass = self.anaglyph_pass(options);
@@ -231,6 +239,8 @@ pub fn produce_wgsl(
     };
     let mvps = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     Ok(Some(match output {
+        // Rendepth's gamma stage has no WGSL mirror: the CPU mixes the GPU's eyes.
+        Output::Anaglyph(_) if scene.finalize.anti_rivalry => return Ok(None),
         Output::Anaglyph(kind) => {
             fin.anaglyph(r, eye(View::Left)?, eye(View::Right)?, kind, scene.finalize)?
         }

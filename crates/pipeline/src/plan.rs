@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use stereolab_core::{AnaglyphKind, Error, Eye, Result};
+use stereolab_core::{AnaglyphGlasses, AnaglyphKind, AnaglyphMethod, Error, Eye, Result};
 
 /// Everything a scene can ask `stereolab render` to write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -48,7 +48,8 @@ pub enum Output {
     ChromaDepthRight,
     /// Both simulated views as a red–cyan anaglyph, for viewers without ChromaDepth glasses.
     ChromaDepthAnaglyph,
-    /// `anaglyph_<kind>`: both eyes' colors mixed by the kind's matrices (the exercise slides).
+    /// `anaglyph_<kind>`: both eyes' colors mixed by the kind's matrices (the exercise slides;
+    /// three.js's method × glasses table as `anaglyph_<method>_<glasses>`).
     Anaglyph(AnaglyphKind),
     /// The left eye's view recolored from the right eye by remapping (the exercise slides).
     RemapLeft,
@@ -180,6 +181,90 @@ impl Output {
         Output::Anaglyph(AnaglyphKind::DuboisRedCyanLcd),
         Output::Anaglyph(AnaglyphKind::DuboisGreenMagenta),
         Output::Anaglyph(AnaglyphKind::DuboisAmberBlue),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::True,
+            AnaglyphGlasses::RedCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::True,
+            AnaglyphGlasses::MagentaCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::True,
+            AnaglyphGlasses::MagentaGreen,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Grey,
+            AnaglyphGlasses::RedCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Grey,
+            AnaglyphGlasses::MagentaCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Grey,
+            AnaglyphGlasses::MagentaGreen,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Colour,
+            AnaglyphGlasses::RedCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Colour,
+            AnaglyphGlasses::MagentaCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Colour,
+            AnaglyphGlasses::MagentaGreen,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::HalfColour,
+            AnaglyphGlasses::RedCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::HalfColour,
+            AnaglyphGlasses::MagentaCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::HalfColour,
+            AnaglyphGlasses::MagentaGreen,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Dubois,
+            AnaglyphGlasses::RedCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Dubois,
+            AnaglyphGlasses::MagentaCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Dubois,
+            AnaglyphGlasses::MagentaGreen,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Optimised,
+            AnaglyphGlasses::RedCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Optimised,
+            AnaglyphGlasses::MagentaCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Optimised,
+            AnaglyphGlasses::MagentaGreen,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Compromise,
+            AnaglyphGlasses::RedCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Compromise,
+            AnaglyphGlasses::MagentaCyan,
+        )),
+        Output::Anaglyph(AnaglyphKind::ThreeJs(
+            AnaglyphMethod::Compromise,
+            AnaglyphGlasses::MagentaGreen,
+        )),
         Output::RemapLeft,
         Output::RemapRight,
         Output::Occlusion,

@@ -700,6 +700,10 @@ impl App {
         }
         ui.checkbox(&mut self.params.linear_light, "anaglyph in linear light");
         ui.checkbox(&mut self.params.swap_eyes, "swap eyes");
+        ui.checkbox(
+            &mut self.params.anti_rivalry,
+            "anaglyph anti-rivalry (Rendepth)",
+        );
         ui.separator();
         ui.heading("Rig");
         let rig = &mut self.params.rig;

@@ -44,6 +44,8 @@ pub struct Params {
     pub linear_light: bool,
     /// `[finalize] swap_eyes`.
     pub swap_eyes: bool,
+    /// `[finalize] anti_rivalry`.
+    pub anti_rivalry: bool,
     /// `[sirds] algorithm`.
     pub sirds_algorithm: SirdsAlgorithm,
     /// `[sirds] start`.
@@ -118,6 +120,7 @@ impl Session {
             chromadepth_d: [scene.chromadepth.d1, scene.chromadepth.d2],
             linear_light: scene.finalize.linear_light,
             swap_eyes: scene.finalize.swap_eyes,
+            anti_rivalry: scene.finalize.anti_rivalry,
             sirds_algorithm: s.algorithm,
             sirds_start: s.per_vertex.start,
             sirds_filter: s.per_vertex.filter,
@@ -147,6 +150,7 @@ impl Session {
         scene.chromadepth.d2 = p.chromadepth_d[1];
         scene.finalize.linear_light = p.linear_light;
         scene.finalize.swap_eyes = p.swap_eyes;
+        scene.finalize.anti_rivalry = p.anti_rivalry;
         scene.sirds.algorithm = p.sirds_algorithm;
         scene.sirds.per_vertex.start = p.sirds_start;
         scene.sirds.per_vertex.filter = p.sirds_filter;
@@ -219,6 +223,11 @@ impl Session {
             Some(Value::Boolean(p.linear_light)),
         );
         set("finalize", "swap_eyes", Some(Value::Boolean(p.swap_eyes)));
+        set(
+            "finalize",
+            "anti_rivalry",
+            Some(Value::Boolean(p.anti_rivalry)),
+        );
         let algorithm = match p.sirds_algorithm {
             SirdsAlgorithm::PerVertex => "per-vertex",
             SirdsAlgorithm::PerPixel => "per-pixel",
@@ -637,6 +646,7 @@ mod tests {
             chromadepth_d: [None, None],
             linear_light: false,
             swap_eyes: false,
+            anti_rivalry: false,
             sirds_algorithm: SirdsAlgorithm::PerVertex,
             sirds_start: StripStart::Center,
             sirds_filter: StripFilter::Bilinear,

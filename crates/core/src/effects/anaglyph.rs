@@ -52,7 +52,101 @@ pub enum AnaglyphKind {
     DuboisGreenMagenta,
     /// Dubois amber-blue (ColorCode-style glasses).
     DuboisAmberBlue,
+    /// One cell of three.js's method × glasses table ([`threejs_anaglyph`]):
+    /// `anaglyph_<method>_<glasses>`, e.g. `anaglyph_compromise_red_cyan`.
+    ThreeJs(AnaglyphMethod, AnaglyphGlasses),
 }
+
+/// three.js's anaglyph methods (`AnaglyphAlgorithm`), spelled as three.js spells them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum AnaglyphMethod {
+    /// `TRUE`: red from the left eye, the right eye's luma in the other filter's channels.
+    True,
+    /// `GREY`: luma only.
+    Grey,
+    /// `COLOUR`: full colour, each channel from the eye whose filter passes it.
+    Colour,
+    /// `HALF_COLOUR`: the left eye's luma, the right eye in colour.
+    HalfColour,
+    /// `DUBOIS`: Dubois' least-squares matrices (three.js's default).
+    Dubois,
+    /// `OPTIMISED`: the left eye's green and blue as red (3dtv.at's optimized).
+    Optimised,
+    /// `COMPROMISE`: Ahtik's balance of colour reproduction and stereo effect.
+    Compromise,
+}
+
+/// The glasses three.js's table is written for (`AnaglyphColorMode`), left filter first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum AnaglyphGlasses {
+    /// `RED_CYAN`.
+    RedCyan,
+    /// `MAGENTA_CYAN`: both filters pass blue, so each eye gets half of the blue channel.
+    MagentaCyan,
+    /// `MAGENTA_GREEN`.
+    MagentaGreen,
+}
+
+impl AnaglyphMethod {
+    /// Every method, in three.js's order.
+    pub const ALL: [AnaglyphMethod; 7] = [
+        AnaglyphMethod::True,
+        AnaglyphMethod::Grey,
+        AnaglyphMethod::Colour,
+        AnaglyphMethod::HalfColour,
+        AnaglyphMethod::Dubois,
+        AnaglyphMethod::Optimised,
+        AnaglyphMethod::Compromise,
+    ];
+}
+
+impl AnaglyphGlasses {
+    /// Every pair of glasses, in three.js's order.
+    pub const ALL: [AnaglyphGlasses; 3] = [
+        AnaglyphGlasses::RedCyan,
+        AnaglyphGlasses::MagentaCyan,
+        AnaglyphGlasses::MagentaGreen,
+    ];
+}
+
+/// The output names of three.js's table, `[method][glasses]` in the order of the two `ALL`s.
+const THREE_JS_NAMES: [[&str; 3]; 7] = [
+    [
+        "anaglyph_true_red_cyan",
+        "anaglyph_true_magenta_cyan",
+        "anaglyph_true_magenta_green",
+    ],
+    [
+        "anaglyph_grey_red_cyan",
+        "anaglyph_grey_magenta_cyan",
+        "anaglyph_grey_magenta_green",
+    ],
+    [
+        "anaglyph_colour_red_cyan",
+        "anaglyph_colour_magenta_cyan",
+        "anaglyph_colour_magenta_green",
+    ],
+    [
+        "anaglyph_half_colour_red_cyan",
+        "anaglyph_half_colour_magenta_cyan",
+        "anaglyph_half_colour_magenta_green",
+    ],
+    [
+        "anaglyph_dubois_red_cyan",
+        "anaglyph_dubois_magenta_cyan",
+        "anaglyph_dubois_magenta_green",
+    ],
+    [
+        "anaglyph_optimised_red_cyan",
+        "anaglyph_optimised_magenta_cyan",
+        "anaglyph_optimised_magenta_green",
+    ],
+    [
+        "anaglyph_compromise_red_cyan",
+        "anaglyph_compromise_magenta_cyan",
+        "anaglyph_compromise_magenta_green",
+    ],
+];
 
 /// Rec. 601 luma weights, as the exercise slides write them (0,299 0,587 0,114).
 const LUMA: [f32; 3] = [0.299, 0.587, 0.114];
@@ -72,9 +166,23 @@ impl AnaglyphKind {
         AnaglyphKind::DuboisAmberBlue,
     ];
 
+    /// three.js's whole table, method by method, glasses within each method: 21 kinds.
+    pub const THREE_JS: [AnaglyphKind; 21] = {
+        let mut all = [AnaglyphKind::True; 21];
+        let mut i = 0;
+        while i < 21 {
+            all[i] = AnaglyphKind::ThreeJs(AnaglyphMethod::ALL[i / 3], AnaglyphGlasses::ALL[i % 3]);
+            i += 1;
+        }
+        all
+    };
+
     /// The output name a scene file asks for: `anaglyph_<kind>`.
     pub fn output_name(self) -> &'static str {
         match self {
+            AnaglyphKind::ThreeJs(method, glasses) => {
+                THREE_JS_NAMES[method as usize][glasses as usize]
+            }
             AnaglyphKind::True => "anaglyph_true",
             AnaglyphKind::Gray => "anaglyph_gray",
             AnaglyphKind::Color => "anaglyph_color",
@@ -103,8 +211,10 @@ impl AnaglyphKind {
     ///   disagree on its sign; only −0.065 keeps the green row's sum at 1).
     /// - `DuboisAmberBlue`: Dubois' amber-blue matrices as vpinball ships them (dolphin's
     ///   LCD amber-blue copy has rows summing to 1.035 and 0.523, a transcription error).
+    /// - `ThreeJs(method, glasses)`: [`threejs_anaglyph`].
     pub fn matrices(self) -> AnaglyphMatrices {
         let (left, right) = match self {
+            AnaglyphKind::ThreeJs(method, glasses) => return threejs_anaglyph(method, glasses),
             AnaglyphKind::True => ([LUMA, ZERO, ZERO], [ZERO, ZERO, LUMA]),
             AnaglyphKind::Gray => ([LUMA, ZERO, ZERO], [ZERO, LUMA, LUMA]),
             AnaglyphKind::Color => (
@@ -175,10 +285,102 @@ impl AnaglyphKind {
     /// Every kind except `True`: the exercise slides' true anaglyph sends luma to red and blue only, so
     /// white becomes magenta (1, 0, 1). The Dubois matrices are least-squares fits, so their
     /// rows sum to 1 only within rounding of the published digits (the CRT blue row sums to
-    /// 0.9960).
+    /// 0.9960). In three.js's table white stays white except in three cells: Dubois and
+    /// Compromise for magenta-cyan (the blue rows sum to 0.962 and 0.648) and Dubois for
+    /// magenta-green (the blue row is the left eye's alone and sums to −0.133: white becomes
+    /// yellow).
     pub fn preserves_white(self) -> bool {
-        self != AnaglyphKind::True
+        use AnaglyphGlasses::{MagentaCyan, MagentaGreen};
+        use AnaglyphMethod::{Compromise, Dubois};
+        !matches!(
+            self,
+            AnaglyphKind::True
+                | AnaglyphKind::ThreeJs(Dubois | Compromise, MagentaCyan)
+                | AnaglyphKind::ThreeJs(Dubois, MagentaGreen)
+        )
     }
+}
+
+/// `(ML, MR)` of one cell of three.js's method × glasses table (`ANAGLYPH_MATRICES` of
+/// `examples/jsm/tsl/display/AnaglyphPassNode.js`, MIT licence; the numbers are reproduced in
+/// `docs/anaglyph-matrices.md` with their sources). Rows are output channels, as everywhere
+/// here; three.js stores the same numbers column-major.
+///
+/// - Red-cyan: `True` differs from the exercise slides' true anaglyph (three.js sends the
+///   left eye's red, not its luma, to red, and the right eye's luma to green and blue);
+///   `Grey`, `Colour`, `HalfColour`, `Optimised` and `Dubois` are the slides', 3dtv.at's and
+///   Dubois' CRT matrices ([`AnaglyphKind::Gray`] and the others, tested equal).
+/// - `Compromise`: J. Ahtik, "Introducing a New Anaglyph Method: Compromise Anaglyph":
+///   `R = 0.439 R_l + 0.447 G_l + 0.148 B_l`, `G = 0.095 R_r + 0.934 G_r + 0.005 B_r`,
+///   `B = 0.018 R_r + 0.028 G_r + 1.057 B_r`.
+/// - Magenta-cyan (R. Lobel, "Magenta-Cyan Anaglyphs"): both filters pass blue, so the blue
+///   output is shared between the eyes, half each (for Grey and HalfColour half of the luma,
+///   written 0.15, 0.29, 0.06); for Compromise three.js writes 0.009, 0.014, 0.074 (left)
+///   and 0.009, 0.014, 0.528 (right), for Dubois 0.088, 0.088, −0.003 (left) and 0.088,
+///   0.088, 0.613 (right).
+/// - Magenta-green: the left eye's red row also drives blue (the magenta filter passes both),
+///   the green row takes what red-cyan's green and blue rows took, or for Dubois and
+///   Compromise the sum of the left's red row and the right's green row. three.js's Dubois
+///   magenta-green gives the left eye the right eye's red row (negative) as blue, so white
+///   becomes yellow ([`AnaglyphKind::preserves_white`]).
+pub fn threejs_anaglyph(method: AnaglyphMethod, glasses: AnaglyphGlasses) -> AnaglyphMatrices {
+    use AnaglyphGlasses::{MagentaCyan, MagentaGreen, RedCyan};
+    use AnaglyphMethod as M;
+    const R: [f32; 3] = [1.0, 0.0, 0.0];
+    const G: [f32; 3] = [0.0, 1.0, 0.0];
+    const B: [f32; 3] = [0.0, 0.0, 1.0];
+    const HALF_B: [f32; 3] = [0.0, 0.0, 0.5];
+    const HALF_LUMA: [f32; 3] = [0.15, 0.29, 0.06];
+    const DUBOIS_L: ColorMatrix = [
+        [0.456100, 0.500484, 0.176381],
+        [-0.0400822, -0.0378246, -0.0157589],
+        [-0.0152161, -0.0205971, -0.00546856],
+    ];
+    const DUBOIS_R: ColorMatrix = [
+        [-0.0434706, -0.0879388, -0.00155529],
+        [0.378476, 0.73364, -0.0184503],
+        [-0.0721527, -0.112961, 1.2264],
+    ];
+    const AHTIK_R: [f32; 3] = [0.439, 0.447, 0.148];
+    const AHTIK_G: [f32; 3] = [0.095, 0.934, 0.005];
+    const AHTIK_B: [f32; 3] = [0.018, 0.028, 1.057];
+    let sum = |a: [f32; 3], b: [f32; 3]| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+    let (left, right) = match (method, glasses) {
+        (M::True, RedCyan) => ([R, ZERO, ZERO], [ZERO, LUMA, LUMA]),
+        (M::True, MagentaCyan) => ([R, ZERO, HALF_B], [ZERO, LUMA, HALF_B]),
+        (M::True, MagentaGreen) => ([R, ZERO, LUMA], [ZERO, LUMA, ZERO]),
+        (M::Grey, RedCyan) => ([LUMA, ZERO, ZERO], [ZERO, LUMA, LUMA]),
+        (M::Grey, MagentaCyan) => ([LUMA, ZERO, HALF_LUMA], [ZERO, LUMA, HALF_LUMA]),
+        (M::Grey, MagentaGreen) => ([LUMA, ZERO, LUMA], [ZERO, LUMA, ZERO]),
+        (M::Colour, RedCyan) => ([R, ZERO, ZERO], [ZERO, G, B]),
+        (M::Colour, MagentaCyan) => ([R, ZERO, HALF_B], [ZERO, G, HALF_B]),
+        (M::Colour, MagentaGreen) => ([R, ZERO, B], [ZERO, G, ZERO]),
+        (M::HalfColour, RedCyan) => ([LUMA, ZERO, ZERO], [ZERO, G, B]),
+        (M::HalfColour, MagentaCyan) => ([LUMA, ZERO, HALF_LUMA], [ZERO, G, HALF_LUMA]),
+        (M::HalfColour, MagentaGreen) => ([LUMA, ZERO, LUMA], [ZERO, G, ZERO]),
+        (M::Dubois, RedCyan) => (DUBOIS_L, DUBOIS_R),
+        (M::Dubois, MagentaCyan) => (
+            [DUBOIS_L[0], DUBOIS_L[1], [0.088, 0.088, -0.003]],
+            [DUBOIS_R[0], DUBOIS_R[1], [0.088, 0.088, 0.613]],
+        ),
+        (M::Dubois, MagentaGreen) => (
+            [DUBOIS_L[0], ZERO, DUBOIS_R[0]],
+            [ZERO, sum(DUBOIS_R[1], DUBOIS_L[0]), ZERO],
+        ),
+        (M::Optimised, RedCyan) => ([[0.0, 0.7, 0.3], ZERO, ZERO], [ZERO, G, B]),
+        (M::Optimised, MagentaCyan) => ([[0.0, 0.7, 0.3], ZERO, HALF_B], [ZERO, G, HALF_B]),
+        (M::Optimised, MagentaGreen) => ([[0.0, 0.7, 0.3], ZERO, B], [ZERO, G, ZERO]),
+        (M::Compromise, RedCyan) => ([AHTIK_R, ZERO, ZERO], [ZERO, AHTIK_G, AHTIK_B]),
+        (M::Compromise, MagentaCyan) => (
+            [AHTIK_R, ZERO, [0.009, 0.014, 0.074]],
+            [ZERO, AHTIK_G, [0.009, 0.014, 0.528]],
+        ),
+        (M::Compromise, MagentaGreen) => (
+            [AHTIK_R, ZERO, AHTIK_B],
+            [ZERO, sum(AHTIK_G, AHTIK_R), ZERO],
+        ),
+    };
+    AnaglyphMatrices { left, right }
 }
 
 /// Finalize options for anaglyphs (the scene's optional `[finalize]` table).
@@ -191,6 +393,23 @@ pub struct AnaglyphOptions {
     /// Swap the eyes: `ML` reads the right eye and `MR` the left (glasses worn the other way
     /// round).
     pub swap_eyes: bool,
+    /// Rendepth's anti-rivalry stage after the mix: each output channel raised to
+    /// `1/γ` with γ = [`ANTI_RIVALRY_GAMMA`] ([`anti_rivalry`]).
+    pub anti_rivalry: bool,
+}
+
+/// Rendepth's per-channel gamma map (R, G, B): red brightened, green darkened, blue kept, so
+/// the eye behind the red filter is not the darker one (A. Hernandez (Cybereality), "Rendepth:
+/// Red/Cyan Anaglyph Filter Optimized for Stereoscopic 3D on LCD Monitors", after Peter
+/// Wimmer's optimized anaglyphs).
+pub const ANTI_RIVALRY_GAMMA: [f32; 3] = [1.6, 0.8, 1.0];
+
+/// Rendepth's anti-rivalry stage on one mixed color in [0, 1]: `c_i^(1/γ_i)` with
+/// γ = [`ANTI_RIVALRY_GAMMA`] (Rendepth's `correct_color`). Applied to the display's
+/// (stored) values, after the sRGB encoding where the mix ran in linear light.
+#[inline]
+pub fn anti_rivalry(c: [f32; 3]) -> [f32; 3] {
+    [0, 1, 2].map(|i| c[i].powf(1.0 / ANTI_RIVALRY_GAMMA[i]))
 }
 
 impl AnaglyphOptions {
@@ -259,6 +478,24 @@ pub fn anaglyph_pixel(
     right: [u8; 4],
     linear_light: bool,
 ) -> [u8; 4] {
+    let options = AnaglyphOptions {
+        linear_light,
+        ..AnaglyphOptions::default()
+    };
+    anaglyph_pixel_with(m, left, right, options)
+}
+
+/// [`anaglyph_pixel`] with every option that changes a pixel's value: `linear_light` and
+/// `anti_rivalry` (Rendepth's gamma stage, [`anti_rivalry`], after the encoding). The
+/// definition the image loops are held to.
+#[inline]
+pub fn anaglyph_pixel_with(
+    m: &AnaglyphMatrices,
+    left: [u8; 4],
+    right: [u8; 4],
+    options: AnaglyphOptions,
+) -> [u8; 4] {
+    let linear_light = options.linear_light;
     let decode = |p: [u8; 4]| {
         let c = [p[0], p[1], p[2]].map(|v| v as f32 / 255.0);
         if linear_light {
@@ -270,6 +507,11 @@ pub fn anaglyph_pixel(
     let out = mix(m, decode(left), decode(right));
     let out = if linear_light {
         out.map(linear_to_srgb)
+    } else {
+        out
+    };
+    let out = if options.anti_rivalry {
+        anti_rivalry(out)
     } else {
         out
     };
@@ -325,10 +567,17 @@ fn anaglyph_on(
         let r = y * w..y * w + len;
         (&left.color[r.clone()], &right.color[r])
     };
-    let bytes = if options.linear_light {
+    let bytes = if options.linear_light || options.anti_rivalry {
         // A GPU decodes an sRGB texture in the sampler; a 256-entry table is the same thing.
         let decode: Vec<f32> = (0..=255u8)
-            .map(|v| srgb_to_linear(v as f32 / 255.0))
+            .map(|v| {
+                let c = v as f32 / 255.0;
+                if options.linear_light {
+                    srgb_to_linear(c)
+                } else {
+                    c
+                }
+            })
             .collect();
         let lin = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| decode[v as usize]);
         let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
@@ -340,8 +589,18 @@ fn anaglyph_on(
                 let px = match last {
                     Some((pair, px)) if pair == (*l, *r) => px,
                     _ => {
-                        let c = mix(&m, lin(l), lin(r)).map(|c| to_u8(linear_to_srgb(c)));
-                        let px = [c[0], c[1], c[2], 255];
+                        let c = mix(&m, lin(l), lin(r));
+                        let c = if options.linear_light {
+                            c.map(linear_to_srgb)
+                        } else {
+                            c
+                        };
+                        let c = if options.anti_rivalry {
+                            anti_rivalry(c)
+                        } else {
+                            c
+                        };
+                        let px = [to_u8(c[0]), to_u8(c[1]), to_u8(c[2]), 255];
                         last = Some(((*l, *r), px));
                         px
                     }
@@ -396,25 +655,24 @@ mod tests {
                 _ => *r = [3, (i * 5) as u8, 250, 255],
             }
         }
-        for kind in AnaglyphKind::ALL {
-            for linear_light in [false, true] {
+        let kinds = AnaglyphKind::ALL.into_iter().chain(AnaglyphKind::THREE_JS);
+        for kind in kinds {
+            for (linear_light, anti_rivalry) in [(false, false), (true, false), (false, true)] {
                 for kernels in [Kernels::Avx2, Kernels::Scalar] {
                     let options = AnaglyphOptions {
                         linear_light,
                         swap_eyes: false,
+                        anti_rivalry,
                     };
                     let img = anaglyph_on(&left, &right, kind, options, kernels).unwrap();
                     for (i, px) in img.pixels().enumerate() {
-                        let want = anaglyph_pixel(
+                        let want = anaglyph_pixel_with(
                             &kind.matrices(),
                             left.color[i],
                             right.color[i],
-                            linear_light,
+                            options,
                         );
-                        assert_eq!(
-                            px.0, want,
-                            "{kind:?} linear {linear_light} {kernels:?}: pixel {i}"
-                        );
+                        assert_eq!(px.0, want, "{kind:?} {options:?} {kernels:?}: pixel {i}");
                     }
                 }
             }

@@ -199,6 +199,9 @@ pub(crate) struct FinalizeSpec {
     /// Swap the eyes in anaglyphs (glasses worn the other way round).
     #[serde(default)]
     pub swap_eyes: bool,
+    /// Rendepth's anti-rivalry gamma stage after every anaglyph's mix.
+    #[serde(default)]
+    pub anti_rivalry: bool,
 }
 
 /// One `[[mesh]]`.

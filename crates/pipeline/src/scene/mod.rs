@@ -322,6 +322,7 @@ impl Scene {
             finalize: AnaglyphOptions {
                 linear_light: f.finalize.linear_light,
                 swap_eyes: f.finalize.swap_eyes,
+                anti_rivalry: f.finalize.anti_rivalry,
             },
             sirds,
             rds: f.rds,

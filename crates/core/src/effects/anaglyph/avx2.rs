@@ -186,7 +186,7 @@ mod tests {
         let (fl, fr): (Vec<_>, Vec<_>) = front.into_iter().unzip();
         left.splice(0..0, fl);
         right.splice(0..0, fr);
-        for kind in AnaglyphKind::ALL {
+        for kind in AnaglyphKind::ALL.into_iter().chain(AnaglyphKind::THREE_JS) {
             let m = kind.matrices();
             let mut fast = vec![MaybeUninit::new([0u8; 4]); left.len()];
             // SAFETY: AVX2 is available (checked above).

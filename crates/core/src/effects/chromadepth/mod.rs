@@ -119,12 +119,11 @@ impl ChromaDepthSettings {
     /// # Errors
     /// An unknown kind name.
     pub fn anaglyph_kind(&self) -> Result<AnaglyphKind> {
-        AnaglyphKind::ALL
-            .into_iter()
+        let every = || AnaglyphKind::ALL.into_iter().chain(AnaglyphKind::THREE_JS);
+        every()
             .find(|k| k.output_name().strip_prefix("anaglyph_") == Some(self.anaglyph.as_str()))
             .ok_or_else(|| {
-                let known: Vec<&str> = AnaglyphKind::ALL
-                    .iter()
+                let known: Vec<&str> = every()
                     .filter_map(|k| k.output_name().strip_prefix("anaglyph_"))
                     .collect();
                 Error::invalid(
