@@ -24,6 +24,7 @@ mod exercises;
 mod figures;
 mod grade;
 mod info;
+mod inspect;
 mod render;
 mod sirds;
 #[cfg(feature = "viewer")]
@@ -86,6 +87,8 @@ enum Command {
     },
     /// Print the derived cameras and the scene's parallax range.
     Info(info::InfoArgs),
+    /// Read another program's stereo picture back as two views: its layout given or detected.
+    Inspect(inspect::InspectArgs),
     /// Draw the slides' figures (rig top views, parallax plot) for a scene.
     Figures(figures::FiguresArgs),
     /// Measure accuracy knobs and speed: error and time side by side.
@@ -252,6 +255,7 @@ fn run(cli: Cli) -> Result<bool> {
         Command::Compare(args) => compare::run(args),
         Command::Exercises { command } => exercises::run(command),
         Command::Info(args) => info::run(args),
+        Command::Inspect(args) => inspect::run(args),
         Command::Figures(args) => figures::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Sirds(args) => sirds::run(&args),

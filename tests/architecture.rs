@@ -21,7 +21,7 @@
 //! - `fixtures`: scenes and depth maps shared by tests, benchmarks and the GPU path.
 //! - `render`: the passes (eye passes, the ChromaDepth pass, the SIRDS strips) over a scene.
 //! - `output`: a rendered frame into the images the scene asked for, and files.
-//! - `info`, `compare`: reports, image metrics.
+//! - `info`, `inspect`, `compare`: reports, other programs' stereo pictures, image metrics.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -48,7 +48,7 @@ const CRATES: &[(&str, &[&[&str]])] = &[
             &["fixtures"],
             &["render"],
             &["output"],
-            &["info", "compare", "memory"],
+            &["info", "inspect", "compare", "memory"],
         ],
     ),
 ];

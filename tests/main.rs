@@ -28,6 +28,7 @@ mod grading_sandbox;
 mod grading_trust;
 mod hard_cases;
 mod image_shift;
+mod inspect;
 mod interruptions;
 mod layout;
 mod memory;

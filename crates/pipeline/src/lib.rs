@@ -14,6 +14,7 @@
 pub mod compare;
 pub mod fixtures;
 pub mod info;
+pub mod inspect;
 pub mod memory;
 pub mod output;
 pub mod plan;

@@ -1,0 +1,700 @@
+//! `stereolab inspect`: another program's stereo image read back as two views. The layout is
+//! given (`--layout`) or detected, and the report says which was taken and on what evidence.
+//!
+//! Each layout's inverse is [`split`], the undoing of the matching writer in
+//! `stereolab_core`'s layouts (a squeezed view is stretched back by repeating its columns or
+//! rows, an interleaved one fills each missing pixel from its neighbour of the same eye, an
+//! anaglyph gives each eye the channels its filter passes, as gray). [`detect`] tries the
+//! layouts that leave a mark no single view has: the black active space of frame packing, the
+//! black blank interval of the squashed above-below format, an anaglyph's edges that sit in
+//! different places in different channels, the comb of interleaved rows or columns; then two
+//! halves that show the same scene. A picture with none of these is refused, never guessed.
+
+use std::path::{Path, PathBuf};
+
+use image::{Rgba, RgbaImage};
+use stereolab_core::{Error, Result, frame_packing_active_space};
+
+use crate::output::stereo_photo::{PhotoFormat, read_stereo};
+
+/// How two views share one picture (or two files).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// Two files, left then right.
+    Pair,
+    /// Left | right, each view full size (parallel viewing).
+    SideBySide,
+    /// Right | left, each view full size (cross-eyed viewing; JPS and PNS order).
+    CrossEyed,
+    /// Left | right squeezed into one view's width (3D TVs' side-by-side (half)).
+    HalfSideBySide,
+    /// Left over right, each view full size.
+    AboveBelow,
+    /// Left over right squeezed into one view's height (top-and-bottom).
+    HalfAboveBelow,
+    /// Left over right, each squashed to `(H − blank)/2` rows around a black blank interval.
+    AboveBelowSquashed,
+    /// HDMI 1.4a frame packing: left, `H/24` black rows, right.
+    FramePacking,
+    /// Even rows left, odd rows right.
+    InterlacedRows,
+    /// Even columns left, odd columns right.
+    InterlacedColumns,
+    /// Left where `x + y` is even.
+    Checkerboard,
+    /// Red for the left eye, green and blue for the right.
+    AnaglyphRedCyan,
+    /// Green for the left eye, red and blue for the right.
+    AnaglyphGreenMagenta,
+    /// Red and green (amber) for the left eye, blue for the right.
+    AnaglyphAmberBlue,
+    /// A CIPA DC-007 multi-picture JPEG (`.mpo`): its first two images.
+    Mpo,
+    /// A JPEG stereo file (`.jps`): right | left unless its descriptor says otherwise.
+    Jps,
+    /// A PNG stereo file (`.pns`): right | left.
+    Pns,
+}
+
+impl Layout {
+    /// The layouts `--layout` takes (the containers come from the file name).
+    pub const GIVEN: [Layout; 14] = [
+        Layout::Pair,
+        Layout::SideBySide,
+        Layout::CrossEyed,
+        Layout::HalfSideBySide,
+        Layout::AboveBelow,
+        Layout::HalfAboveBelow,
+        Layout::AboveBelowSquashed,
+        Layout::FramePacking,
+        Layout::InterlacedRows,
+        Layout::InterlacedColumns,
+        Layout::Checkerboard,
+        Layout::AnaglyphRedCyan,
+        Layout::AnaglyphGreenMagenta,
+        Layout::AnaglyphAmberBlue,
+    ];
+
+    /// The name `--layout` and the report use: the output name of the layout that writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Pair => "pair",
+            Layout::SideBySide => "side_by_side",
+            Layout::CrossEyed => "cross_eyed",
+            Layout::HalfSideBySide => "half_side_by_side",
+            Layout::AboveBelow => "above_below",
+            Layout::HalfAboveBelow => "half_above_below",
+            Layout::AboveBelowSquashed => "above_below_squashed",
+            Layout::FramePacking => "frame_packing",
+            Layout::InterlacedRows => "interlaced_rows",
+            Layout::InterlacedColumns => "interlaced_columns",
+            Layout::Checkerboard => "checkerboard",
+            Layout::AnaglyphRedCyan => "anaglyph_red_cyan",
+            Layout::AnaglyphGreenMagenta => "anaglyph_green_magenta",
+            Layout::AnaglyphAmberBlue => "anaglyph_amber_blue",
+            Layout::Mpo => "mpo",
+            Layout::Jps => "jps",
+            Layout::Pns => "pns",
+        }
+    }
+
+    /// Parses a `--layout` value.
+    ///
+    /// # Errors
+    /// `Invalid` listing the known names.
+    pub fn parse(name: &str) -> Result<Layout> {
+        let wanted = name.replace('-', "_");
+        Layout::GIVEN
+            .into_iter()
+            .find(|l| l.name() == wanted)
+            .ok_or_else(|| {
+                let known: Vec<&str> = Layout::GIVEN.iter().map(|l| l.name()).collect();
+                Error::invalid(
+                    "--layout",
+                    stereolab_core::excerpt(name),
+                    format!("known layouts: {}", known.join(", ")),
+                )
+            })
+    }
+
+    /// Whether each view comes back gray (an anaglyph keeps one filter's channels per eye).
+    pub fn gray_views(self) -> bool {
+        matches!(
+            self,
+            Layout::AnaglyphRedCyan | Layout::AnaglyphGreenMagenta | Layout::AnaglyphAmberBlue
+        )
+    }
+}
+
+/// Two views read back, the layout they came in, and why that layout.
+#[derive(Clone, Debug)]
+pub struct Views {
+    /// The left eye's view.
+    pub left: RgbaImage,
+    /// The right eye's view.
+    pub right: RgbaImage,
+    /// The layout taken.
+    pub layout: Layout,
+    /// `given` (by `--layout` or the file name), or the detection's evidence.
+    pub evidence: String,
+}
+
+/// Reads `paths` (two images: a pair; one: a layout) as two views.
+///
+/// # Errors
+/// A file that cannot be read, two files of different sizes, a `--layout` that does not fit
+/// the picture, or a picture with no detectable stereo layout.
+pub fn read(paths: &[PathBuf], layout: Option<Layout>) -> Result<Views> {
+    match paths {
+        [left, right] => {
+            if layout.is_some_and(|l| l != Layout::Pair) {
+                return Err(Error::invalid(
+                    "--layout",
+                    layout.map_or("", Layout::name),
+                    "two files are a left/right pair; give one file for a layout",
+                ));
+            }
+            let (l, r) = (open(left)?, open(right)?);
+            if l.dimensions() != r.dimensions() {
+                return Err(Error::invalid(
+                    "inspect",
+                    format!(
+                        "{} is {}×{}, {} is {}×{}",
+                        left.display(),
+                        l.width(),
+                        l.height(),
+                        right.display(),
+                        r.width(),
+                        r.height()
+                    ),
+                    "the two views of a pair have the same size",
+                ));
+            }
+            Ok(Views {
+                left: l,
+                right: r,
+                layout: Layout::Pair,
+                evidence: "two files".into(),
+            })
+        }
+        [one] => read_one(one, layout),
+        _ => Err(Error::invalid(
+            "inspect",
+            format!("{} files", paths.len()),
+            "give one picture with both views, or a left and a right picture",
+        )),
+    }
+}
+
+fn read_one(path: &Path, layout: Option<Layout>) -> Result<Views> {
+    if let Some(format) = PhotoFormat::from_path(path) {
+        if layout.is_some() {
+            return Err(Error::invalid(
+                "--layout",
+                layout.map_or("", Layout::name),
+                format!(
+                    "a .{} file says its own layout; leave --layout out",
+                    format.extension()
+                ),
+            ));
+        }
+        let (left, right) = read_stereo(path)?;
+        let layout = match format {
+            PhotoFormat::Mpo => Layout::Mpo,
+            PhotoFormat::Jps => Layout::Jps,
+            PhotoFormat::Pns => Layout::Pns,
+        };
+        return Ok(Views {
+            left,
+            right,
+            layout,
+            evidence: format!("the .{} container", format.extension()),
+        });
+    }
+    let img = open(path)?;
+    let (layout, evidence) = match layout {
+        Some(Layout::Pair) => {
+            return Err(Error::invalid(
+                "--layout",
+                "pair",
+                "a pair is two files: give the right eye's picture too",
+            ));
+        }
+        Some(l) => (l, "given".to_string()),
+        None => detect(&img).map_err(|e| match e {
+            Error::Invalid { reason, .. } => Error::invalid(
+                "inspect",
+                path.display(),
+                format!("{reason}; if it is a stereo picture, say its --layout"),
+            ),
+            other => other,
+        })?,
+    };
+    let (left, right) = split(&img, layout)?;
+    Ok(Views {
+        left,
+        right,
+        layout,
+        evidence,
+    })
+}
+
+fn open(path: &Path) -> Result<RgbaImage> {
+    Ok(stereolab_core::open_output_image(path, "stereo picture")?.to_rgba8())
+}
+
+/// The two views of `img` in `layout`, each at the size of one view (squeezed and interleaved
+/// views restored to the frame's size).
+///
+/// # Errors
+/// A picture that cannot hold the layout (an odd width for side by side, a frame packing
+/// height that fits no view height, no blank interval for the squashed format).
+pub fn split(img: &RgbaImage, layout: Layout) -> Result<(RgbaImage, RgbaImage)> {
+    let (w, h) = img.dimensions();
+    let crop = |x, y, cw, ch| image::imageops::crop_imm(img, x, y, cw, ch).to_image();
+    let need = |ok: bool, what: &str| {
+        if ok {
+            Ok(())
+        } else {
+            Err(Error::invalid(
+                "--layout",
+                layout.name(),
+                format!("a {w}×{h} picture {what}"),
+            ))
+        }
+    };
+    Ok(match layout {
+        Layout::SideBySide | Layout::CrossEyed | Layout::Jps | Layout::Pns => {
+            need(w % 2 == 0 && w >= 2, "needs an even width")?;
+            let (a, b) = (crop(0, 0, w / 2, h), crop(w / 2, 0, w / 2, h));
+            if layout == Layout::SideBySide {
+                (a, b)
+            } else {
+                (b, a)
+            }
+        }
+        Layout::HalfSideBySide => {
+            need(w >= 2, "needs two columns")?;
+            let half = w / 2;
+            let stretch =
+                |x0: u32| RgbaImage::from_fn(w, h, |x, y| *img.get_pixel(x0 + (x * half / w), y));
+            (stretch(0), stretch(half))
+        }
+        Layout::AboveBelow => {
+            need(h % 2 == 0 && h >= 2, "needs an even height")?;
+            (crop(0, 0, w, h / 2), crop(0, h / 2, w, h / 2))
+        }
+        Layout::HalfAboveBelow => {
+            need(h >= 2, "needs two rows")?;
+            let half = h / 2;
+            let stretch =
+                |y0: u32| RgbaImage::from_fn(w, h, |x, y| *img.get_pixel(x, y0 + (y * half / h)));
+            (stretch(0), stretch(half))
+        }
+        Layout::AboveBelowSquashed => {
+            let (top, blank) = blank_band(img).ok_or_else(|| {
+                Error::invalid(
+                    "--layout",
+                    layout.name(),
+                    "no black blank interval between two equal halves",
+                )
+            })?;
+            let stretch =
+                |y0: u32| RgbaImage::from_fn(w, h, |x, y| *img.get_pixel(x, y0 + (y * top / h)));
+            (stretch(0), stretch(top + blank))
+        }
+        Layout::FramePacking => {
+            let view = packed_view_height(h);
+            need(view.is_some(), "is no 2H + H/24 rows for any view height H")?;
+            let view = view.unwrap_or(0);
+            let gap = frame_packing_active_space(view);
+            (crop(0, 0, w, view), crop(0, view + gap, w, view))
+        }
+        Layout::InterlacedRows => {
+            need(h >= 2, "needs two rows")?;
+            let field = |parity: u32| {
+                RgbaImage::from_fn(w, h, |x, y| *img.get_pixel(x, same_parity(y, parity, h)))
+            };
+            (field(0), field(1))
+        }
+        Layout::InterlacedColumns => {
+            need(w >= 2, "needs two columns")?;
+            let field = |parity: u32| {
+                RgbaImage::from_fn(w, h, |x, y| *img.get_pixel(same_parity(x, parity, w), y))
+            };
+            (field(0), field(1))
+        }
+        Layout::Checkerboard => {
+            need(w >= 2, "needs two columns")?;
+            let field = |parity: u32| {
+                RgbaImage::from_fn(w, h, |x, y| {
+                    // The pixel itself where it is this eye's, else its row neighbour.
+                    let p = (parity + y) % 2;
+                    *img.get_pixel(same_parity(x, p, w), y)
+                })
+            };
+            (field(0), field(1))
+        }
+        Layout::AnaglyphRedCyan => (channels(img, [1, 0, 0]), channels(img, [0, 1, 1])),
+        Layout::AnaglyphGreenMagenta => (channels(img, [0, 1, 0]), channels(img, [1, 0, 1])),
+        Layout::AnaglyphAmberBlue => (channels(img, [1, 1, 0]), channels(img, [0, 0, 1])),
+        Layout::Pair | Layout::Mpo => {
+            return Err(Error::invalid(
+                "--layout",
+                layout.name(),
+                "is not a layout of one picture",
+            ));
+        }
+    })
+}
+
+/// `i` if it has `parity`, else its neighbour that has (the one before, at the far edge).
+fn same_parity(i: u32, parity: u32, n: u32) -> u32 {
+    if i % 2 == parity {
+        i
+    } else if i + 1 < n {
+        i + 1
+    } else {
+        i - 1
+    }
+}
+
+/// The channels of `pass` that are not black all over (a true anaglyph leaves green black).
+fn lit(img: &RgbaImage, pass: [u32; 3]) -> [u32; 3] {
+    let used: [u32; 3] =
+        std::array::from_fn(|c| u32::from(pass[c] == 1 && img.pixels().any(|p| p.0[c] > 0)));
+    if used.contains(&1) { used } else { pass }
+}
+
+/// One eye of an anaglyph: the mean of the channels its filter passes (those not black all
+/// over), as gray.
+fn channels(img: &RgbaImage, pass: [u32; 3]) -> RgbaImage {
+    let pass = lit(img, pass);
+    let n: u32 = pass.iter().sum();
+    RgbaImage::from_fn(img.width(), img.height(), |x, y| {
+        let p = img.get_pixel(x, y).0;
+        let sum: u32 = (0..3).map(|c| pass[c] * u32::from(p[c])).sum();
+        let v = ((sum + n / 2) / n) as u8;
+        Rgba([v, v, v, 255])
+    })
+}
+
+/// The view height H of a frame-packed picture `rows` tall: `2H + H/24 = rows`.
+fn packed_view_height(rows: u32) -> Option<u32> {
+    let guess = u64::from(rows) * 24 / 49;
+    (guess.saturating_sub(2)..=guess + 2)
+        .filter_map(|v| u32::try_from(v).ok())
+        .find(|&v| {
+            v > 0 && 2 * u64::from(v) + u64::from(frame_packing_active_space(v)) == u64::from(rows)
+        })
+}
+
+/// Whether row `y` of `img` is black (every channel of every pixel at most 2).
+fn black_row(img: &RgbaImage, y: u32) -> bool {
+    (0..img.width()).all(|x| img.get_pixel(x, y).0[..3].iter().all(|&c| c <= 2))
+}
+
+/// The squashed format's geometry: `(rows, blank)` when rows `rows..rows + blank` are black,
+/// with `rows` view rows on either side (`2·rows + blank` = the height, ± the one row an odd
+/// remainder leaves at the bottom), and the rows just around the band are not all black.
+fn blank_band(img: &RgbaImage) -> Option<(u32, u32)> {
+    let h = img.height();
+    let mid = h / 2;
+    if h < 4 || !black_row(img, mid) {
+        return None;
+    }
+    let mut top = mid;
+    while top > 0 && black_row(img, top - 1) {
+        top -= 1;
+    }
+    let mut end = mid + 1;
+    while end < h && black_row(img, end) {
+        end += 1;
+    }
+    let blank = end - top;
+    let below = h - end;
+    let fits = top > 0 && (below == top || below == top + 1);
+    fits.then_some((top, blank))
+}
+
+/// Rec. 601 luma of every pixel, in [0, 255].
+fn luma(img: &RgbaImage) -> Vec<f32> {
+    img.pixels()
+        .map(|p| 0.299 * f32::from(p.0[0]) + 0.587 * f32::from(p.0[1]) + 0.114 * f32::from(p.0[2]))
+        .collect()
+}
+
+/// How alike the edges of an anaglyph's two eyes are at 64 px: the correlation of their
+/// gradient magnitudes. A filter's channels may show a surface brighter or darker than its
+/// background (a brown model is bright in red, dark in blue), but its outline is in both.
+fn edges_alike(img: &RgbaImage, layout: Layout) -> Option<f64> {
+    let (a, b) = split(img, layout).ok()?;
+    let edges = |v: &RgbaImage| {
+        let (l, w, h) = small_luma(v, 64);
+        let at = |x: u32, y: u32| l[(y * w + x) as usize];
+        let mut g = Vec::new();
+        for y in 1..h {
+            for x in 1..w {
+                g.push((at(x, y) - at(x - 1, y)).abs() + (at(x, y) - at(x, y - 1)).abs());
+            }
+        }
+        g
+    };
+    ncc(&edges(&a), &edges(&b))
+}
+
+/// Normalized cross-correlation of two equally long signals; `None` when either is flat.
+fn ncc(a: &[f32], b: &[f32]) -> Option<f64> {
+    let n = a.len().min(b.len()) as f64;
+    if n == 0.0 {
+        return None;
+    }
+    let mean = |s: &[f32]| s.iter().map(|&v| f64::from(v)).sum::<f64>() / n;
+    let (ma, mb) = (mean(a), mean(b));
+    let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
+    for (&x, &y) in a.iter().zip(b) {
+        let (x, y) = (f64::from(x) - ma, f64::from(y) - mb);
+        ab += x * y;
+        aa += x * x;
+        bb += y * y;
+    }
+    (aa > 1e-9 * n && bb > 1e-9 * n).then(|| ab / (aa * bb).sqrt())
+}
+
+/// `img` box-filtered to at most `side` pixels on its longer side, as luma.
+fn small_luma(img: &RgbaImage, side: u32) -> (Vec<f32>, u32, u32) {
+    let (w, h) = img.dimensions();
+    let f = w.max(h).div_ceil(side).max(1);
+    let (sw, sh) = (w / f, h / f);
+    let full = luma(img);
+    let mut out = vec![0f32; (sw * sh) as usize];
+    for y in 0..sh * f {
+        for x in 0..sw * f {
+            out[((y / f) * sw + x / f) as usize] += full[(y * w + x) as usize];
+        }
+    }
+    let k = (f * f) as f32;
+    out.iter_mut().for_each(|v| *v /= k);
+    (out, sw, sh)
+}
+
+/// How alike the two views of `layout` are, seen at 64 px: the correlation of their lumas.
+/// Stereo views of one scene differ by a few pixels of parallax, which vanish at that scale.
+fn views_alike(img: &RgbaImage, layout: Layout) -> Option<f64> {
+    let (a, b) = split(img, layout).ok()?;
+    let (a, ..) = small_luma(&a, 64);
+    let (b, ..) = small_luma(&b, 64);
+    ncc(&a, &b)
+}
+
+/// The comb of interleaving along one axis: the mean |second difference| over neighbours one
+/// pixel away, divided by that over neighbours two pixels away. A single view changes slowly,
+/// so its neighbours one pixel away are the closer (below 1); interleaved views put the other
+/// eye one pixel away, so every parallax edge adds to the numerator only.
+fn comb(l: &[f32], w: u32, h: u32, vertical: bool) -> f64 {
+    let at = |x: u32, y: u32| f64::from(l[(y * w + x) as usize]);
+    let (mut near, mut far) = (0.0, 0.0);
+    let (len, other) = if vertical { (h, w) } else { (w, h) };
+    if len < 5 {
+        return 0.0;
+    }
+    for o in 0..other {
+        for i in 2..len - 2 {
+            let p = |i: u32| if vertical { at(o, i) } else { at(i, o) };
+            near += (p(i) - 0.5 * (p(i - 1) + p(i + 1))).abs();
+            far += (p(i) - 0.5 * (p(i - 2) + p(i + 2))).abs();
+        }
+    }
+    if far <= 0.0 { 0.0 } else { near / far }
+}
+
+/// Horizontal gradient of one channel (`[1, 0, 0]` red, …, means for several).
+fn channel_gradient(img: &RgbaImage, pass: [u32; 3]) -> Vec<f32> {
+    let (w, h) = img.dimensions();
+    let n: u32 = pass.iter().sum();
+    let v = |x: u32, y: u32| {
+        let p = img.get_pixel(x, y).0;
+        (0..3)
+            .map(|c| (pass[c] * u32::from(p[c])) as f32)
+            .sum::<f32>()
+            / n as f32
+    };
+    let mut g = Vec::with_capacity((w.saturating_sub(1) * h) as usize);
+    for y in 0..h {
+        for x in 1..w {
+            g.push((v(x, y) - v(x - 1, y)).abs());
+        }
+    }
+    g
+}
+
+/// The score of an anaglyph for glasses whose left filter passes `left` and right `right`:
+/// how much better the right filter's channels agree with each other than with the left's, on
+/// horizontal edges. One camera's picture has its edges in the same place in every channel
+/// (score near 0); an anaglyph moves them by the parallax between the eyes' channels.
+fn anaglyph_score(img: &RgbaImage, left: [u32; 3], right: [u32; 3]) -> Option<f64> {
+    let (left, right) = (lit(img, left), lit(img, right));
+    let gl = channel_gradient(img, left);
+    let gr = channel_gradient(img, right);
+    let across = ncc(&gl, &gr)?;
+    // Within the filter that passes two lit channels; a filter of one lit channel (a true
+    // anaglyph's) agrees with itself.
+    let two = [right, left]
+        .into_iter()
+        .find(|f| f.iter().sum::<u32>() == 2);
+    let within = match two {
+        Some(f) => {
+            let c: Vec<usize> = (0..3).filter(|&c| f[c] == 1).collect();
+            ncc(
+                &channel_gradient(img, one_hot(c[0])),
+                &channel_gradient(img, one_hot(c[1])),
+            )?
+        }
+        None => 1.0,
+    };
+    Some(within - across)
+}
+
+fn one_hot(c: usize) -> [u32; 3] {
+    let mut p = [0; 3];
+    p[c] = 1;
+    p
+}
+
+/// The least [`views_alike`] for two halves to count as one scene's two views.
+pub const ALIKE: f64 = 0.8;
+/// The least [`comb`] that counts as interleaving.
+pub const COMB: f64 = 0.8;
+/// The least [`anaglyph_score`] that counts as an anaglyph.
+pub const ANAGLYPH: f64 = 0.25;
+
+/// The layout of one picture, with the evidence, or why none was found.
+///
+/// # Errors
+/// `Invalid` when no layout leaves its mark (a flat picture, a single view).
+pub fn detect(img: &RgbaImage) -> Result<(Layout, String)> {
+    let (w, h) = img.dimensions();
+    let alike = |l: Layout| views_alike(img, l).unwrap_or(0.0);
+    // Frame packing: the exact height and a black active space between two alike views.
+    if let Some(view) = packed_view_height(h) {
+        let gap = frame_packing_active_space(view);
+        let black = gap > 0 && (view..view + gap).all(|y| black_row(img, y));
+        let a = alike(Layout::FramePacking);
+        if black && a >= ALIKE {
+            return Ok((
+                Layout::FramePacking,
+                format!(
+                    "{h} rows = 2 × {view} + {gap} black rows of active space; views alike {a:.2}"
+                ),
+            ));
+        }
+    }
+    // The squashed format: a black band around the middle between two alike halves.
+    if let Some((rows, blank)) = blank_band(img) {
+        let a = alike(Layout::AboveBelowSquashed);
+        if a >= ALIKE {
+            return Ok((
+                Layout::AboveBelowSquashed,
+                format!("{blank} black rows between two views of {rows} rows; views alike {a:.2}"),
+            ));
+        }
+    }
+    // Anaglyphs: edges displaced between the channels of the two filters.
+    let anaglyphs = [
+        (Layout::AnaglyphRedCyan, [1, 0, 0], [0, 1, 1]),
+        (Layout::AnaglyphGreenMagenta, [0, 1, 0], [1, 0, 1]),
+        (Layout::AnaglyphAmberBlue, [1, 1, 0], [0, 0, 1]),
+    ];
+    let best = anaglyphs
+        .iter()
+        .filter_map(|&(l, a, b)| anaglyph_score(img, a, b).map(|s| (l, s)))
+        // The first of equal scores: a red-blue (true) anaglyph reads as red-cyan.
+        .fold(None, |best: Option<(Layout, f64)>, c| match best {
+            Some(b) if b.1 >= c.1 => Some(b),
+            _ => Some(c),
+        });
+    // A colourful picture of different-coloured things moves edges between channels too: the
+    // two eyes' channels must also show one scene.
+    let edges = |l: Layout| edges_alike(img, l).unwrap_or(0.0);
+    if let Some((layout, score)) = best.filter(|&(l, s)| s >= ANAGLYPH && edges(l) >= ALIKE) {
+        return Ok((
+            layout,
+            format!(
+                "edges agree within each filter's channels {score:.2} better than across them \
+                 (one camera's picture: about 0); the eyes' outlines alike {:.2}",
+                edges(layout)
+            ),
+        ));
+    }
+    // Interleaving: a comb along rows, columns or both.
+    let l = luma(img);
+    let (cv, ch) = (comb(&l, w, h, true), comb(&l, w, h, false));
+    let combed = match (cv >= COMB, ch >= COMB) {
+        (true, true) => Some(Layout::Checkerboard),
+        (true, false) => Some(Layout::InterlacedRows),
+        (false, true) => Some(Layout::InterlacedColumns),
+        (false, false) => None,
+    };
+    // Noise has a comb near 1 too: the two fields must also show one scene.
+    if let Some(layout) = combed.filter(|&l| alike(l) >= ALIKE) {
+        return Ok((
+            layout,
+            format!(
+                "comb {cv:.2} down the columns, {ch:.2} along the rows (a single view: below \
+                 {COMB}); the fields alike {:.2}",
+                alike(layout)
+            ),
+        ));
+    }
+    // Two alike halves: side by side or above-below, full or squeezed by the aspect.
+    let (sbs, ab) = (alike(Layout::SideBySide), alike(Layout::AboveBelow));
+    let aspect = f64::from(w) / f64::from(h);
+    if sbs >= ALIKE && sbs >= ab {
+        let (layout, why) = if aspect >= 2.0 {
+            (
+                Layout::SideBySide,
+                "at least twice as wide as tall: full-size views",
+            )
+        } else {
+            (
+                Layout::HalfSideBySide,
+                "less than twice as wide as tall: views squeezed to half width",
+            )
+        };
+        return Ok((
+            layout,
+            format!(
+                "left and right halves alike {sbs:.2} (top and bottom {ab:.2}); {w}×{h} is {why} \
+                 (parallel order assumed: a cross-eyed pair reads as swapped eyes)"
+            ),
+        ));
+    }
+    if ab >= ALIKE {
+        let (layout, why) = if aspect <= 1.0 {
+            (
+                Layout::AboveBelow,
+                "at least as tall as wide: full-size views",
+            )
+        } else {
+            (
+                Layout::HalfAboveBelow,
+                "wider than tall: views squeezed to half height",
+            )
+        };
+        return Ok((
+            layout,
+            format!(
+                "top and bottom halves alike {ab:.2} (left and right {sbs:.2}); {w}×{h} is {why}"
+            ),
+        ));
+    }
+    Err(Error::invalid(
+        "inspect",
+        format!("{w}×{h}"),
+        format!(
+            "no stereo layout found: no frame-packing or blank-interval band, no anaglyph \
+             (score below {ANAGLYPH}), no interleaving comb (rows {cv:.2}, columns {ch:.2}, below \
+             {COMB}), halves not alike (side by side {sbs:.2}, above-below {ab:.2}, below {ALIKE})"
+        ),
+    ))
+}

@@ -1,0 +1,65 @@
+//! `stereolab inspect`: another program's stereo picture read back as two views, its layout
+//! given or detected, and the views written out.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use stereolab::inspect::{self, Layout};
+use stereolab_core::{Error, OutputSet, Result};
+
+/// Arguments of `stereolab inspect`.
+#[derive(Args)]
+pub struct InspectArgs {
+    /// One picture holding both views (any layout `--layout` names, or .mpo/.jps/.pns), or a
+    /// left and a right picture.
+    #[arg(required = true, num_args = 1..=2)]
+    pub images: Vec<PathBuf>,
+    /// The layout instead of detecting it: side_by_side, cross_eyed, half_side_by_side,
+    /// above_below, half_above_below, above_below_squashed, frame_packing, interlaced_rows,
+    /// interlaced_columns, checkerboard, anaglyph_red_cyan, anaglyph_green_magenta,
+    /// anaglyph_amber_blue.
+    #[arg(long)]
+    pub layout: Option<String>,
+    /// Folder for the two views read back (`left.png`, `right.png`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Runs `stereolab inspect`.
+///
+/// # Errors
+/// An unreadable picture, a layout that does not fit it, or none found.
+pub fn run(args: InspectArgs) -> Result<()> {
+    let layout = args.layout.as_deref().map(Layout::parse).transpose()?;
+    let views = inspect::read(&args.images, layout)?;
+    let names: Vec<String> = args
+        .images
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    outln!("inspect: {}", names.join(", "));
+    outln!("  layout: {} ({})", views.layout.name(), views.evidence);
+    let (w, h) = views.left.dimensions();
+    outln!(
+        "  views: {w}×{h} each{}",
+        if views.layout.gray_views() {
+            ", gray (each eye's filter channels)"
+        } else {
+            ""
+        }
+    );
+    if let Some(dir) = &args.out {
+        let paths = [dir.join("left.png"), dir.join("right.png")];
+        for p in &paths {
+            stereolab_core::check_output_path(p)?;
+        }
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        let mut set = OutputSet::new();
+        set.stage_png(&paths[0], &views.left)?;
+        set.stage_png(&paths[1], &views.right)?;
+        for p in set.commit()? {
+            outln!("  wrote {}", p.display());
+        }
+    }
+    Ok(())
+}
