@@ -20,7 +20,8 @@ pub struct InspectArgs {
     /// anaglyph_amber_blue.
     #[arg(long)]
     pub layout: Option<String>,
-    /// Folder for the two views read back (`left.png`, `right.png`).
+    /// Folder for the two views read back (`left.png`, `right.png`) and the disparity map
+    /// with its legend (`disparity.png`).
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
@@ -48,8 +49,14 @@ pub fn run(args: InspectArgs) -> Result<()> {
             ""
         }
     );
+    let measured = inspect::measure(&views)?;
+    out!("{}", inspect::describe(&measured));
     if let Some(dir) = &args.out {
-        let paths = [dir.join("left.png"), dir.join("right.png")];
+        let paths = [
+            dir.join("left.png"),
+            dir.join("right.png"),
+            dir.join("disparity.png"),
+        ];
         for p in &paths {
             stereolab_core::check_output_path(p)?;
         }
@@ -57,6 +64,7 @@ pub fn run(args: InspectArgs) -> Result<()> {
         let mut set = OutputSet::new();
         set.stage_png(&paths[0], &views.left)?;
         set.stage_png(&paths[1], &views.right)?;
+        set.stage_png(&paths[2], &inspect::disparity_image(&measured)?)?;
         for p in set.commit()? {
             outln!("  wrote {}", p.display());
         }

@@ -344,3 +344,198 @@ fn the_command_reports_the_layout_and_writes_the_views() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("no stereo layout found"), "{stderr}");
 }
+
+/// Semi-global matching on Julesz's random-dot pair (dots everywhere: a textured scene)
+/// against the exact parallax `p(z) = d(1 − z0/z)` of the left eye's depth.
+#[test]
+fn sgm_finds_the_exact_parallax_of_a_random_dot_pair() {
+    use stereolab::inspect::disparity::{SgmSettings, sgm};
+    use stereolab::plan::View;
+    use stereolab_core::parallax_map;
+    let scene = Scene::load(&asset("scenes/rds_planes.toml"), &[]).unwrap();
+    let outputs = [Output::RdsLeft, Output::RdsRight];
+    let frame = render(&scene, &Plan::new(&outputs)).unwrap();
+    let gray = |o: Output| -> Vec<u8> {
+        rgba(&produce(o, &frame, &scene).unwrap())
+            .pixels()
+            .map(|p| p.0[1])
+            .collect()
+    };
+    let (l, r) = (gray(Output::RdsLeft), gray(Output::RdsRight));
+    let exact = parallax_map(
+        frame.view(View::Left).unwrap(),
+        &scene.parallax_rig().unwrap(),
+    )
+    .unwrap();
+    let (w, h) = (scene.width, scene.height);
+    let range = exact
+        .iter()
+        .flatten()
+        .fold(0f64, |m, p| m.max(p.abs()))
+        .ceil() as i32
+        + 4;
+    let map = sgm(&l, &r, w, h, SgmSettings::symmetric(range)).unwrap();
+    let mut errors: Vec<f64> = Vec::new();
+    let mut visible = 0;
+    for (d, p) in map.disparity.iter().zip(&exact) {
+        if let Some(p) = p {
+            visible += 1;
+            if !d.is_nan() {
+                errors.push((f64::from(*d) - p).abs());
+            }
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let median = errors[errors.len() / 2];
+    let within_1 = errors.iter().filter(|e| **e <= 1.0).count() as f64 / errors.len() as f64;
+    let matched = errors.len() as f64 / f64::from(visible);
+    eprintln!(
+        "sgm on rds_planes {w}×{h}, ±{range} px: matched {:.1}% of {visible} px, median error {median:.3} px, {:.1}% within 1 px",
+        100.0 * matched,
+        100.0 * within_1
+    );
+    assert!(median <= 0.25, "median error {median}");
+    assert!(within_1 >= 0.95, "{within_1}");
+    assert!(matched >= 0.85, "{matched}");
+}
+
+/// `python3` when it has OpenCV (`.ci/run` puts a virtual environment with PyPI's
+/// opencv-python-headless first on the path); `None`, with the reason printed, when it has
+/// not, which under CI is a broken setup and fails.
+fn python_with_opencv() -> Option<String> {
+    let python = "python3".to_string();
+    let ok = Command::new(&python)
+        .args(["-c", "import cv2, numpy"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if ok {
+        return Some(python);
+    }
+    let why = format!("{python} has no cv2/numpy (pip install opencv-python-headless)");
+    assert!(std::env::var_os("CI").is_none(), "{why}");
+    eprintln!("skipped: {why}");
+    None
+}
+
+/// stereolab's matcher against OpenCV's StereoSGBM (an independent implementation of the same
+/// paper) on the random-dot pair, both held to the exact parallax too.
+#[test]
+fn sgm_agrees_with_opencvs_stereo_sgbm() {
+    use stereolab::inspect::disparity::{SgmSettings, sgm};
+    use stereolab::plan::View;
+    use stereolab_core::parallax_map;
+    let Some(python) = python_with_opencv() else {
+        return;
+    };
+    let dir = out_dir("inspect_opencv");
+    let scene = Scene::load(&asset("scenes/rds_planes.toml"), &[]).unwrap();
+    let outputs = [Output::RdsLeft, Output::RdsRight];
+    let frame = render(&scene, &Plan::new(&outputs)).unwrap();
+    let (lp, rp) = (dir.join("left.png"), dir.join("right.png"));
+    let (li, ri) = (
+        produce(Output::RdsLeft, &frame, &scene).unwrap(),
+        produce(Output::RdsRight, &frame, &scene).unwrap(),
+    );
+    rgba(&li).save(&lp).unwrap();
+    rgba(&ri).save(&rp).unwrap();
+    let gray = |i: &Image| -> Vec<u8> { rgba(i).pixels().map(|p| p.0[1]).collect() };
+    let range = 12;
+    let (w, h) = (scene.width, scene.height);
+    let ours = sgm(&gray(&li), &gray(&ri), w, h, SgmSettings::symmetric(range)).unwrap();
+    let out = dir.join("opencv.f32");
+    let run = Command::new(&python)
+        .arg(crate::common::root().join("tests/data/inspect/opencv_sgbm.py"))
+        .args([&lp, &rp])
+        .arg(range.to_string())
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let theirs: Vec<f32> = std::fs::read(&out)
+        .unwrap()
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    assert_eq!(theirs.len(), ours.disparity.len());
+    let exact = parallax_map(
+        frame.view(View::Left).unwrap(),
+        &scene.parallax_rig().unwrap(),
+    )
+    .unwrap();
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut both = Vec::new();
+    let (mut ours_exact, mut theirs_exact) = (Vec::new(), Vec::new());
+    for ((a, b), p) in ours.disparity.iter().zip(&theirs).zip(&exact) {
+        if !a.is_nan() && !b.is_nan() {
+            both.push(f64::from((a - b).abs()));
+            if let Some(p) = p {
+                ours_exact.push((f64::from(*a) - p).abs());
+                theirs_exact.push((f64::from(*b) - p).abs());
+            }
+        }
+    }
+    let share = both.len() as f64 / ours.disparity.len() as f64;
+    let (m, mo, mt) = (median(both), median(ours_exact), median(theirs_exact));
+    eprintln!(
+        "{}: both matched {:.1}%, median |stereolab − OpenCV| {m:.3} px; against the exact \
+         parallax: stereolab {mo:.3} px, OpenCV {mt:.3} px",
+        String::from_utf8_lossy(&run.stdout).trim(),
+        100.0 * share
+    );
+    assert!(share > 0.8, "{share}");
+    assert!(m <= 0.25, "median difference {m} px");
+}
+
+/// The measured parallax of the Wuson pair lies within the exact range of its drawn pixels, and
+/// two copies of one view are reported as having no visible depth.
+#[test]
+fn measured_parallax_lies_in_the_exact_range_and_copies_show_no_depth() {
+    use stereolab::inspect::{Views, describe, measure};
+    use stereolab::plan::View;
+    use stereolab_core::parallax_map;
+    let mut scene = Scene::load(&asset("scenes/wuson.toml"), &[]).unwrap();
+    scene.set_size(320, 240).unwrap();
+    let frame = render(&scene, &Plan::new(&[Output::Left, Output::Right])).unwrap();
+    let exact: Vec<f64> = parallax_map(
+        frame.view(View::Left).unwrap(),
+        &scene.parallax_rig().unwrap(),
+    )
+    .unwrap()
+    .into_iter()
+    .flatten()
+    .collect();
+    let (lo, hi) = exact
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(*p), b.max(*p)));
+    let img = |o: Output| rgba(&produce(o, &frame, &scene).unwrap()).clone();
+    let views = Views {
+        left: img(Output::Left),
+        right: img(Output::Right),
+        layout: Layout::Pair,
+        evidence: String::new(),
+    };
+    let m = measure(&views).unwrap();
+    let [p5, p50, p95] = m.percentiles.unwrap();
+    eprintln!(
+        "wuson 320×240: exact {lo:.2}..{hi:.2} px; measured 5th {p5:.2}, median {p50:.2}, 95th {p95:.2}, matched {:.1}%",
+        100.0 * m.matched
+    );
+    assert!(lo - 0.5 <= p5 && p95 <= hi + 0.5 && p5 < p50 && p50 < p95);
+    // Only the model is matched: the flat background has nothing to match.
+    let drawn = exact.len() as f64 / f64::from(320 * 240);
+    assert!(m.matched <= drawn + 0.02, "{} of {drawn}", m.matched);
+    assert!(!describe(&m).contains("finding"), "{}", describe(&m));
+    let copies = Views {
+        right: views.left.clone(),
+        ..views
+    };
+    let text = describe(&measure(&copies).unwrap());
+    assert!(text.contains("finding: no visible depth"), "{text}");
+}

@@ -10,6 +10,8 @@
 //! different places in different channels, the comb of interleaved rows or columns; then two
 //! halves that show the same scene. A picture with none of these is refused, never guessed.
 
+pub mod disparity;
+
 use std::path::{Path, PathBuf};
 
 use image::{Rgba, RgbaImage};
@@ -561,11 +563,14 @@ fn one_hot(c: usize) -> [u32; 3] {
     p
 }
 
-/// The least [`views_alike`] for two halves to count as one scene's two views.
+/// The least correlation of two views at 64 px (their lumas, or an anaglyph's outlines) for
+/// them to count as one scene's two views.
 pub const ALIKE: f64 = 0.8;
-/// The least [`comb`] that counts as interleaving.
+/// The least comb (second differences one pixel away over those two pixels away) that counts
+/// as interleaving.
 pub const COMB: f64 = 0.8;
-/// The least [`anaglyph_score`] that counts as an anaglyph.
+/// The least anaglyph score (edge agreement within a filter's channels minus across the
+/// filters) that counts as an anaglyph.
 pub const ANAGLYPH: f64 = 0.25;
 
 /// The layout of one picture, with the evidence, or why none was found.
@@ -697,4 +702,178 @@ pub fn detect(img: &RgbaImage) -> Result<(Layout, String)> {
              {COMB}), halves not alike (side by side {sbs:.2}, above-below {ab:.2}, below {ALIKE})"
         ),
     ))
+}
+
+/// What the matcher measured on two views.
+#[derive(Clone, Debug)]
+pub struct Measured {
+    /// The disparity map of the left view at the matching scale, in full-size pixels.
+    pub map: disparity::DisparityMap,
+    /// The views were matched at `1/scale` of their size (a cost volume within
+    /// [`disparity::MAX_CELLS`]).
+    pub scale: u32,
+    /// The disparities searched, `−range..=range` full-size pixels.
+    pub range: i32,
+    /// The share of the left view's pixels with a left-right consistent match.
+    pub matched: f64,
+    /// 5th percentile, median and 95th percentile of the parallax (px), if any matched.
+    pub percentiles: Option<[f64; 3]>,
+    /// The views' width (px).
+    pub width: u32,
+}
+
+/// The gray (Rec. 601 luma) of `img` box-filtered by `scale`.
+fn gray_at(img: &RgbaImage, scale: u32) -> (Vec<u8>, u32, u32) {
+    let (w, h) = img.dimensions();
+    let (sw, sh) = (w / scale, h / scale);
+    let l = luma(img);
+    let mut out = Vec::with_capacity((sw * sh) as usize);
+    for y in 0..sh {
+        for x in 0..sw {
+            let mut s = 0f32;
+            for dy in 0..scale {
+                for dx in 0..scale {
+                    s += l[((y * scale + dy) * w + x * scale + dx) as usize];
+                }
+            }
+            out.push((s / (scale * scale) as f32).round() as u8);
+        }
+    }
+    (out, sw, sh)
+}
+
+/// Matches the two views: parallax searched over ±⅛ of the width (at least 8 px), at the
+/// largest scale `1/s` whose cost volume fits [`disparity::MAX_CELLS`].
+///
+/// # Errors
+/// Views of different sizes, or views too small to match (under 16 px a side).
+pub fn measure(views: &Views) -> Result<Measured> {
+    let (w, h) = views.left.dimensions();
+    if views.right.dimensions() != (w, h) {
+        return Err(Error::invalid(
+            "inspect",
+            format!("{w}×{h} and {:?}", views.right.dimensions()),
+            "the two views must have the same size",
+        ));
+    }
+    if w < 16 || h < 16 {
+        return Err(Error::invalid(
+            "inspect",
+            format!("{w}×{h}"),
+            "views under 16 pixels a side are too small to match",
+        ));
+    }
+    let range = (w / 8).max(8) as i32;
+    let fits = |s: u32| {
+        let cells =
+            u64::from(w / s) * u64::from(h / s) * (2 * (range as u64).div_ceil(u64::from(s)) + 1);
+        cells <= disparity::MAX_CELLS
+    };
+    let scale = (1..=64).find(|&s| fits(s)).unwrap_or(64);
+    let (l, sw, sh) = gray_at(&views.left, scale);
+    let (r, ..) = gray_at(&views.right, scale);
+    let r_scaled = (range as u32).div_ceil(scale) as i32;
+    let mut map = disparity::sgm(&l, &r, sw, sh, disparity::SgmSettings::symmetric(r_scaled))?;
+    // Full-size pixels; a match no better than its rivals (flat, untextured areas) is none.
+    for (d, c) in map.disparity.iter_mut().zip(&map.confidence) {
+        *d = if *c >= MIN_CONFIDENCE {
+            *d * scale as f32
+        } else {
+            f32::NAN
+        };
+    }
+    let mut valid: Vec<f64> = map.valid().map(f64::from).collect();
+    valid.sort_by(f64::total_cmp);
+    let matched = valid.len() as f64 / map.disparity.len() as f64;
+    let at = |q: f64| valid[((valid.len() - 1) as f64 * q).round() as usize];
+    let percentiles = (!valid.is_empty()).then(|| [at(0.05), at(0.5), at(0.95)]);
+    Ok(Measured {
+        map,
+        scale,
+        range,
+        matched,
+        percentiles,
+        width: w,
+    })
+}
+
+/// The least [`disparity::DisparityMap::confidence`] a match needs to count: below it the
+/// best disparity is hardly better than another (a flat surface, a repeated pattern).
+pub const MIN_CONFIDENCE: f32 = 0.1;
+
+/// The StereoGraphics guide's comfortable parallax: ±3% of the width.
+pub const BUDGET_SHARE: f64 = 0.03;
+
+/// The report's lines about a measurement: coverage, the parallax range against the guide's
+/// budget, and whether there is depth to see at all.
+pub fn describe(m: &Measured) -> String {
+    let mut s = format!(
+        "  disparity: semi-global matching (census 5×5, 8 paths), {:.1}% of pixels matched \
+         (left-right consistent, confidence at least {MIN_CONFIDENCE}), searched ±{} px{}\n",
+        100.0 * m.matched,
+        m.range,
+        if m.scale > 1 {
+            format!(" at 1/{} size", m.scale)
+        } else {
+            String::new()
+        }
+    );
+    let Some([lo, mid, hi]) = m.percentiles else {
+        s += "  no pixel matched: the views show no common texture\n";
+        return s;
+    };
+    let pct = |p: f64| 100.0 * p / f64::from(m.width);
+    s += &format!(
+        "  parallax: {lo:.1} to {hi:.1} px (5th to 95th percentile; {:.1}% to {:.1}% of the \
+         width), median {mid:.1} px; negative is in front of the screen\n",
+        pct(lo),
+        pct(hi)
+    );
+    if hi - lo < 1.0 {
+        s += "  finding: no visible depth: the parallax range is under 1 px; increase the \
+              separation (or these are two copies of one view)\n";
+    }
+    let budget = BUDGET_SHARE * f64::from(m.width);
+    if lo < -budget || hi > budget {
+        s += &format!(
+            "  finding: parallax beyond the StereoGraphics guide's ±3% ({budget:.1} px): move \
+             the zero-parallax plane toward the scene's middle or reduce the separation\n"
+        );
+    }
+    s
+}
+
+/// The disparity map as a picture: stereolab's parallax colours (blue in front of the
+/// screen, red behind), dark gray where nothing matched, a legend below.
+///
+/// # Errors
+/// The legend cannot be drawn (a map under one pixel wide).
+pub fn disparity_image(m: &Measured) -> Result<RgbaImage> {
+    let (w, h) = (m.map.width, m.map.height);
+    // The colour scale: the 99th percentile of |parallax|, so a few wild matches do not
+    // wash the map out.
+    let mut mags: Vec<f64> = m.map.valid().map(|d| f64::from(d).abs()).collect();
+    mags.sort_by(f64::total_cmp);
+    let scale = mags
+        .get((mags.len().saturating_sub(1) as f64 * 0.99) as usize)
+        .copied()
+        .unwrap_or(0.5)
+        .max(0.5);
+    let legend =
+        stereolab_core::draw_legend(w, scale, &|p| stereolab_core::parallax_color(p, scale))?;
+    let mut bytes: Vec<u8> = m
+        .map
+        .disparity
+        .iter()
+        .flat_map(|d| {
+            if d.is_nan() {
+                [40, 40, 40, 255]
+            } else {
+                stereolab_core::parallax_color(f64::from(*d), scale)
+            }
+        })
+        .collect();
+    bytes.extend_from_slice(legend.data());
+    RgbaImage::from_raw(w, h + legend.height(), bytes)
+        .ok_or_else(|| Error::internal("inspect", "map and legend size mismatch"))
 }
