@@ -51,6 +51,9 @@ pub fn run(args: InspectArgs) -> Result<()> {
     );
     let measured = inspect::measure(&views)?;
     out!("{}", inspect::describe(&measured));
+    let samples = inspect::vertical_samples(&views, &measured);
+    let fit = inspect::fit_vertical(&samples, w, h);
+    out!("{}", inspect::describe_vertical(fit.as_ref(), w));
     if let Some(dir) = &args.out {
         let paths = [
             dir.join("left.png"),

@@ -539,3 +539,84 @@ fn measured_parallax_lies_in_the_exact_range_and_copies_show_no_depth() {
     let text = describe(&measure(&copies).unwrap());
     assert!(text.contains("finding: no visible depth"), "{text}");
 }
+
+/// Planted mistakes in the random-dot pair, each named by its finding, and none on the
+/// correct pair: a toe-in rig (its keystone against `info`'s largest vertical parallax), the
+/// right view 2 px lower, the right view rotated by 0.4°.
+#[test]
+fn vertical_disparity_names_toe_in_misalignment_and_rotation() {
+    use stereolab::inspect::{Views, describe_vertical, fit_vertical, measure, vertical_samples};
+    let pair = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let scene = Scene::load(&asset("scenes/rds_planes.toml"), &sets).unwrap();
+        let outputs = [Output::RdsLeft, Output::RdsRight];
+        let frame = render(&scene, &Plan::new(&outputs)).unwrap();
+        let img = |o: Output| rgba(&produce(o, &frame, &scene).unwrap()).clone();
+        (img(Output::RdsLeft), img(Output::RdsRight))
+    };
+    let findings = |left: RgbaImage, right: RgbaImage| {
+        let (w, h) = left.dimensions();
+        let views = Views {
+            left,
+            right,
+            layout: Layout::Pair,
+            evidence: String::new(),
+        };
+        let m = measure(&views).unwrap();
+        let fit = fit_vertical(&vertical_samples(&views, &m), w, h).unwrap();
+        (fit, describe_vertical(Some(&fit), w))
+    };
+    let (left, right) = pair(&[]);
+    let (w, h) = left.dimensions();
+    let (fit, text) = findings(left.clone(), right.clone());
+    assert!(!text.contains("finding"), "{text}");
+    assert!(
+        fit.offset.abs() < 0.2 && fit.keystone.abs() < 0.2,
+        "{fit:?}"
+    );
+
+    // Toe-in: the keystone at the corners is the rig's largest vertical parallax (`info`
+    // prints 1.006% of the height for this scene: 2.41 px).
+    let (tl, tr) = pair(&["stereo.mode=\"toe-in\""]);
+    let (fit, text) = findings(tl, tr);
+    assert!(text.contains("finding: toe-in"), "{text}");
+    assert!(
+        (fit.keystone.abs() - 0.01006 * f64::from(h)).abs() < 0.3,
+        "{fit:?}"
+    );
+
+    // Two rows lower.
+    let lower = RgbaImage::from_fn(w, h, |x, y| *right.get_pixel(x, y.saturating_sub(2)));
+    let (fit, text) = findings(left.clone(), lower);
+    assert!(
+        text.contains("finding: vertical misalignment: the right view is 2.0 px lower"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("toe-in") && !text.contains("rotation between"),
+        "{text}"
+    );
+    assert!((fit.offset - 2.0).abs() < 0.2, "{fit:?}");
+
+    // Rotated by 0.4° about the centre (nearest pixel).
+    let t = 0.4f64.to_radians();
+    let (cx, cy) = (f64::from(w) / 2.0, f64::from(h) / 2.0);
+    let rotated = RgbaImage::from_fn(w, h, |x, y| {
+        let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
+        let sx = (cx + dx * t.cos() - dy * t.sin())
+            .floor()
+            .clamp(0.0, f64::from(w - 1));
+        let sy = (cy + dx * t.sin() + dy * t.cos())
+            .floor()
+            .clamp(0.0, f64::from(h - 1));
+        *right.get_pixel(sx as u32, sy as u32)
+    });
+    let (fit, text) = findings(left, rotated);
+    assert!(
+        text.contains("finding: rotation between the views"),
+        "{text}"
+    );
+    // The edge's shift is tan(0.4°) · W/2 = 1.12 px.
+    assert!((fit.rotation.abs() - t.tan() * cx).abs() < 0.25, "{fit:?}");
+    assert!(!text.contains("toe-in"), "{text}");
+}

@@ -709,6 +709,9 @@ pub fn detect(img: &RgbaImage) -> Result<(Layout, String)> {
 pub struct Measured {
     /// The disparity map of the left view at the matching scale, in full-size pixels.
     pub map: disparity::DisparityMap,
+    /// The whole right view's vertical shift (rows, `y_right − y_left`) found before matching
+    /// and undone for it ([`row_shift`]).
+    pub row_shift: i32,
     /// The views were matched at `1/scale` of their size (a cost volume within
     /// [`disparity::MAX_CELLS`]).
     pub scale: u32,
@@ -720,6 +723,43 @@ pub struct Measured {
     pub percentiles: Option<[f64; 3]>,
     /// The views' width (px).
     pub width: u32,
+}
+
+/// The whole-row vertical shift of `right` against `left` (`y_right − y_left`) within ±⅒ of
+/// the height: the shift that best correlates the two views' row means. A row's mean does not
+/// change when its content moves sideways, so horizontal parallax leaves the profiles alike
+/// and only a vertical shift moves them.
+pub fn row_shift(left: &RgbaImage, right: &RgbaImage) -> i32 {
+    let (w, h) = left.dimensions();
+    let profile = |img: &RgbaImage| -> Vec<f32> {
+        let l = luma(img);
+        (0..h as usize)
+            .map(|y| l[y * w as usize..(y + 1) * w as usize].iter().sum::<f32>() / w as f32)
+            .collect()
+    };
+    let (a, b) = (profile(left), profile(right));
+    let reach = (h / 10) as i32;
+    let score = |s: i32| {
+        // Rows y of the left against y + s of the right, where both exist.
+        let (from, to) = ((-s).max(0), (h as i32 - s).min(h as i32));
+        if to - from < h as i32 / 2 {
+            return f64::MIN;
+        }
+        let x: Vec<f32> = (from..to).map(|y| a[y as usize]).collect();
+        let y: Vec<f32> = (from..to).map(|y| b[(y + s) as usize]).collect();
+        ncc(&x, &y).unwrap_or(f64::MIN)
+    };
+    (-reach..=reach)
+        .map(|s| (s, score(s)))
+        // The smallest |shift| among equal scores.
+        .fold((0i32, f64::MIN), |best, c| {
+            if c.1 > best.1 || (c.1 == best.1 && c.0.abs() < best.0.abs()) {
+                c
+            } else {
+                best
+            }
+        })
+        .0
 }
 
 /// The gray (Rec. 601 luma) of `img` box-filtered by `scale`.
@@ -770,8 +810,16 @@ pub fn measure(views: &Views) -> Result<Measured> {
         cells <= disparity::MAX_CELLS
     };
     let scale = (1..=64).find(|&s| fits(s)).unwrap_or(64);
+    let shift = row_shift(&views.left, &views.right);
     let (l, sw, sh) = gray_at(&views.left, scale);
-    let (r, ..) = gray_at(&views.right, scale);
+    // The right view moved back by the whole rows it is shifted (edge rows repeated), so the
+    // matcher compares the same rows.
+    let unshifted = RgbaImage::from_fn(w, h, |x, y| {
+        *views
+            .right
+            .get_pixel(x, (y as i32 + shift).clamp(0, h as i32 - 1) as u32)
+    });
+    let (r, ..) = gray_at(&unshifted, scale);
     let r_scaled = (range as u32).div_ceil(scale) as i32;
     let mut map = disparity::sgm(&l, &r, sw, sh, disparity::SgmSettings::symmetric(r_scaled))?;
     // Full-size pixels; a match no better than its rivals (flat, untextured areas) is none.
@@ -789,6 +837,7 @@ pub fn measure(views: &Views) -> Result<Measured> {
     let percentiles = (!valid.is_empty()).then(|| [at(0.05), at(0.5), at(0.95)]);
     Ok(Measured {
         map,
+        row_shift: shift,
         scale,
         range,
         matched,
@@ -876,4 +925,257 @@ pub fn disparity_image(m: &Measured) -> Result<RgbaImage> {
     bytes.extend_from_slice(legend.data());
     RgbaImage::from_raw(w, h + legend.height(), bytes)
         .ok_or_else(|| Error::internal("inspect", "map and legend size mismatch"))
+}
+
+/// One block's vertical disparity: the left view's block centred at `(x, y)` (full-size
+/// pixels) is found `v` pixels lower in the right view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VerticalSample {
+    /// Column of the block's centre.
+    pub x: f64,
+    /// Row of the block's centre.
+    pub y: f64,
+    /// `y_right − y_left`, sub-pixel.
+    pub v: f64,
+}
+
+/// The vertical disparity of a pair as `v = a + b·X + c·Y + e·X·Y` over the view, with
+/// `X = (x − W/2)/(W/2)` and `Y = (y − H/2)/(H/2)` in −1..1: `a` is the shift at the centre,
+/// `b` the rotation's shift at the left and right edges, `c` a size difference's shift at the
+/// top and bottom, `e` toe-in's keystone at the corners (all in pixels).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VerticalFit {
+    /// Shift at the centre (px): vertical misalignment.
+    pub offset: f64,
+    /// At the left and right edges (px, opposite signs): a rotation between the views.
+    pub rotation: f64,
+    /// At the top and bottom edges (px, opposite signs): one view larger than the other.
+    pub scale: f64,
+    /// At the corners (px, opposite signs at opposite corners): toe-in's keystone.
+    pub keystone: f64,
+    /// The samples fitted.
+    pub samples: usize,
+    /// Root-mean-square residual of the fit (px).
+    pub rms: f64,
+    /// Each term's standard error (offset, rotation, scale, keystone; px).
+    pub standard_error: [f64; 4],
+    /// How far the samples reach in each term's variable (1, |X|, |Y|, |X·Y|; 1 at the
+    /// view's edges and corners).
+    pub extent: [f64; 4],
+}
+
+impl VerticalFit {
+    /// Whether term `i` (0 offset, 1 rotation, 2 scale, 3 keystone) is a finding: at least
+    /// [`VERTICAL_FINDING`] px where the samples reach, and four standard errors from zero.
+    pub fn significant(&self, i: usize) -> bool {
+        let c = [self.offset, self.rotation, self.scale, self.keystone][i];
+        c.abs() * self.extent[i] >= VERTICAL_FINDING && c.abs() >= 4.0 * self.standard_error[i]
+    }
+}
+
+/// Vertical disparity block by block: 11×11 blocks of the left view on a grid, each searched in
+/// the right view at its horizontal disparity (±1 px) over `±max(3, H/40)` rows by the sum of
+/// absolute differences, refined by a parabola; blocks without texture or without a clear best
+/// row are left out.
+pub fn vertical_samples(views: &Views, m: &Measured) -> Vec<VerticalSample> {
+    const R: i32 = 5;
+    let (w, h) = views.left.dimensions();
+    let (l, r) = (luma(&views.left), luma(&views.right));
+    let (wi, hi) = (w as i32, h as i32);
+    let reach = (hi / 40).max(3);
+    let step = (w.max(h) / 64).max(12) as i32;
+    let at = |img: &[f32], x: i32, y: i32| img[(y * wi + x) as usize];
+    let mut out = Vec::new();
+    let mut y = R + reach;
+    while y < hi - R - reach {
+        let mut x = R;
+        while x < wi - R {
+            // The block's horizontal disparity from the map (at its scale).
+            let (mx, my) = ((x as u32) / m.scale, (y as u32) / m.scale);
+            let d = (mx < m.map.width && my < m.map.height)
+                .then(|| m.map.disparity[(my * m.map.width + mx) as usize])
+                .filter(|d| !d.is_nan());
+            if let Some(d) = d {
+                let (mut lo, mut hi_v) = (f32::MAX, f32::MIN);
+                for dy in -R..=R {
+                    for dx in -R..=R {
+                        let v = at(&l, x + dx, y + dy);
+                        lo = lo.min(v);
+                        hi_v = hi_v.max(v);
+                    }
+                }
+                let xr = x + d.round() as i32;
+                let yr = y + m.row_shift;
+                if hi_v - lo > 8.0
+                    && xr - R - 1 >= 0
+                    && xr + R + 1 < wi
+                    && yr - R - reach >= 0
+                    && yr + R + reach < hi
+                {
+                    let sad = |sx: i32, sy: i32| -> f64 {
+                        let mut s = 0.0;
+                        for dy in -R..=R {
+                            for dx in -R..=R {
+                                s += f64::from(
+                                    (at(&l, x + dx, y + dy) - at(&r, sx + dx, sy + dy)).abs(),
+                                );
+                            }
+                        }
+                        s
+                    };
+                    // Per row offset, the best of three columns around the disparity.
+                    let costs: Vec<f64> = (-reach..=reach)
+                        .map(|dv| {
+                            (-1..=1)
+                                .map(|dx| sad(xr + dx, yr + dv))
+                                .fold(f64::MAX, f64::min)
+                        })
+                        .collect();
+                    let k = (0..costs.len())
+                        .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
+                        .unwrap_or(0);
+                    let second = (0..costs.len())
+                        .filter(|&j| j.abs_diff(k) > 1)
+                        .map(|j| costs[j])
+                        .fold(f64::MAX, f64::min);
+                    let clear = costs[k] < 0.8 * second;
+                    if clear && k > 0 && k + 1 < costs.len() {
+                        let (a, b, c) = (costs[k - 1], costs[k], costs[k + 1]);
+                        let curv = a - 2.0 * b + c;
+                        let frac = if curv > 0.0 {
+                            ((a - c) / (2.0 * curv)).clamp(-0.5, 0.5)
+                        } else {
+                            0.0
+                        };
+                        out.push(VerticalSample {
+                            x: f64::from(x),
+                            y: f64::from(y),
+                            v: f64::from(m.row_shift + k as i32 - reach) + frac,
+                        });
+                    }
+                }
+            }
+            x += step;
+        }
+        y += step;
+    }
+    out
+}
+
+/// The least-squares fit of [`VerticalFit`]'s model to `samples`: the normal equations
+/// `NᵀN c = Nᵀv` solved by inverting `NᵀN` (Gauss-Jordan), whose diagonal with the residual
+/// variance gives each term's standard error; `None` under 12 samples or for a singular system
+/// (samples on a line).
+pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Option<VerticalFit> {
+    if samples.len() < 12 {
+        return None;
+    }
+    let (cx, cy) = (f64::from(width) / 2.0, f64::from(height) / 2.0);
+    let basis = |s: &VerticalSample| {
+        let (x, y) = ((s.x - cx) / cx, (s.y - cy) / cy);
+        [1.0, x, y, x * y]
+    };
+    // [NᵀN | I], reduced to [I | (NᵀN)⁻¹].
+    let mut a = [[0.0f64; 8]; 4];
+    let mut rhs = [0.0f64; 4];
+    let mut extent = [0.0f64; 4];
+    for s in samples {
+        let f = basis(s);
+        for i in 0..4 {
+            for j in 0..4 {
+                a[i][j] += f[i] * f[j];
+            }
+            rhs[i] += f[i] * s.v;
+            extent[i] = extent[i].max(f[i].abs());
+        }
+    }
+    for (i, row) in a.iter_mut().enumerate() {
+        row[4 + i] = 1.0;
+    }
+    for col in 0..4 {
+        let pivot = (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[pivot][col].abs() < 1e-9 {
+            return None;
+        }
+        a.swap(col, pivot);
+        let p = a[col][col];
+        a[col].iter_mut().for_each(|v| *v /= p);
+        for row in 0..4 {
+            if row != col {
+                let f = a[row][col];
+                for k in 0..8 {
+                    a[row][k] -= f * a[col][k];
+                }
+            }
+        }
+    }
+    let coef: [f64; 4] = std::array::from_fn(|i| (0..4).map(|j| a[i][4 + j] * rhs[j]).sum());
+    let rss: f64 = samples
+        .iter()
+        .map(|s| {
+            let f = basis(s);
+            let model: f64 = (0..4).map(|i| coef[i] * f[i]).sum();
+            (s.v - model).powi(2)
+        })
+        .sum();
+    let variance = rss / (samples.len() - 4) as f64;
+    let se: [f64; 4] = std::array::from_fn(|i| (variance * a[i][4 + i]).max(0.0).sqrt());
+    Some(VerticalFit {
+        offset: coef[0],
+        rotation: coef[1],
+        scale: coef[2],
+        keystone: coef[3],
+        samples: samples.len(),
+        rms: (rss / samples.len() as f64).sqrt(),
+        standard_error: se,
+        extent,
+    })
+}
+
+/// The least vertical disparity (px) a term of the fit must reach to be a finding: half a
+/// pixel, about what the eyes stop fusing comfortably at small sizes.
+pub const VERTICAL_FINDING: f64 = 0.5;
+
+/// The report's lines about the vertical disparity and its findings.
+pub fn describe_vertical(fit: Option<&VerticalFit>, width: u32) -> String {
+    let Some(f) = fit else {
+        return "  vertical disparity: too few textured blocks to measure\n".into();
+    };
+    let mut s = format!(
+        "  vertical disparity ({} blocks, fit residual {:.2} px): {:+.2} px at the centre, \
+         {:+.2} px at the right edge (rotation), {:+.2} px at the bottom edge (size), {:+.2} px \
+         at the bottom-right corner (keystone)\n",
+        f.samples, f.rms, f.offset, f.rotation, f.scale, f.keystone
+    );
+    if f.significant(3) {
+        s += &format!(
+            "  finding: toe-in: vertical disparity grows toward the corners in the keystone \
+             pattern, up to {:.1} px; render with parallel axes and sheared frusta (off-axis)\n",
+            f.keystone.abs()
+        );
+    }
+    if f.significant(0) {
+        s += &format!(
+            "  finding: vertical misalignment: the right view is {:.1} px {} than the left; \
+             shift it back\n",
+            f.offset.abs(),
+            if f.offset > 0.0 { "lower" } else { "higher" }
+        );
+    }
+    if f.significant(1) {
+        let degrees = (f.rotation / (f64::from(width) / 2.0)).atan().to_degrees();
+        s += &format!(
+            "  finding: rotation between the views: {degrees:+.2}° (±{:.1} px at the edges); \
+             level the cameras or rotate one view back\n",
+            f.rotation.abs()
+        );
+    }
+    if f.significant(2) {
+        s += &format!(
+            "  finding: one view is larger: ±{:.1} px at the top and bottom; match the cameras' \
+             fields of view\n",
+            f.scale.abs()
+        );
+    }
+    s
 }
