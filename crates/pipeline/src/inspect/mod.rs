@@ -1007,7 +1007,7 @@ pub fn vertical_samples(views: &Views, m: &Measured) -> Vec<VerticalSample> {
                 let xr = x + d.round() as i32;
                 let yr = y + m.row_shift;
                 if hi_v - lo > 8.0
-                    && xr - R - 1 >= 0
+                    && xr - R > 0
                     && xr + R + 1 < wi
                     && yr - R - reach >= 0
                     && yr + R + reach < hi
@@ -1100,11 +1100,12 @@ pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Opti
         a.swap(col, pivot);
         let p = a[col][col];
         a[col].iter_mut().for_each(|v| *v /= p);
-        for row in 0..4 {
+        let pivot_row = a[col];
+        for (row, r) in a.iter_mut().enumerate() {
             if row != col {
-                let f = a[row][col];
-                for k in 0..8 {
-                    a[row][k] -= f * a[col][k];
+                let f = r[col];
+                for (v, p) in r.iter_mut().zip(&pivot_row) {
+                    *v -= f * p;
                 }
             }
         }
