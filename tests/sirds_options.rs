@@ -719,3 +719,79 @@ fn shipped_option_scenes_render() {
         .count();
     assert_eq!(black, 2 * 12 * 12, "two black squares in the top band");
 }
+
+/// `stereolab sirds --depth MAP --texture FILE` with `--set` for the other options: an RGB
+/// MTS whose colors are texel means (a texture of 3 colors and black gives few distinct
+/// colors, random dots would give hundreds), the guide band drawn; a texture narrower than
+/// the separations is refused naming `sirds.texture`, and nothing is written.
+#[test]
+fn cli_makes_a_mapped_texture_stereogram_of_a_depth_map() {
+    let dir = common::out_dir("sirds_options_cli");
+    let (w, h) = (300u32, 120u32);
+    let mut pgm = format!("P5\n{w} {h}\n255\n").into_bytes();
+    pgm.extend((0..h).flat_map(|y| (0..w).map(move |x| ((x / 3 + y / 5) % 2 * 200) as u8)));
+    std::fs::write(dir.join("map.pgm"), pgm).expect("map");
+    let colors = [
+        [0, 0, 0, 255],
+        [200, 30, 30, 255],
+        [30, 200, 30, 255],
+        [30, 30, 200, 255],
+    ];
+    image::RgbaImage::from_fn(w, h, |x, y| {
+        image::Rgba(colors[((x / 7 + y / 3) % 4) as usize])
+    })
+    .save(dir.join("tex.png"))
+    .expect("texture");
+    image::RgbaImage::from_pixel(40, 40, image::Rgba([1, 2, 3, 255]))
+        .save(dir.join("narrow.png"))
+        .expect("narrow");
+    let run = |texture: &str, out: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .current_dir(&dir)
+            .args([
+                "sirds",
+                "--depth",
+                "map.pgm",
+                "--texture",
+                texture,
+                "-o",
+                out,
+            ])
+            .args([
+                "--set",
+                "sirds.tileable=true",
+                "--set",
+                "sirds.guides=\"bottom\"",
+            ])
+            .output()
+            .expect("runs")
+    };
+    let ok = run("tex.png", "mts.png");
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let img = image::open(dir.join("mts.png"))
+        .expect("written")
+        .to_rgba8();
+    assert_eq!(img.dimensions(), (w, h));
+    let body: std::collections::BTreeSet<[u8; 4]> =
+        img.rows().take(60).flatten().map(|p| p.0).collect();
+    assert!(
+        body.len() > 3 && body.len() < 60,
+        "{} colors: texel means",
+        body.len()
+    );
+    assert!(
+        img.rows().last().expect("row").all(|p| p.0 == [255; 4]),
+        "the guide band"
+    );
+    let bad = run("narrow.png", "bad.png");
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && err.contains("sirds.texture"),
+        "{err}"
+    );
+    assert!(!dir.join("bad.png").exists());
+}
