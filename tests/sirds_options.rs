@@ -306,7 +306,8 @@ fn tileable_links_hold_across_the_wrap() {
 
 /// Two copies of a tileable SIRDS side by side decode across the seam: within ±1 px of the
 /// tiled depth's separations in the columns around the seam, as well as elsewhere; the same
-/// map without `tileable` does not.
+/// map without `tileable` does not (measured: 80.4% at the seam, 75.9% over the whole image;
+/// 25.8% at the seam without `tileable`).
 #[test]
 fn tileable_sirds_decodes_across_the_seam() {
     let d = SirdsGeometry::default().to_pixels().expect("valid");
@@ -784,7 +785,10 @@ fn cli_makes_a_mapped_texture_stereogram_of_a_depth_map() {
         body.len()
     );
     assert!(
-        img.rows().last().expect("row").all(|p| p.0 == [255; 4]),
+        img.rows()
+            .next_back()
+            .expect("row")
+            .all(|p| p.0 == [255; 4]),
         "the guide band"
     );
     let bad = run("narrow.png", "bad.png");
