@@ -173,8 +173,9 @@ fn rgba_of(path: &Path) -> (Vec<[u8; 4]>, u32, u32) {
 }
 
 /// pamstereogram's own MTS (`-texfile`, a noise disc on black, the depth map's size) decoded by
-/// stereolab untold: the far plane's 128 px and the disc's nearer separations are found, and
-/// the separations on the disc are smaller than off it.
+/// stereolab untold: the median separation off the disc is the far plane's 128 px, on the disc
+/// a nearer one (measured: 128.0 px and 102.0 px; 65.9% of the pixels matched, found
+/// 62..=128 px).
 #[test]
 fn pamstereograms_mapped_texture_decodes_with_stereolab() {
     let dir = common::out_dir("sirds_options_mts");
