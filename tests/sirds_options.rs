@@ -800,3 +800,45 @@ fn cli_makes_a_mapped_texture_stereogram_of_a_depth_map() {
     );
     assert!(!dir.join("bad.png").exists());
 }
+
+/// `stereolab render SCENE --explain` names the options in use and runs the one depth pass
+/// only: each shipped scene's line, and none for a scene without SIRDS outputs.
+#[test]
+fn explain_names_the_sirds_options_and_one_depth_pass() {
+    for (scene, want) in [
+        (
+            "sirds_texture",
+            "sirds: per-pixel (TIW), mapped texture 256×128\n",
+        ),
+        (
+            "sirds_tileable",
+            "sirds: per-pixel (TIW), tileable, guide boxes top, 10 px\n",
+        ),
+        (
+            "sirds_planes",
+            "sirds: per-pixel (TIW), 6 depth planes, guide boxes top and bottom, 12 px\n",
+        ),
+        ("anaglyph", ""),
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .args(["render", "--explain"])
+            .arg(asset(&format!("scenes/{scene}.toml")))
+            .output()
+            .expect("runs");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{scene}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        if want.is_empty() {
+            assert!(!text.contains("sirds:"), "{scene}: {text}");
+        } else {
+            assert!(text.contains(want), "{scene}: {text}");
+            assert!(
+                text.contains("passes run: 1") && text.contains("depth only"),
+                "{text}"
+            );
+        }
+    }
+}

@@ -188,6 +188,37 @@ impl Default for Settings {
 }
 
 impl Settings {
+    /// One line for `stereolab render --explain`: the algorithm and the options of
+    /// pamstereogram's set in use (texture, tileable, planes, guides).
+    pub fn describe(&self) -> String {
+        let mut parts = vec![match self.algorithm {
+            Algorithm::PerVertex => "per-vertex strips".to_string(),
+            Algorithm::PerPixel => "per-pixel (TIW)".to_string(),
+        }];
+        if let Pattern::Textured(t) = &self.pattern {
+            let (w, h) = t.texture.dimensions();
+            parts.push(format!("mapped texture {w}×{h}"));
+        }
+        if self.per_pixel.tileable {
+            parts.push("tileable".to_string());
+        }
+        if let Some(n) = self.per_pixel.planes {
+            parts.push(format!("{n} depth planes"));
+        }
+        if self.guide_dots {
+            parts.push("guide dots".to_string());
+        }
+        if let Some(g) = self.guide_boxes {
+            let place = match g.place {
+                GuidePlace::Top => "top",
+                GuidePlace::Bottom => "bottom",
+                GuidePlace::Both => "top and bottom",
+            };
+            parts.push(format!("guide boxes {place}, {} px", g.size));
+        }
+        parts.join(", ")
+    }
+
     /// The options that only TIW (per-pixel) makes: the first one set, by its field name.
     pub fn per_pixel_only(&self) -> Option<&'static str> {
         if matches!(self.pattern, Pattern::Textured(_)) {
