@@ -756,7 +756,8 @@ mod tests {
 
     /// TIW streamed from samples gives [`per_pixel`]'s bytes on the same nearness: a small
     /// map (computed separations, a last chunk of 7 rows) and one of 2^20 pixels (the table),
-    /// hidden-surface removal on and off, with oversampling (no table), and reads of
+    /// hidden-surface removal on and off, with oversampling (no table), tileable rows with
+    /// depth planes or oversampling (the linked sets' coloring), and reads of
     /// arbitrary sizes come in whole rows, in order.
     #[test]
     fn per_pixel_samples_matches_per_pixel() {
@@ -780,6 +781,16 @@ mod tests {
                 PerPixelOptions {
                     hidden_surface: true,
                     oversample: 3,
+                    ..PerPixelOptions::default()
+                },
+                PerPixelOptions {
+                    tileable: true,
+                    planes: Some(7),
+                    ..PerPixelOptions::default()
+                },
+                PerPixelOptions {
+                    oversample: 2,
+                    tileable: true,
                     ..PerPixelOptions::default()
                 },
             ] {
