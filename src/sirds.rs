@@ -8,8 +8,7 @@ use stereolab::output::sirds::{from_frame, save, stream_depth_map};
 use stereolab::plan::{Output, Plan};
 use stereolab::render::render;
 use stereolab_core::{
-    DepthMap, Error, Near, Result, SirdsPattern, SirdsSettings, depth_from_separation,
-    from_depth_map,
+    DepthMap, Error, Near, Result, SirdsSettings, depth_from_separation, from_depth_map,
 };
 
 /// Arguments of `stereolab sirds`.
@@ -127,10 +126,13 @@ fn report(args: &SirdsArgs) -> Result<String> {
         return decode_report(args, path, &out);
     }
     if let Some(path) = &args.depth {
-        let mut settings = stereolab::scene::sirds_settings_from_sets(&args.sets)?;
+        // `--texture FILE` is `--set sirds.texture="FILE"`.
+        let mut sets = args.sets.clone();
         if let Some(texture) = &args.texture {
-            settings.pattern = SirdsPattern::textured(texture, settings.pattern)?;
+            let path = toml::Value::String(texture.display().to_string());
+            sets.push(format!("sirds.texture={path}"));
         }
+        let settings = stereolab::scene::sirds_settings_from_sets(&sets)?;
         // `--near` when given; else what the file says (stereolab's own window depth: black
         // is near); else white, netpbm's convention.
         let told = stereolab_core::near_of_file(path).filter(|_| args.near.is_none());

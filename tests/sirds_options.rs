@@ -65,52 +65,71 @@ fn no_hsr() -> PerPixelOptions {
 /// On a flat background every pixel `l` with `l + s` inside the row is linked to `l + s`, so
 /// the sets are the residues mod `s`; each must hold the rounded mean of its non-black texels
 /// (computed here from the texture directly), or one color throughout where all are black.
+/// Black is the background as the texture's top-left pixel, and as `texture_background` of a
+/// texture whose top-left pixel is red (that red then counts in its set's mean).
 #[test]
 fn mapped_texture_sets_take_the_mean_of_their_non_background_texels() {
     let d = SirdsGeometry::default().to_pixels().expect("valid");
     let (w, h) = (400u32, 6u32);
     let map = DepthMap::new(w, h, vec![0.0; (w * h) as usize]).expect("map");
-    // A third of the texels black; whole residue classes black in row 3 (columns < 30).
+    // A quarter of the texels black; whole residue classes black in row 3.
     let s = whole(&d, 0.0);
     let texture = noise_texture(w, h, |x, y| {
         (x * 7 + y * 5) % 4 == 0 || (y == 3 && x % s as u32 == 5)
     });
-    let pattern = textured(texture.clone(), SirdsPattern::Gray { seed: 4 });
-    let px = per_pixel(&map, &d, &pattern, &no_hsr()).expect("mts");
-    let (mut checked, mut background_sets) = (0, 0);
-    for y in 0..h {
-        for c in 0..s {
-            let members: Vec<u32> = (c as u32..w).step_by(s).collect();
-            let texels: Vec<[u8; 4]> = members
-                .iter()
-                .map(|&x| texture.get_pixel(x, y).0)
-                .filter(|t| *t != [0, 0, 0, 255])
-                .collect();
-            let got: Vec<[u8; 4]> = members.iter().map(|&x| px[(y * w + x) as usize]).collect();
-            assert!(
-                got.iter().all(|&g| g == got[0]),
-                "row {y} class {c}: one color"
-            );
-            if texels.is_empty() {
-                background_sets += 1;
-                continue;
+    let mut red_corner = texture.clone();
+    red_corner.put_pixel(0, 0, image::Rgba([255, 0, 0, 255]));
+    let dir = common::out_dir("sirds_options_means");
+    red_corner.save(dir.join("red_corner.png")).expect("png");
+    let spec =
+        spec("texture = \"red_corner.png\"\ntexture_background = [0, 0, 0]\ndots = \"gray\"");
+    let root = stereolab_core::InputRoot::anywhere(&dir);
+    let from_file = SirdsSettings::from_spec(&spec, &root)
+        .expect("valid")
+        .pattern;
+    for (texture, pattern) in [
+        (
+            texture.clone(),
+            textured(texture, SirdsPattern::Gray { seed: 4 }),
+        ),
+        (red_corner, from_file),
+    ] {
+        let px = per_pixel(&map, &d, &pattern, &no_hsr()).expect("mts");
+        let (mut checked, mut background_sets) = (0, 0);
+        for y in 0..h {
+            for c in 0..s {
+                let members: Vec<u32> = (c as u32..w).step_by(s).collect();
+                let texels: Vec<[u8; 4]> = members
+                    .iter()
+                    .map(|&x| texture.get_pixel(x, y).0)
+                    .filter(|t| *t != [0, 0, 0, 255])
+                    .collect();
+                let got: Vec<[u8; 4]> = members.iter().map(|&x| px[(y * w + x) as usize]).collect();
+                assert!(
+                    got.iter().all(|&g| g == got[0]),
+                    "row {y} class {c}: one color"
+                );
+                if texels.is_empty() {
+                    background_sets += 1;
+                    continue;
+                }
+                let n = texels.len() as u32;
+                let mean = |k: usize| {
+                    ((texels.iter().map(|t| u32::from(t[k])).sum::<u32>() + n / 2) / n) as u8
+                };
+                assert_eq!(
+                    got[0],
+                    [mean(0), mean(1), mean(2), 255],
+                    "row {y} class {c}"
+                );
+                checked += 1;
             }
-            let n = texels.len() as u32;
-            let mean = |k: usize| {
-                ((texels.iter().map(|t| u32::from(t[k])).sum::<u32>() + n / 2) / n) as u8
-            };
-            assert_eq!(
-                got[0],
-                [mean(0), mean(1), mean(2), 255],
-                "row {y} class {c}"
-            );
-            checked += 1;
         }
+        assert!(
+            checked > 400 && background_sets >= 1,
+            "{checked} sets, {background_sets} black"
+        );
     }
-    assert!(
-        checked > 400 && background_sets >= 1,
-        "{checked} sets, {background_sets} black"
-    );
 }
 
 /// The sphere over a ramp as an MTS (a noise texture, black in every 5th column), decoded with the decoder told the set-up: within ±1 px of the
@@ -595,7 +614,7 @@ fn field_of(r: stereolab_core::Result<impl std::fmt::Debug>) -> String {
 }
 
 /// Bad values name their field and a remedy: planes outside 2..=255, a guide size of 0 or
-/// without guides, boxes that do not fit, a texture that is missing, not an image, too
+/// without guides, a texture background without a texture or outside 0..=255, boxes that do not fit, a texture that is missing, not an image, too
 /// narrow or too large, and the per-pixel options on a per-vertex scene.
 #[test]
 fn bad_option_values_name_their_field() {
@@ -606,6 +625,7 @@ fn bad_option_values_name_their_field() {
         ("guide_size = 10", "sirds.guide_size"),
         ("texture = \"textures/none.png\"", "sirds.texture"),
         ("texture = \"sirds_sphere.toml\"", "sirds.texture"),
+        ("texture_background = [0, 0, 0]", "sirds.texture_background"),
     ] {
         let e = field_of(settings(text));
         assert!(e.contains(field), "{text}: {e}");
@@ -615,6 +635,11 @@ fn bad_option_values_name_their_field() {
         toml::from_str::<SirdsSpec>("guides = \"left\"").expect_err("unknown")
     );
     assert!(e.contains("top, bottom, both"), "{e}");
+    let e = format!(
+        "{:?}",
+        toml::from_str::<SirdsSpec>("texture_background = [0, 0, 256]").expect_err("not a u8")
+    );
+    assert!(e.contains("texture_background") && e.contains("u8"), "{e}");
     let dir = common::out_dir("sirds_options_errors");
     // Narrower than the largest separation (90 px), and wider than 4096.
     for (name, w) in [("narrow.png", 60u32), ("wide.png", 4097)] {

@@ -44,7 +44,8 @@ pub const MAX_TEXTURE_SIDE: u32 = 4096;
 pub struct Textured {
     /// The texture.
     pub texture: image::RgbaImage,
-    /// Its background color: its top-left pixel (pamstereogram picks one automatically).
+    /// Its background color: `sirds.texture_background`, else its top-left pixel
+    /// (pamstereogram picks one automatically; `-bgcolor` sets it).
     pub background: [u8; 4],
     /// The pattern of the background sets.
     pub base: Pattern,
@@ -83,12 +84,14 @@ impl Pattern {
         Ok(Pattern::Image(Arc::new(img.to_rgba8())))
     }
 
-    /// `base` with the texture at `path` (`sirds.texture`): a mapped-texture stereogram.
+    /// `base` with the texture at `path` (`sirds.texture`): a mapped-texture stereogram whose
+    /// background color is `background` (`sirds.texture_background`, pamstereogram's
+    /// `-bgcolor`), or the texture's top-left pixel.
     ///
     /// # Errors
     /// `Invalid` naming `sirds.texture` for a file that is not a readable image or has a side
     /// above [`MAX_TEXTURE_SIDE`].
-    pub fn textured(path: &Path, base: Pattern) -> Result<Pattern> {
+    pub fn textured(path: &Path, base: Pattern, background: Option<[u8; 3]>) -> Result<Pattern> {
         let img = crate::framebuffer::open_image(path, "texture").map_err(|e| {
             Error::invalid(
                 "sirds.texture",
@@ -105,7 +108,10 @@ impl Pattern {
             ));
         }
         let texture = img.to_rgba8();
-        let background = texture.get_pixel(0, 0).0;
+        let background = match background {
+            Some([r, g, b]) => [r, g, b, 255],
+            None => texture.get_pixel(0, 0).0,
+        };
         Ok(Pattern::Textured(Arc::new(Textured {
             texture,
             background,

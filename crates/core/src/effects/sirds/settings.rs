@@ -122,6 +122,8 @@ pub struct SirdsSpec {
     /// A texture image (relative to the scene file) for a mapped-texture stereogram
     /// (per-pixel only).
     pub texture: Option<String>,
+    /// The texture's background color, `[r, g, b]` 0..=255 (default: its top-left pixel).
+    pub texture_background: Option<[u8; 3]>,
     /// Links wrap around each row, so the image tiles horizontally (per-pixel only).
     #[serde(default)]
     pub tileable: bool,
@@ -303,7 +305,17 @@ impl Settings {
             },
         };
         let pattern = match &spec.texture {
-            Some(p) => Pattern::textured(&root.resolve("sirds.texture", p)?, pattern)?,
+            Some(p) => {
+                let path = root.resolve("sirds.texture", p)?;
+                Pattern::textured(&path, pattern, spec.texture_background)?
+            }
+            None if spec.texture_background.is_some() => {
+                return Err(Error::invalid(
+                    "sirds.texture_background",
+                    format!("{:?}", spec.texture_background.unwrap_or_default()),
+                    "is the background color of sirds.texture: set sirds.texture too",
+                ));
+            }
             None => pattern,
         };
         Ok(Settings {
