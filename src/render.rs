@@ -142,6 +142,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let limit = budget.unwrap_or_else(stereolab::memory::default_budget);
     if explain {
         out!("{}", plan.explain());
+        if plan.outputs.iter().any(|o| o.name().starts_with("sirds")) {
+            outln!("  sirds: {}", s.sirds.describe());
+        }
         outln!(
             "  memory: {needs}; budget {}{}",
             stereolab::memory::human_bytes(limit),

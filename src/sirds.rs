@@ -27,6 +27,11 @@ pub struct SirdsArgs {
     // when the required argument conflicts with one present (a scene, --decode).
     #[arg(long, value_parser = ["white", "black"], requires = "depth")]
     pub near: Option<String>,
+    /// With --depth only: a mapped-texture stereogram colored by this image (the scene
+    /// field `sirds.texture`; best the depth map's size, at least the largest separation
+    /// wide).
+    #[arg(long, requires = "depth", value_name = "FILE")]
+    pub texture: Option<PathBuf>,
     /// Decode this autostereogram: write the depth it encodes to --out and say whether it is
     /// one at all. With a scene (its `[sirds]` table) or `--set sirds.*` flags the decoder is
     /// told the viewing set-up: it decodes over that model's separations (eq. 1 or eq. 3,
@@ -121,7 +126,13 @@ fn report(args: &SirdsArgs) -> Result<String> {
         return decode_report(args, path, &out);
     }
     if let Some(path) = &args.depth {
-        let settings = stereolab::scene::sirds_settings_from_sets(&args.sets)?;
+        // `--texture FILE` is `--set sirds.texture="FILE"`.
+        let mut sets = args.sets.clone();
+        if let Some(texture) = &args.texture {
+            let path = toml::Value::String(texture.display().to_string());
+            sets.push(format!("sirds.texture={path}"));
+        }
+        let settings = stereolab::scene::sirds_settings_from_sets(&sets)?;
         // `--near` when given; else what the file says (stereolab's own window depth: black
         // is near); else white, netpbm's convention.
         let told = stereolab_core::near_of_file(path).filter(|_| args.near.is_none());
@@ -132,7 +143,7 @@ fn report(args: &SirdsArgs) -> Result<String> {
         let d = settings.geometry.to_pixels()?;
         let netpbm = stereolab::output::sirds::Netpbm::of(&out).is_some();
         let (w, h, mapping) = super::with_spinner("making the autostereogram", || {
-            if netpbm && !settings.guide_dots {
+            if netpbm && !settings.guide_dots && settings.guide_boxes.is_none() {
                 stream_depth_map(path, near, &settings, &out)
             } else {
                 let (map, mapping) = DepthMap::load_with(path, near)?;

@@ -41,6 +41,7 @@ mod shear_rotate;
 mod sirds;
 mod sirds_experiments;
 mod sirds_interop;
+mod sirds_options;
 mod sirds_told;
 mod stability;
 mod stereo_photo;

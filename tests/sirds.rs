@@ -201,6 +201,7 @@ fn per_pixel_linked_pixels_have_equal_colors() {
         let opts = PerPixelOptions {
             hidden_surface,
             oversample: 1,
+            ..PerPixelOptions::default()
         };
         let img = per_pixel(&depth, &d, &pattern, &opts).expect("sirds");
         let mut linker = RowLinker::default();
@@ -293,6 +294,7 @@ fn decode_round_trip_every_algorithm_and_option() {
             s.sirds.per_pixel = PerPixelOptions {
                 hidden_surface,
                 oversample,
+                ..PerPixelOptions::default()
             };
             variants.push((format!("per-pixel hsr={hidden_surface} x{oversample}"), s));
         }

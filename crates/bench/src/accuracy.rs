@@ -658,6 +658,7 @@ fn sirds_knobs(scale: Scale) -> Result<Vec<Knob>> {
         s.sirds.per_pixel = PerPixelOptions {
             hidden_surface,
             oversample,
+            ..PerPixelOptions::default()
         };
         sirds_point(&s, None, it)
     };

@@ -172,6 +172,7 @@ fn knobs(iters: usize) -> Result<Vec<Row>> {
         s.sirds.per_pixel = PerPixelOptions {
             hidden_surface,
             oversample,
+            ..PerPixelOptions::default()
         };
         variants.push((
             "TIW hsr/oversample",
@@ -216,6 +217,7 @@ fn large_depth_map(iters: usize) -> Result<Vec<Row>> {
         let opts = PerPixelOptions {
             hidden_surface,
             oversample: 1,
+            ..PerPixelOptions::default()
         };
         per_pixel(&depth, &d, &pattern, &opts)?;
         let ms = median_ms(iters.min(3), || {

@@ -149,10 +149,14 @@ pub use effects::sirds::disparity::{
     separation_eye_distance, separation_view_angle, tan_phi_eye_distance,
 };
 pub use effects::sirds::pair::{Views as SirdsViews, views as sirds_views};
-pub use effects::sirds::pattern::draw_guide_dots;
+pub use effects::sirds::pattern::{
+    GuideBoxes, GuidePlace, MAX_GUIDE_SIZE, MAX_TEXTURE_SIDE, Textured as SirdsTexture,
+    draw_guide_boxes, draw_guide_dots, guide_box_columns,
+};
 pub use effects::sirds::per_pixel::{
-    MAX_OVERSAMPLE, PerPixelOptions, RowLinker, SampleTable, check_inputs as check_sirds_inputs,
-    left_of_pair, per_pixel, per_pixel_samples, per_pixel_streamed,
+    MAX_OVERSAMPLE, PLANES as SIRDS_PLANES, PerPixelOptions, RowLinker, SampleTable,
+    check_inputs as check_sirds_inputs, left_of_pair, per_pixel, per_pixel_samples,
+    per_pixel_streamed, plane_nearness, plane_separation,
 };
 pub use effects::sirds::search::{
     Region as SearchRegion, Search as SeparationSearch, SearchOptions as SeparationSearchOptions,

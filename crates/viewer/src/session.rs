@@ -128,7 +128,7 @@ impl Session {
                 SirdsPattern::BlackWhite { seed }
                 | SirdsPattern::Gray { seed }
                 | SirdsPattern::Color { seed } => seed,
-                SirdsPattern::Image(_) => 1,
+                SirdsPattern::Image(_) | SirdsPattern::Textured(_) => 1,
             },
             turn_degrees: 0.0,
         };

@@ -103,7 +103,7 @@ pub fn animate(
                     SirdsPattern::BlackWhite { seed }
                     | SirdsPattern::Gray { seed }
                     | SirdsPattern::Color { seed } => seed.wrapping_add(i as u64),
-                    SirdsPattern::Image(_) => 0,
+                    SirdsPattern::Image(_) | SirdsPattern::Textured(_) => 0,
                 };
                 s.sirds.pattern = seed_pattern.reseeded(seed);
             }

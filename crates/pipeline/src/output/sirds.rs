@@ -9,9 +9,9 @@ use crate::render::Frame;
 use crate::scene::Scene;
 use stereolab_core::{
     DepthMap, DepthMapping, DepthRange, DepthSamples, Disparity, DisparityModel, Error,
-    Framebuffer, Near, PgmRows, Result, Sirds, SirdsAlgorithm, SirdsSettings, StripFilter,
-    StripGeometry, StripResult, depth_range, draw_guide_dots, image_error, per_pixel, per_vertex,
-    write_atomic, write_png,
+    Framebuffer, Near, PgmRows, Result, Sirds, SirdsAlgorithm, SirdsPattern, SirdsSettings,
+    StripFilter, StripGeometry, StripResult, depth_range, draw_guide_boxes, draw_guide_dots,
+    image_error, per_pixel, per_vertex, write_atomic, write_png,
 };
 
 /// The cyclopean depth pass of `frame`.
@@ -77,6 +77,12 @@ pub fn fig5_bands(frame: &Frame, scene: &Scene) -> Result<Sirds> {
     for (model, filter) in FIG5_BANDS {
         let mut s = scene.clone();
         s.sirds.algorithm = SirdsAlgorithm::PerVertex;
+        // The figure is the strip algorithm's: TIW's options (texture, tileable, planes) off.
+        if let SirdsPattern::Textured(t) = &s.sirds.pattern {
+            s.sirds.pattern = t.base.clone();
+        }
+        s.sirds.per_pixel.tileable = false;
+        s.sirds.per_pixel.planes = None;
         s.sirds.geometry.model = model;
         s.sirds.per_vertex.filter = filter;
         bands.push(from_frame(frame, &s)?);
@@ -115,6 +121,13 @@ pub fn from_frame_with(
             (per_pixel(&encoded, &d, &s.pattern, &s.per_pixel)?, None)
         }
         SirdsAlgorithm::PerVertex => {
+            if let Some(field) = s.per_pixel_only() {
+                return Err(Error::invalid(
+                    field,
+                    "with algorithm per-vertex",
+                    "is made by TIW's per-pixel linking: set sirds.algorithm = \"per-pixel\"",
+                ));
+            }
             let g = StripGeometry::new(
                 &scene.strip_objects(),
                 &frame.views.center,
@@ -128,6 +141,10 @@ pub fn from_frame_with(
     };
     if s.guide_dots {
         draw_guide_dots(&mut pixels, scene.width, scene.height, d.max_separation());
+    }
+    if let Some(boxes) = s.guide_boxes {
+        let (w, h, sep) = (scene.width, scene.height, d.max_separation());
+        draw_guide_boxes(&mut pixels, w, h, sep, boxes)?;
     }
     Ok(Sirds {
         pixels,

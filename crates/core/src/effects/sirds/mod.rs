@@ -90,7 +90,7 @@ pub fn depth_range(
 /// Makes a SIRDS of a depth map with TIW's algorithm (`stereolab sirds --depth`).
 ///
 /// # Errors
-/// As [`per_pixel::per_pixel`].
+/// As [`per_pixel::per_pixel`] and [`pattern::draw_guide_boxes`].
 pub fn from_depth_map(depth: DepthMap, s: &Settings) -> Result<Sirds> {
     let d = s.geometry.to_pixels()?;
     let mut pixels = if s.cross_eyed {
@@ -100,6 +100,10 @@ pub fn from_depth_map(depth: DepthMap, s: &Settings) -> Result<Sirds> {
     };
     if s.guide_dots {
         pattern::draw_guide_dots(&mut pixels, depth.width, depth.height, d.max_separation());
+    }
+    if let Some(boxes) = s.guide_boxes {
+        let (w, h) = (depth.width, depth.height);
+        pattern::draw_guide_boxes(&mut pixels, w, h, d.max_separation(), boxes)?;
     }
     Ok(Sirds {
         pixels,

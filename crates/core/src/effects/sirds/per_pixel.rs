@@ -18,6 +18,12 @@ pub struct PerPixelOptions {
     /// Horizontal oversampling factor (1 = off): links are made on a grid this many times
     /// finer, and each output pixel averages its sub-pixels, so depth steps become sub-pixel.
     pub oversample: u32,
+    /// Links wrap around each row ([`RowLinker::link_row_cyclic`]), so the image tiles
+    /// horizontally (`sirds.tileable`).
+    pub tileable: bool,
+    /// Depth quantised to this many planes before linking ([`plane_separation`],
+    /// `sirds.planes`); `None`: continuous.
+    pub planes: Option<u32>,
 }
 
 impl Default for PerPixelOptions {
@@ -25,12 +31,42 @@ impl Default for PerPixelOptions {
         PerPixelOptions {
             hidden_surface: true,
             oversample: 1,
+            tileable: false,
+            planes: None,
         }
     }
 }
 
 /// Largest oversampling factor accepted.
 pub const MAX_OVERSAMPLE: u32 = 16;
+
+/// Fewest and most depth planes `sirds.planes` accepts (an 8-bit depth map has 256 levels).
+pub const PLANES: std::ops::RangeInclusive<u32> = 2..=255;
+
+/// The separation of the depth plane nearest to separation `s`: `planes` planes equally spaced
+/// in separation from the background's `s_far` to the front's `s_near`,
+/// `s_far − round((s_far − s) / step) · step` with `step = (s_far − s_near) / (planes − 1)`.
+/// Source: netpbm's pamstereogram manual (Scott Pakin), `-planes=near,far`: the separations
+/// of the distinct depths are the whole pixels from near to far, "far − near + 1" of them;
+/// with `planes = s_far − s_near + 1` (both whole) the planes are exactly those.
+#[inline]
+pub fn plane_separation(s: f32, s_near: f32, s_far: f32, planes: u32) -> f32 {
+    let step = (s_far - s_near) / (planes - 1) as f32;
+    s_far - ((s_far - s) / step).round() * step
+}
+
+/// Nearness `z` moved onto its depth plane ([`plane_separation`]): the nearness whose
+/// separation is the plane's.
+#[inline]
+pub fn plane_nearness(z: f32, d: &Disparity, planes: u32) -> f32 {
+    let s = plane_separation(
+        d.separation(z),
+        d.separation(1.0),
+        d.separation(0.0),
+        planes,
+    );
+    d.nearness_of_separation(s).clamp(0.0, 1.0)
+}
 
 /// TIW's `round(X) = (int)(X + 0.5)` for the non-negative separations.
 #[inline]
@@ -139,6 +175,34 @@ impl RowLinker {
         });
     }
 
+    /// [`Self::link_row`] with the links wrapping around the row (`sirds.tileable`): the pair a
+    /// point at `x` constrains is `l = (x − ⌈s/2⌉) mod n` and `(l + s) mod n` (the same split
+    /// as [`left_of_pair`]), so the row is a ring and the image tiles horizontally without a
+    /// seam. The sets of pixels that must share a color are kept in `parent` (union–find; each
+    /// set's root is its leftmost pixel); `self.same` is not used. Hidden-surface removal walks
+    /// the row without wrapping.
+    pub fn link_row_cyclic(&mut self, z: &[f32], y: u32, d: &Disparity, scale: u32, hidden: bool) {
+        let n = z.len();
+        let step_scale = step_scale(d, scale);
+        self.same.clear();
+        self.same.extend(0..n as u32);
+        for x in 0..n {
+            let (s, rise) = pair_params(d, z[x], scale, step_scale);
+            if s == 0 || s >= n || (hidden && !ray_clear(z, x, z[x], rise)) {
+                continue;
+            }
+            let left = left_of_pair(x, s, y).rem_euclid(n as isize) as usize;
+            let right = (left + s) % n;
+            let (a, b) = (find(&mut self.same, left), find(&mut self.same, right));
+            let (lo, hi) = (a.min(b), a.max(b));
+            self.same[hi] = lo as u32;
+        }
+        for x in 0..n {
+            let root = find(&mut self.same, x);
+            self.same[x] = root as u32;
+        }
+    }
+
     /// TIW's linking of one row with `params(x)` giving pixel x's separation (whole samples)
     /// and ray rise per step.
     fn link_with(
@@ -211,6 +275,16 @@ impl RowLinker {
         self.window_max
             .extend(z.chunks(r).map(|c| c.iter().copied().fold(0.0, f32::max)));
     }
+}
+
+/// The root of `x`'s set in the union–find `parent`, halving the path on the way.
+fn find(parent: &mut [u32], mut x: usize) -> usize {
+    while parent[x] as usize != x {
+        let up = parent[parent[x] as usize];
+        parent[x] = up;
+        x = up as usize;
+    }
+    x
 }
 
 /// TIW's visibility walk: `true` when neither ray from the point at `x` (nearness `zx`) is
@@ -328,6 +402,9 @@ struct RowWork {
     linker: RowLinker,
     fine: Vec<f32>,
     colors: Vec<[u8; 4]>,
+    planes: Vec<f32>,
+    roots: Vec<u32>,
+    sums: Vec<[u32; 4]>,
 }
 
 impl RowWork {
@@ -346,6 +423,20 @@ impl RowWork {
         row_out: &mut [[u8; 4]],
     ) {
         let o = opts.oversample;
+        if opts.tileable || matches!(pattern, Pattern::Textured(_)) || opts.planes.is_some() {
+            let mut planes = std::mem::take(&mut self.planes);
+            let z = match opts.planes {
+                Some(n) => {
+                    planes.clear();
+                    planes.extend(z.iter().map(|&v| plane_nearness(v, d, n)));
+                    &planes[..]
+                }
+                None => z,
+            };
+            self.row_by_sets(z, y, d, pattern, opts, row_out);
+            self.planes = planes;
+            return;
+        }
         match keys {
             Some((keys, table)) if o == 1 => {
                 self.linker
@@ -365,6 +456,88 @@ impl RowWork {
             color_row(&self.linker.same, y, o, pattern, &mut self.colors);
             average_subpixels(&self.colors, o, row_out);
         }
+    }
+
+    /// [`Self::row`] for tileable rows, depth planes and textures: links (wrapping or not), then
+    /// each set of linked samples colored as a whole ([`color_sets`]).
+    fn row_by_sets(
+        &mut self,
+        z: &[f32],
+        y: u32,
+        d: &Disparity,
+        pattern: &Pattern,
+        opts: &PerPixelOptions,
+        row_out: &mut [[u8; 4]],
+    ) {
+        let o = opts.oversample;
+        let z = if o == 1 {
+            z
+        } else {
+            oversample_row(z, o, &mut self.fine);
+            &self.fine[..]
+        };
+        self.roots.clear();
+        if opts.tileable {
+            self.linker.link_row_cyclic(z, y, d, o, opts.hidden_surface);
+            self.roots.extend_from_slice(&self.linker.same);
+        } else {
+            self.linker.link_row(z, y, d, o, opts.hidden_surface);
+            // TIW's chains point right; a set's root is its rightmost sample.
+            self.roots.resize(z.len(), 0);
+            for x in (0..z.len()).rev() {
+                let s = self.linker.same[x] as usize;
+                self.roots[x] = if s == x { x as u32 } else { self.roots[s] };
+            }
+        }
+        if o == 1 {
+            color_sets(&self.roots, y, o, pattern, &mut self.sums, row_out);
+        } else {
+            self.colors.resize(z.len(), [0; 4]);
+            color_sets(&self.roots, y, o, pattern, &mut self.sums, &mut self.colors);
+            average_subpixels(&self.colors, o, row_out);
+        }
+    }
+}
+
+/// Colors each set of linked samples (`roots[x]`: the root sample of x's set) as one: the
+/// pattern at the root, or for a mapped texture the rounded mean of the set's texels that are
+/// not the background color ([`Textured`](super::pattern::Textured)), the base pattern at the
+/// root where all are background.
+fn color_sets(
+    roots: &[u32],
+    y: u32,
+    o: u32,
+    pattern: &Pattern,
+    sums: &mut Vec<[u32; 4]>,
+    colors: &mut [[u8; 4]],
+) {
+    assert_eq!(colors.len(), roots.len(), "one color per sample");
+    let Pattern::Textured(t) = pattern else {
+        for (c, &r) in colors.iter_mut().zip(roots) {
+            *c = pattern.color(r / o, y);
+        }
+        return;
+    };
+    sums.clear();
+    sums.resize(roots.len(), [0; 4]);
+    for (x, &r) in roots.iter().enumerate() {
+        let texel = t.texel(x as u32 / o, y);
+        if texel != t.background {
+            let sum = &mut sums[r as usize];
+            for c in 0..3 {
+                sum[c] += u32::from(texel[c]);
+            }
+            sum[3] += 1;
+        }
+    }
+    for (c, &r) in colors.iter_mut().zip(roots) {
+        let [red, green, blue, n] = sums[r as usize];
+        *c = if n == 0 {
+            t.base.color(r / o, y)
+        } else {
+            let mean = |v: u32| ((v + n / 2) / n) as u8;
+            [mean(red), mean(green), mean(blue), 255]
+        };
     }
 }
 
@@ -583,7 +756,8 @@ mod tests {
 
     /// TIW streamed from samples gives [`per_pixel`]'s bytes on the same nearness: a small
     /// map (computed separations, a last chunk of 7 rows) and one of 2^20 pixels (the table),
-    /// hidden-surface removal on and off, with oversampling (no table), and reads of
+    /// hidden-surface removal on and off, with oversampling (no table), tileable rows with
+    /// depth planes or oversampling (the linked sets' coloring), and reads of
     /// arbitrary sizes come in whole rows, in order.
     #[test]
     fn per_pixel_samples_matches_per_pixel() {
@@ -602,10 +776,22 @@ mod tests {
                 PerPixelOptions {
                     hidden_surface: false,
                     oversample: 1,
+                    ..PerPixelOptions::default()
                 },
                 PerPixelOptions {
                     hidden_surface: true,
                     oversample: 3,
+                    ..PerPixelOptions::default()
+                },
+                PerPixelOptions {
+                    tileable: true,
+                    planes: Some(7),
+                    ..PerPixelOptions::default()
+                },
+                PerPixelOptions {
+                    oversample: 2,
+                    tileable: true,
+                    ..PerPixelOptions::default()
                 },
             ] {
                 let want = per_pixel(&map, &d, &pattern, &opts).expect("tiw");

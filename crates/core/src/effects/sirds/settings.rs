@@ -6,8 +6,8 @@ use serde::Deserialize;
 
 use super::depthmap::DepthRange;
 use super::disparity::{DisparityModel, Geometry};
-use super::pattern::Pattern;
-use super::per_pixel::{MAX_OVERSAMPLE, PerPixelOptions};
+use super::pattern::{GuideBoxes, GuidePlace, MAX_GUIDE_SIZE, Pattern};
+use super::per_pixel::{MAX_OVERSAMPLE, PLANES, PerPixelOptions};
 use crate::error::{Error, Result};
 use crate::files::InputRoot;
 
@@ -119,6 +119,21 @@ pub struct SirdsSpec {
     /// View cross-eyed (inverts depth) instead of wall-eyed.
     #[serde(default)]
     pub cross_eyed: bool,
+    /// A texture image (relative to the scene file) for a mapped-texture stereogram
+    /// (per-pixel only).
+    pub texture: Option<String>,
+    /// The texture's background color, `[r, g, b]` 0..=255 (default: its top-left pixel).
+    pub texture_background: Option<[u8; 3]>,
+    /// Links wrap around each row, so the image tiles horizontally (per-pixel only).
+    #[serde(default)]
+    pub tileable: bool,
+    /// Depth quantised to this many planes, 2..=255 (per-pixel only).
+    pub planes: Option<u32>,
+    /// pamstereogram's guide boxes: `top`, `bottom` or `both`.
+    #[serde(default, deserialize_with = "guide_names::deserialize")]
+    pub guides: Option<GuidePlace>,
+    /// Side of each guide box in pixels (default 20).
+    pub guide_size: Option<u32>,
 }
 
 macro_rules! names {
@@ -140,6 +155,7 @@ macro_rules! names {
 names!(model_names, DisparityModel, "eye-distance" => DisparityModel::EyeDistance, "view-angle" => DisparityModel::ViewAngle);
 names!(start_names, Start, "left" => Start::Left, "center" => Start::Center);
 names!(filter_names, Filter, "nearest" => Filter::Nearest, "bilinear" => Filter::Bilinear);
+names!(guide_names, Option<GuidePlace>, "top" => Some(GuidePlace::Top), "bottom" => Some(GuidePlace::Bottom), "both" => Some(GuidePlace::Both));
 
 /// `[sirds]` validated.
 #[derive(Clone, Debug, PartialEq)]
@@ -162,6 +178,8 @@ pub struct Settings {
     pub guide_dots: bool,
     /// Cross-eyed viewing.
     pub cross_eyed: bool,
+    /// pamstereogram's guide boxes, if asked.
+    pub guide_boxes: Option<GuideBoxes>,
 }
 
 impl Default for Settings {
@@ -172,6 +190,50 @@ impl Default for Settings {
 }
 
 impl Settings {
+    /// One line for `stereolab render --explain`: the algorithm and the options of
+    /// pamstereogram's set in use (texture, tileable, planes, guides).
+    pub fn describe(&self) -> String {
+        let mut parts = vec![match self.algorithm {
+            Algorithm::PerVertex => "per-vertex strips".to_string(),
+            Algorithm::PerPixel => "per-pixel (TIW)".to_string(),
+        }];
+        if let Pattern::Textured(t) = &self.pattern {
+            let (w, h) = t.texture.dimensions();
+            parts.push(format!("mapped texture {w}×{h}"));
+        }
+        if self.per_pixel.tileable {
+            parts.push("tileable".to_string());
+        }
+        if let Some(n) = self.per_pixel.planes {
+            parts.push(format!("{n} depth planes"));
+        }
+        if self.guide_dots {
+            parts.push("guide dots".to_string());
+        }
+        if let Some(g) = self.guide_boxes {
+            let place = match g.place {
+                GuidePlace::Top => "top",
+                GuidePlace::Bottom => "bottom",
+                GuidePlace::Both => "top and bottom",
+            };
+            parts.push(format!("guide boxes {place}, {} px", g.size));
+        }
+        parts.join(", ")
+    }
+
+    /// The options that only TIW (per-pixel) makes: the first one set, by its field name.
+    pub fn per_pixel_only(&self) -> Option<&'static str> {
+        if matches!(self.pattern, Pattern::Textured(_)) {
+            Some("sirds.texture")
+        } else if self.per_pixel.tileable {
+            Some("sirds.tileable")
+        } else if self.per_pixel.planes.is_some() {
+            Some("sirds.planes")
+        } else {
+            None
+        }
+    }
+
     /// Validates `spec`; a pattern image path is resolved by `root` (the scene's folder).
     ///
     /// # Errors
@@ -207,6 +269,32 @@ impl Settings {
         if spec.iterations == Some(0) {
             return Err(Error::invalid("sirds.iterations", 0, "must be at least 1"));
         }
+        if let Some(n) = spec.planes.filter(|n| !PLANES.contains(n)) {
+            return Err(Error::invalid(
+                "sirds.planes",
+                n,
+                format!(
+                    "must lie in {}..={} (the number of depth planes)",
+                    PLANES.start(),
+                    PLANES.end()
+                ),
+            ));
+        }
+        let guide_size = spec.guide_size.unwrap_or(20);
+        if !(1..=MAX_GUIDE_SIZE).contains(&guide_size) {
+            return Err(Error::invalid(
+                "sirds.guide_size",
+                guide_size,
+                format!("must lie in 1..={MAX_GUIDE_SIZE} pixels"),
+            ));
+        }
+        if spec.guide_size.is_some() && spec.guides.is_none() {
+            return Err(Error::invalid(
+                "sirds.guide_size",
+                guide_size,
+                "sizes the guide boxes: set sirds.guides = \"top\", \"bottom\" or \"both\" too",
+            ));
+        }
         let seed = spec.seed.unwrap_or(1);
         let pattern = match &spec.pattern_image {
             Some(p) => Pattern::load_image(&root.resolve("sirds.pattern_image", p)?)?,
@@ -215,6 +303,20 @@ impl Settings {
                 DotKind::Gray => Pattern::Gray { seed },
                 DotKind::Color => Pattern::Color { seed },
             },
+        };
+        let pattern = match &spec.texture {
+            Some(p) => {
+                let path = root.resolve("sirds.texture", p)?;
+                Pattern::textured(&path, pattern, spec.texture_background)?
+            }
+            None if spec.texture_background.is_some() => {
+                return Err(Error::invalid(
+                    "sirds.texture_background",
+                    format!("{:?}", spec.texture_background.unwrap_or_default()),
+                    "is the background color of sirds.texture: set sirds.texture too",
+                ));
+            }
+            None => pattern,
         };
         Ok(Settings {
             algorithm: spec.algorithm,
@@ -229,10 +331,16 @@ impl Settings {
             per_pixel: PerPixelOptions {
                 hidden_surface: spec.hidden_surface.unwrap_or(true),
                 oversample,
+                tileable: spec.tileable,
+                planes: spec.planes,
             },
             pattern,
             guide_dots: spec.guide_dots,
             cross_eyed: spec.cross_eyed,
+            guide_boxes: spec.guides.map(|place| GuideBoxes {
+                place,
+                size: guide_size,
+            }),
         })
     }
 }
