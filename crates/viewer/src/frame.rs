@@ -58,11 +58,13 @@ pub struct Shown {
 /// Whatever rendering or the output fails with (an invalid rig, a ChromaDepth range outside
 /// the clip planes, …).
 pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Result<Shown> {
-    let plan = Plan::new(&[params.output]);
+    // A multiview output renders the scene's `multiview.views` cameras.
+    let shown = params.output.with_views(scene.views);
+    let plan = Plan::new(&[shown]);
     let start = Instant::now();
     let frame = render(scene, &plan)?;
     let passes_done = Instant::now();
-    let image = output::produce(params.output, &frame, scene)?;
+    let image = output::produce(shown, &frame, scene)?;
     let effect = passes_done.elapsed();
     let total = start.elapsed();
     let readouts_start = Instant::now();
@@ -200,6 +202,21 @@ impl Shown {
                     y if y >= below => (View::Right, x, y - below),
                     _ => return None,
                 }
+            }
+            // The tile's camera, row-major in the tiles' grid.
+            Output::ViewTiles(_) => {
+                let n = self.frame.views.multi.len() as u32;
+                let (columns, _) = stereolab_core::view_grid(n);
+                let i = (y / h) * columns + x / w;
+                if i >= n {
+                    return None;
+                }
+                (View::Multi(i as u8), x % w, y % h)
+            }
+            Output::ViewInterleaved(_) => {
+                let n = self.frame.views.multi.len() as u32;
+                let i = stereolab_core::lenticular_view(x, n.max(1));
+                (View::Multi(i as u8), x, y)
             }
             _ => {
                 let view = [View::Left, View::Center, View::Right]
