@@ -164,6 +164,7 @@ fn two_views_are_the_left_and_right_images_byte_for_byte() {
         &["stereo.lighting=\"cyclopic\""][..],
         &["stereo.viewer=\"left-eye\""][..],
         &["stereo.eye_separation=\"auto\"", "stereo.user_balance=0.7"][..],
+        &["stereo.mode=\"image-shift\""][..],
     ] {
         let mut sets = vec!["multiview.views=2"];
         sets.extend_from_slice(extra);
@@ -176,6 +177,17 @@ fn two_views_are_the_left_and_right_images_byte_for_byte() {
             assert_eq!(multi, pair, "{extra:?}: view {i} against {eye:?}");
             assert_eq!(frame.views.multi[i], *frame.matrices(eye), "{extra:?}");
         }
+        let scene = shipped("multiview", &sets);
+        let frame = render(
+            &scene,
+            &Plan::new(&[Output::ViewTiles(2), Output::SideBySide]),
+        )
+        .unwrap();
+        assert_eq!(
+            rgba(produce(Output::ViewTiles(2), &frame, &scene).unwrap()),
+            rgba(produce(Output::SideBySide, &frame, &scene).unwrap()),
+            "{extra:?}: two tiles are left | right"
+        );
     }
 }
 
@@ -338,7 +350,7 @@ fn bad_wiggle_and_multiview_values_name_their_field() {
             "multiview",
             &["stereo.mode=\"image-shift\""][..],
             "stereo.mode",
-            "off-axis",
+            "multiview.views = 2, not 5",
         ),
         (
             "multiview",

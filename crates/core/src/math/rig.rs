@@ -602,11 +602,12 @@ impl StereoRig {
     /// with the rig's zero-parallax plane (off-axis: each frustum sheared to meet it; toe-in:
     /// each camera turned to the fusion point; parallel: symmetric, zero parallax at infinity).
     /// Two views are the rig's left and right eyes, the same matrices as
-    /// [`StereoRig::eyes_for_image`].
+    /// [`StereoRig::eyes_for_image`] (for [`CameraMode::ImageShift`] too, whose whole-pixel
+    /// split is defined for two eyes only).
     ///
     /// # Errors
-    /// `views` outside 2..=[`MAX_VIEWS`]; [`CameraMode::ImageShift`] (its whole-pixel split is
-    /// defined for two eyes); as [`StereoRig::eyes`].
+    /// `views` outside 2..=[`MAX_VIEWS`]; more than two views of [`CameraMode::ImageShift`];
+    /// as [`StereoRig::eyes`].
     pub fn views(
         &self,
         camera: &Camera,
@@ -622,11 +623,18 @@ impl StereoRig {
             ));
         }
         if self.mode == CameraMode::ImageShift {
+            // Its whole-pixel shift is split between two eyes: two views are those eyes.
+            if views == 2 {
+                return Ok(self.eyes_for_image(camera, width, height)?.to_vec());
+            }
             return Err(Error::invalid(
                 "stereo.mode",
                 "\"image-shift\"",
-                "splits its whole-pixel shift between two eyes only; for multiview outputs use \
-                 \"off-axis\", the same geometry without the blank columns",
+                format!(
+                    "splits its whole-pixel shift between two eyes only, so it renders \
+                     multiview.views = 2, not {views}; for more views use \"off-axis\", the \
+                     same geometry without the blank columns"
+                ),
             ));
         }
         camera.validate()?;
