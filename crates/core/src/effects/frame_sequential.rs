@@ -151,7 +151,7 @@ impl WiggleSettings {
                 ),
             ));
         }
-        if ms % 10 != 0 {
+        if !ms.is_multiple_of(10) {
             let below = ms / 10 * 10;
             return Err(Error::invalid(
                 "wiggle.frame_ms",
