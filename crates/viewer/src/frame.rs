@@ -266,8 +266,43 @@ mod tests {
     use super::*;
     use stereolab_core::{Camera, StereoRig, ZeroParallax, parallax_budget_of};
 
-    /// The border-only count is the per-pixel budget's count, on framebuffers whose depths are
-    /// scattered over the whole range (background included), for several zero-parallax planes.
+    /// The viewer shows the scene's N views, and a pick in a tile finds the point the tile's
+    /// camera sees there: projected by that camera, the point lands back on the pixel.
+    #[test]
+    fn multiview_tiles_show_the_scenes_views_and_pick_their_cameras() {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../assets/scenes/multiview.toml");
+        let mut scene = Scene::load(&path, &[]).unwrap();
+        scene.set_size(64, 48).unwrap();
+        let session = crate::session::Session::new(&scene, &path, &[]).unwrap();
+        let mut p = session.initial.clone();
+        p.output = Output::ViewTiles(2);
+        session.apply(&p, &mut scene);
+        let shown = render_shown(&scene, &p, None).unwrap();
+        // Five views: a 3×2 grid of 64×48 tiles, the sixth empty.
+        assert_eq!(shown.image.display_size(), (3 * 64, 2 * 48));
+        assert_eq!(shown.frame.views.multi.len(), 5);
+        assert!(shown.pick(2 * 64 + 32, 48 + 24).is_none(), "the empty tile");
+        let mut hits = 0;
+        for i in 0..5u32 {
+            let (tx, ty) = (i % 3, i / 3);
+            for (x, y) in [(20, 10), (32, 24), (44, 30), (50, 20)] {
+                let Some(q) = shown.pick(tx * 64 + x, ty * 48 + y) else {
+                    continue;
+                };
+                let ndc = shown.frame.views.multi[i as usize].mvp.project_point3(q);
+                let px = (ndc.x + 1.0) * 0.5 * 64.0;
+                let py = (1.0 - ndc.y) * 0.5 * 48.0;
+                assert!(
+                    (px - (x as f32 + 0.5)).abs() < 0.01 && (py - (y as f32 + 0.5)).abs() < 0.01,
+                    "view {i} at ({x}, {y}): projects to ({px}, {py})"
+                );
+                hits += 1;
+            }
+        }
+        assert!(hits >= 5, "{hits} picks hit the model");
+    }
+
     #[test]
     fn window_violations_count_as_the_budget_does() {
         let camera = Camera {
