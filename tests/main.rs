@@ -47,4 +47,5 @@ mod stability;
 mod stereo_photo;
 #[cfg(feature = "viewer")]
 mod viewer;
+mod views;
 mod zero_parallax;

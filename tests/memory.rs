@@ -121,7 +121,7 @@ fn the_estimate_holds_the_measured_peak() {
             .replace("soup.obj", "star.obj"),
     )
     .expect("scene");
-    let cases: [(&Path, &[&str]); 8] = [
+    let cases: [(&Path, &[&str]); 10] = [
         (&asset("scenes/anaglyph.toml"), &["--size", "2048x2048"]),
         (&asset("scenes/wuson.toml"), &["--size", "2048x1536"]),
         (&asset("scenes/sirds_fig5.toml"), &["--size", "2048x1024"]),
@@ -134,6 +134,12 @@ fn the_estimate_holds_the_measured_peak() {
         (&star, &["--size", "1024x768"]),
         // The stars past the view: clipped into fans, each sliver across many bands.
         (&star, &["--size", "1024x768", "--set", "mesh.0.scale=4"]),
+        // Both eyes quantised to one GIF palette, and nine views in a 3×3 grid of tiles.
+        (&asset("scenes/wiggle.toml"), &["--size", "2048x1536"]),
+        (
+            &asset("scenes/multiview.toml"),
+            &["--size", "1024x768", "--set", "multiview.views=9"],
+        ),
     ];
     for (k, (scene, args)) in cases.into_iter().enumerate() {
         let dir = out_dir(&format!("memory-{k}"));

@@ -39,13 +39,13 @@ pub use framebuffer::{
 // The camera and the stereo rig: each formula a short function (`math::stereo`), the rig that
 // checks its inputs and calls them.
 pub use math::stereo::{
-    auto_eye_separation, cyclopic_projection, eye_translation, frustum_asymmetry,
-    image_shift_translation, off_axis_frustum, toe_in_view, view_width_at,
-    zero_parallax_at_fraction,
+    auto_eye_separation, camera_frustum_asymmetry, camera_translation, cyclopic_projection,
+    eye_translation, frustum_asymmetry, image_shift_translation, off_axis_frustum,
+    toe_in_camera_view, toe_in_view, view_offset, view_width_at, zero_parallax_at_fraction,
 };
 pub use math::{
-    Camera, CameraMode, EyeMatrices, ImageShift, Lighting, ResolvedRig, Separation, StereoRig,
-    Viewer, ZeroParallax, fit_zero_parallax, frustum, look_at, perspective, project_ndc,
+    Camera, CameraMode, EyeMatrices, ImageShift, Lighting, MAX_VIEWS, ResolvedRig, Separation,
+    StereoRig, Viewer, ZeroParallax, fit_zero_parallax, frustum, look_at, perspective, project_ndc,
 };
 
 // Shading and the fixed-point rasterizer (knows nothing of stereo).
@@ -76,7 +76,8 @@ pub use effects::calibration::{
 };
 pub use effects::eye_input::check_same_size;
 pub use effects::frame_sequential::{
-    Field as FrameField, FrameSequentialSettings, MAX_CYCLES, MAX_EYE_RATE_HZ,
+    DEFAULT_WIGGLE_FRAME_MS, Field as FrameField, FrameSequentialSettings, MAX_CYCLES,
+    MAX_EYE_RATE_HZ, MAX_WIGGLE_FRAME_MS, MIN_WIGGLE_FRAME_MS, WiggleSettings, WiggleStart,
 };
 pub use effects::ghosting::{
     BRIGHT as GHOST_BRIGHT, DARK as GHOST_DARK, DEFAULT_LEAK as DEFAULT_GHOSTING_LEAK, GhostRisk,
@@ -85,7 +86,8 @@ pub use effects::ghosting::{
 };
 pub use effects::layout::{
     above_below, above_below_squashed, frame_packing, frame_packing_active_space, half_above_below,
-    half_side_by_side, interleave, side_by_side,
+    half_side_by_side, interleave, lenticular_interleave, lenticular_view, side_by_side, view_grid,
+    view_tiles,
 };
 
 // Remapping, the visibility check, random-dot pairs.

@@ -72,6 +72,15 @@ pub fn images_held(output: Output) -> f64 {
         // Both views and the active space between them (H/24 rows).
         Output::FramePacking => 2.0 + 1.0 / 24.0,
         Output::ShearVsRotate => 3.0,
+        // Both eyes; the GIF also its palette indices (a byte a pixel, each eye) and the
+        // quantiser's copy of both eyes.
+        Output::WiggleApng => 2.0,
+        Output::WiggleGif => 4.5,
+        // The tiles' whole grid, empty tiles included.
+        Output::ViewTiles(n) => {
+            let (columns, rows) = stereolab_core::view_grid(u32::from(n));
+            f64::from(columns * rows)
+        }
         Output::SirdsFig5 => 6.0,
         _ => 1.0,
     }

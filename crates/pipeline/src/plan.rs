@@ -3,7 +3,15 @@
 
 use std::fmt::Write as _;
 
+<<<<<<< HEAD
 use stereolab_core::{AnaglyphGlasses, AnaglyphKind, AnaglyphMethod, Error, Eye, Result};
+=======
+use stereolab_core::{AnaglyphKind, Error, Eye, MAX_VIEWS, Result};
+
+/// The views a multiview output renders when the scene has no `[multiview]` section: the rig's
+/// own two eyes (Blender's default multi-view setup, "Stereo 3D", is the left/right pair).
+pub const DEFAULT_VIEWS: u8 = 2;
+>>>>>>> views
 
 /// Everything a scene can ask `stereolab render` to write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -100,6 +108,17 @@ pub enum Output {
     /// The StereoGraphics guide's above-below calibration screen: two arrows that line up when
     /// `layout.blank_interval` matches the display's blank interval. Needs no pass.
     AboveBelowCalibration,
+    /// Wiggle stereoscopy as StereoPhoto Maker (Masuji Suto) exports it: left and right
+    /// alternating forever, `wiggle.frame_ms` each, as an animated GIF (`wiggle_gif.gif`).
+    WiggleGif,
+    /// The same wiggle as an animated PNG (`wiggle_apng.png`), lossless.
+    WiggleApng,
+    /// The scene's N views (`multiview.views`, N cameras on the rig's baseline) as tiles of
+    /// one image, row-major from the top left (`view_grid`).
+    ViewTiles(u8),
+    /// The N views interleaved column by column for a lenticular sheet, the rightmost view
+    /// first under each lenticule (`lenticular_view`).
+    ViewInterleaved(u8),
 }
 
 /// Which camera a pass renders from.
@@ -119,6 +138,9 @@ pub enum View {
     RotateLeft,
     /// The scene's rig as toe-in (rotate), right eye.
     RotateRight,
+    /// Camera `i` of the scene's N multiview cameras on the rig's baseline, 0 the leftmost
+    /// (`StereoRig::views`).
+    Multi(u8),
 }
 
 impl From<Eye> for View {
@@ -285,6 +307,10 @@ impl Output {
         Output::CancelledLeft,
         Output::CancelledRight,
         Output::AboveBelowCalibration,
+        Output::WiggleGif,
+        Output::WiggleApng,
+        Output::ViewTiles(DEFAULT_VIEWS),
+        Output::ViewInterleaved(DEFAULT_VIEWS),
     ];
 
     /// Everything this output is, in one row: its name, its file, the passes it reads.
@@ -374,6 +400,15 @@ impl Output {
             Output::CancelledRight => png("cancelled_right", PAIR),
             // A test pattern of the layout alone: no pass at all.
             Output::AboveBelowCalibration => png("above_below_calibration", &[]),
+            Output::WiggleGif => OutputSpec {
+                name: "wiggle_gif",
+                extension: "gif",
+                needs: PAIR,
+            },
+            Output::WiggleApng => png("wiggle_apng", PAIR),
+            // The first N of the multiview passes, N the scene's `multiview.views`.
+            Output::ViewTiles(n) => png("view_tiles", multi_passes(n)),
+            Output::ViewInterleaved(n) => png("view_interleaved", multi_passes(n)),
         }
     }
 
@@ -408,6 +443,24 @@ impl Output {
             })
     }
 
+    /// How many multiview cameras this output renders (`multiview.views`); `None` for the
+    /// outputs of the stereo pair and the center eye.
+    pub fn views(self) -> Option<u8> {
+        match self {
+            Output::ViewTiles(n) | Output::ViewInterleaved(n) => Some(n),
+            _ => None,
+        }
+    }
+
+    /// This output with its multiview camera count set to `views` (others as they are).
+    pub fn with_views(self, views: u8) -> Output {
+        match self {
+            Output::ViewTiles(_) => Output::ViewTiles(views),
+            Output::ViewInterleaved(_) => Output::ViewInterleaved(views),
+            o => o,
+        }
+    }
+
     /// The passes this output reads.
     pub fn needs(self) -> Vec<Pass> {
         self.spec().needs.to_vec()
@@ -423,6 +476,22 @@ pub struct OutputSpec {
     pub extension: &'static str,
     /// The passes the output reads (none for the random-dot texture and the calibration screen).
     pub needs: &'static [Pass],
+}
+
+/// The shaded passes of every multiview camera: [`multi_passes`] slices the first N.
+static MULTI_PASSES: [Pass; MAX_VIEWS as usize] = {
+    let mut passes = [color(View::Multi(0)); MAX_VIEWS as usize];
+    let mut i = 0;
+    while i < passes.len() {
+        passes[i] = color(View::Multi(i as u8));
+        i += 1;
+    }
+    passes
+};
+
+/// The shaded passes of the first `views` multiview cameras (at most [`MAX_VIEWS`]).
+fn multi_passes(views: u8) -> &'static [Pass] {
+    &MULTI_PASSES[..usize::from(views).min(MULTI_PASSES.len())]
 }
 
 /// A shaded pass of `view` (color and depth).

@@ -58,11 +58,13 @@ pub struct Shown {
 /// Whatever rendering or the output fails with (an invalid rig, a ChromaDepth range outside
 /// the clip planes, …).
 pub fn render_shown(scene: &Scene, params: &Params, picked: Option<Vec3>) -> Result<Shown> {
-    let plan = Plan::new(&[params.output]);
+    // A multiview output renders the scene's `multiview.views` cameras.
+    let shown = params.output.with_views(scene.views);
+    let plan = Plan::new(&[shown]);
     let start = Instant::now();
     let frame = render(scene, &plan)?;
     let passes_done = Instant::now();
-    let image = output::produce(params.output, &frame, scene)?;
+    let image = output::produce(shown, &frame, scene)?;
     let effect = passes_done.elapsed();
     let total = start.elapsed();
     let readouts_start = Instant::now();
@@ -201,6 +203,21 @@ impl Shown {
                     _ => return None,
                 }
             }
+            // The tile's camera, row-major in the tiles' grid.
+            Output::ViewTiles(_) => {
+                let n = self.frame.views.multi.len() as u32;
+                let (columns, _) = stereolab_core::view_grid(n);
+                let i = (y / h) * columns + x / w;
+                if i >= n {
+                    return None;
+                }
+                (View::Multi(i as u8), x % w, y % h)
+            }
+            Output::ViewInterleaved(_) => {
+                let n = self.frame.views.multi.len() as u32;
+                let i = stereolab_core::lenticular_view(x, n.max(1));
+                (View::Multi(i as u8), x, y)
+            }
             _ => {
                 let view = [View::Left, View::Center, View::Right]
                     .into_iter()
@@ -249,8 +266,43 @@ mod tests {
     use super::*;
     use stereolab_core::{Camera, StereoRig, ZeroParallax, parallax_budget_of};
 
-    /// The border-only count is the per-pixel budget's count, on framebuffers whose depths are
-    /// scattered over the whole range (background included), for several zero-parallax planes.
+    /// The viewer shows the scene's N views, and a pick in a tile finds the point the tile's
+    /// camera sees there: projected by that camera, the point lands back on the pixel.
+    #[test]
+    fn multiview_tiles_show_the_scenes_views_and_pick_their_cameras() {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../assets/scenes/multiview.toml");
+        let mut scene = Scene::load(&path, &[]).unwrap();
+        scene.set_size(64, 48).unwrap();
+        let session = crate::session::Session::new(&scene, &path, &[]).unwrap();
+        let mut p = session.initial.clone();
+        p.output = Output::ViewTiles(2);
+        session.apply(&p, &mut scene);
+        let shown = render_shown(&scene, &p, None).unwrap();
+        // Five views: a 3×2 grid of 64×48 tiles, the sixth empty.
+        assert_eq!(shown.image.display_size(), (3 * 64, 2 * 48));
+        assert_eq!(shown.frame.views.multi.len(), 5);
+        assert!(shown.pick(2 * 64 + 32, 48 + 24).is_none(), "the empty tile");
+        let mut hits = 0;
+        for i in 0..5u32 {
+            let (tx, ty) = (i % 3, i / 3);
+            for (x, y) in [(20, 10), (32, 24), (44, 30), (50, 20)] {
+                let Some(q) = shown.pick(tx * 64 + x, ty * 48 + y) else {
+                    continue;
+                };
+                let ndc = shown.frame.views.multi[i as usize].mvp.project_point3(q);
+                let px = (ndc.x + 1.0) * 0.5 * 64.0;
+                let py = (1.0 - ndc.y) * 0.5 * 48.0;
+                assert!(
+                    (px - (x as f32 + 0.5)).abs() < 0.01 && (py - (y as f32 + 0.5)).abs() < 0.01,
+                    "view {i} at ({x}, {y}): projects to ({px}, {py})"
+                );
+                hits += 1;
+            }
+        }
+        assert!(hits >= 5, "{hits} picks hit the model");
+    }
+
     #[test]
     fn window_violations_count_as_the_budget_does() {
         let camera = Camera {

@@ -589,6 +589,8 @@ mod tests {
             Output::ChromaDepth,
             Output::Sirds,
             Output::SideBySide,
+            Output::ViewTiles(2),
+            Output::WiggleApng,
         ] {
             p.output = output;
             session.apply(&p, &mut scene);

@@ -94,6 +94,110 @@ impl FrameSequentialSettings {
     }
 }
 
+/// The wiggle's time per frame unless the scene says otherwise, in milliseconds.
+pub const DEFAULT_WIGGLE_FRAME_MS: u32 = 120;
+/// The shortest wiggle frame: GIF viewers show delays under 2/100 s as 1/10 s.
+pub const MIN_WIGGLE_FRAME_MS: u32 = 20;
+/// The longest wiggle frame (5 s: longer is a slide show, not a wiggle).
+pub const MAX_WIGGLE_FRAME_MS: u32 = 5000;
+
+/// Which view a wiggle starts with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum WiggleStart {
+    /// Left, right, left, … (default).
+    #[default]
+    Left,
+    /// Right, left, right, …
+    Right,
+}
+
+/// `[wiggle]` in a scene file: wiggle stereoscopy as StereoPhoto Maker (Masuji Suto) exports
+/// it, the left and right views alternating forever, each shown `frame_ms` milliseconds, so
+/// the depth is seen with one eye (or none) from the motion parallax.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WiggleSettings {
+    /// Milliseconds each view is shown, a multiple of 10 (GIF stores delays in 1/100 s) from
+    /// [`MIN_WIGGLE_FRAME_MS`] to [`MAX_WIGGLE_FRAME_MS`].
+    pub frame_ms: u32,
+    /// The view shown first.
+    pub start: WiggleStart,
+}
+
+impl Default for WiggleSettings {
+    fn default() -> Self {
+        WiggleSettings {
+            frame_ms: DEFAULT_WIGGLE_FRAME_MS,
+            start: WiggleStart::Left,
+        }
+    }
+}
+
+impl WiggleSettings {
+    /// # Errors
+    /// `Invalid` naming `wiggle.frame_ms` when it is out of range or not a multiple of 10 (the
+    /// remedy names the nearest multiples): a GIF delay is a whole number of 1/100 s, and both
+    /// wiggle files show the same timing, so the time is refused rather than rounded.
+    pub fn validate(&self) -> Result<()> {
+        let ms = self.frame_ms;
+        if !(MIN_WIGGLE_FRAME_MS..=MAX_WIGGLE_FRAME_MS).contains(&ms) {
+            return Err(Error::invalid(
+                "wiggle.frame_ms",
+                ms,
+                format!(
+                    "must be {MIN_WIGGLE_FRAME_MS} to {MAX_WIGGLE_FRAME_MS} milliseconds per \
+                     view (StereoPhoto Maker's wiggles run about 100 to 200)"
+                ),
+            ));
+        }
+        if !ms.is_multiple_of(10) {
+            let below = ms / 10 * 10;
+            return Err(Error::invalid(
+                "wiggle.frame_ms",
+                ms,
+                format!(
+                    "must be a multiple of 10 ms (a GIF delay is a whole number of 1/100 s); \
+                     use {below} or {}",
+                    below + 10
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The GIF delay of each frame in 1/100 s: `frame_ms / 10`.
+    ///
+    /// # Errors
+    /// As [`WiggleSettings::validate`].
+    pub fn gif_delay_centiseconds(&self) -> Result<u16> {
+        self.validate()?;
+        Ok(u16::try_from(self.frame_ms / 10).expect("bounded by MAX_WIGGLE_FRAME_MS"))
+    }
+
+    /// The two frames in display order (the file loops forever), each shown
+    /// `frame_ms / 1000` s.
+    ///
+    /// # Errors
+    /// As [`WiggleSettings::validate`].
+    pub fn fields(&self) -> Result<Vec<Field>> {
+        self.validate()?;
+        let num = u16::try_from(self.frame_ms).expect("bounded by MAX_WIGGLE_FRAME_MS");
+        let order = match self.start {
+            WiggleStart::Left => [BACK_LEFT, BACK_RIGHT],
+            WiggleStart::Right => [BACK_RIGHT, BACK_LEFT],
+        };
+        Ok(order
+            .into_iter()
+            .map(|buffer| Field {
+                buffer,
+                delay_num: num,
+                delay_den: 1000,
+            })
+            .collect())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -133,5 +237,36 @@ mod tests {
             .to_string();
             assert!(e.contains(field), "{e}");
         }
+    }
+
+    #[test]
+    fn wiggle_frame_times_are_bounded_and_whole_centiseconds() {
+        for (ms, remedy) in [
+            (0, "20 to 5000"),
+            (10, "20 to 5000"),
+            (5010, "20 to 5000"),
+            (125, "use 120 or 130"),
+            (21, "use 20 or 30"),
+        ] {
+            let e = WiggleSettings {
+                frame_ms: ms,
+                ..WiggleSettings::default()
+            }
+            .validate()
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("wiggle.frame_ms") && e.contains(remedy), "{e}");
+        }
+        let s = WiggleSettings {
+            frame_ms: 130,
+            start: WiggleStart::Right,
+        };
+        assert_eq!(s.gif_delay_centiseconds().unwrap(), 13);
+        let f = s.fields().unwrap();
+        assert_eq!(
+            f.iter().map(|f| f.buffer).collect::<Vec<_>>(),
+            [BACK_RIGHT, BACK_LEFT]
+        );
+        assert!(f.iter().all(|f| (f.delay_num, f.delay_den) == (130, 1000)));
     }
 }

@@ -121,6 +121,72 @@ pub fn interleave(
     }))
 }
 
+/// The grid `(columns, rows)` that [`view_tiles`] lays `views` views out in: `⌈√N⌉` columns and
+/// as many rows as the views fill (2 → 2×1, 4 → 2×2, 5 → 3×2, 9 → 3×3).
+pub fn view_grid(views: u32) -> (u32, u32) {
+    let mut columns = 1;
+    while columns * columns < views {
+        columns += 1;
+    }
+    (columns, views.div_ceil(columns))
+}
+
+/// The N views as tiles of one image, row-major from the top left in [`view_grid`]'s grid: view
+/// `i` at column `i mod C`, row `⌊i / C⌋` (view 0, the leftmost camera, top left, as a quilt
+/// of a multi-view display lists them); tiles no view fills are opaque black.
+///
+/// # Errors
+/// No views, or views of different sizes.
+pub fn view_tiles(views: &[&Framebuffer]) -> Result<RgbaImage> {
+    let first = check_views(views)?;
+    let (w, h) = (first.width, first.height);
+    let (columns, rows) = view_grid(views.len() as u32);
+    Ok(RgbaImage::from_fn(columns * w, rows * h, |x, y| {
+        let i = (y / h) * columns + x / w;
+        Rgba(match views.get(i as usize) {
+            Some(v) => v.pixel(x % w, y % h),
+            None => [0, 0, 0, 255],
+        })
+    }))
+}
+
+/// The view a lenticular sheet's column `x` shows with `views` views under each lenticule:
+/// `N − 1 − (x mod N)`. A lenticule images the strips under it mirrored (the strip at its left
+/// edge is seen from the right), so each lenticule holds the views right-most first (the
+/// rightmost camera's strip leftmost: "Lenticular stereogram maker", Charles Douglas Wehner;
+/// "3D Lenticular Printing Interlacing Algorithm Illustrated Using Photoshop", Isaac Cheung).
+pub fn lenticular_view(x: u32, views: u32) -> u32 {
+    views - 1 - x % views
+}
+
+/// The N views interleaved column by column for a lenticular sheet with one pixel column per
+/// view under each lenticule: column `x` from view [`lenticular_view`]`(x, N)`, one eye-sized
+/// image.
+///
+/// # Errors
+/// No views, or views of different sizes.
+pub fn lenticular_interleave(views: &[&Framebuffer]) -> Result<RgbaImage> {
+    let first = check_views(views)?;
+    let n = views.len() as u32;
+    Ok(RgbaImage::from_fn(first.width, first.height, |x, y| {
+        Rgba(views[lenticular_view(x, n) as usize].pixel(x, y))
+    }))
+}
+
+/// The first of `views`, after checking there is one and that all have its size.
+fn check_views<'a>(views: &[&'a Framebuffer]) -> Result<&'a Framebuffer> {
+    let first = *views.first().ok_or_else(|| {
+        Error::internal(
+            "multiview",
+            "no views to lay out (the plan ran no view pass)",
+        )
+    })?;
+    for v in views {
+        same_size(first, v)?;
+    }
+    Ok(first)
+}
+
 /// The mean of `n` pixels' linear light in one channel, encoded back to 8-bit sRGB: the box
 /// filter of the frame-compatible formats. `weights` pair each pixel with its share of the
 /// output pixel's footprint (they sum to 1). Color channels are decoded (IEC 61966-2-1) before
@@ -240,4 +306,28 @@ pub fn frame_packing(left: &Framebuffer, right: &Framebuffer) -> Result<RgbaImag
             right.pixel(x, y - h - gap)
         })
     }))
+}
+
+#[cfg(test)]
+mod view_layout_tests {
+    use super::*;
+
+    #[test]
+    fn view_grids_are_the_smallest_square_side_wide() {
+        for n in 1..=64u32 {
+            let (c, r) = view_grid(n);
+            // An independent definition: the fewest columns c with c² ≥ n, rows to fill.
+            let want_c = (1..).find(|c: &u32| c * c >= n).unwrap();
+            assert_eq!((c, r), (want_c, n.div_ceil(want_c)), "{n}");
+            assert!(c * r >= n && c * (r - 1) < n, "{n}");
+        }
+        assert_eq!(view_grid(5), (3, 2));
+        assert_eq!(view_grid(9), (3, 3));
+    }
+
+    #[test]
+    fn lenticular_columns_run_from_the_rightmost_view() {
+        let got: Vec<u32> = (0..8).map(|x| lenticular_view(x, 4)).collect();
+        assert_eq!(got, [3, 2, 1, 0, 3, 2, 1, 0]);
+    }
 }

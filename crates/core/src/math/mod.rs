@@ -8,8 +8,8 @@ mod rig;
 pub mod stereo;
 
 pub use rig::{
-    Camera, CameraMode, EyeMatrices, ImageShift, Lighting, ResolvedRig, Separation, StereoRig,
-    Viewer, ZeroParallax, fit_zero_parallax,
+    Camera, CameraMode, EyeMatrices, ImageShift, Lighting, MAX_VIEWS, ResolvedRig, Separation,
+    StereoRig, Viewer, ZeroParallax, fit_zero_parallax,
 };
 
 use glam::{Mat4, Vec3, Vec4};

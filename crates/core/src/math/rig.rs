@@ -4,8 +4,8 @@ use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
 use super::stereo::{
-    auto_eye_separation, cyclopic_projection, eye_translation, frustum_asymmetry,
-    image_shift_translation, off_axis_frustum, toe_in_view, view_width_at,
+    auto_eye_separation, camera_frustum_asymmetry, camera_translation, cyclopic_projection,
+    image_shift_translation, off_axis_frustum, toe_in_camera_view, view_offset, view_width_at,
     zero_parallax_at_fraction,
 };
 use super::{frustum, look_at};
@@ -203,6 +203,11 @@ pub enum ZeroParallax {
 pub fn fit_zero_parallax(z_near: f32, z_far: f32, balance: f32) -> f32 {
     balance * 2.0 / (1.0 / z_near + 1.0 / z_far)
 }
+
+/// The most cameras [`StereoRig::views`] places on the baseline (`[multiview] views`): each is
+/// a full pass and an eye-sized image, and lenticular and multi-view panels use from 5 to about
+/// 50 views.
+pub const MAX_VIEWS: u32 = 64;
 
 /// The stereo rig: separation, fusion distance, camera mode, and the StereoGraphics guide's user factors.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -524,6 +529,29 @@ impl StereoRig {
         shift: Option<(ImageShift, u32)>,
     ) -> EyeMatrices {
         let half = 0.5 * r.eye_separation;
+        let mut viewport_shift = None;
+        if let (CameraMode::ImageShift, Some((s, width))) = (self.mode, shift) {
+            // The left image moves left by its share of the whole-pixel shift, the right one right.
+            let k = match eye {
+                Eye::Left => -(s.left as i32),
+                Eye::Right => s.right as i32,
+            };
+            viewport_shift = Some((k, width));
+        }
+        self.camera_at(camera, aspect, r, eye.sign() * half, viewport_shift)
+    }
+
+    /// The matrices of a camera at `x = offset` on the rig's baseline (the eyes at `∓d/2`),
+    /// its image moved `viewport_shift = (pixels, width)` when viewported (image-shift only).
+    fn camera_at(
+        &self,
+        camera: &Camera,
+        aspect: f32,
+        r: &ResolvedRig,
+        offset: f32,
+        viewport_shift: Option<(i32, u32)>,
+    ) -> EyeMatrices {
+        let half = 0.5 * r.eye_separation;
         let z0 = r.zero_parallax_distance;
         // The viewer's modelview (the camera's), and the rig's: centred between the eyes. With
         // the viewer at the left eye the rig's midpoint is d/2 to the camera's right.
@@ -537,27 +565,23 @@ impl StereoRig {
         let symmetric = [-w, w, -h, h, n, f];
         let (eye_view, fr) = match self.mode {
             CameraMode::OffAxis => {
-                let asymmetry = frustum_asymmetry(eye, half, self.user_balance, n, z0);
+                let asymmetry = camera_frustum_asymmetry(offset, self.user_balance, n, z0);
                 (
-                    eye_translation(eye, half) * mv,
+                    camera_translation(offset) * mv,
                     off_axis_frustum(w, h, n, f, asymmetry),
                 )
             }
             // Image-shift renders the parallel eyes; the shift comes after the projection.
             CameraMode::Parallel | CameraMode::ImageShift => {
-                (eye_translation(eye, half) * mv, symmetric)
+                (camera_translation(offset) * mv, symmetric)
             }
-            CameraMode::ToeIn => (toe_in_view(mv, eye, half, z0), symmetric),
+            CameraMode::ToeIn => (toe_in_camera_view(mv, offset, z0), symmetric),
         };
         let mut p = frustum(fr[0], fr[1], fr[2], fr[3], fr[4], fr[5]);
-        let mut viewport_shift = 0i32;
-        if let (CameraMode::ImageShift, Some((s, width))) = (self.mode, shift) {
-            // The left image moves left by its share of the whole-pixel shift, the right one right.
-            viewport_shift = match eye {
-                Eye::Left => -(s.left as i32),
-                Eye::Right => s.right as i32,
-            };
-            p = image_shift_translation(viewport_shift, width) * p;
+        let mut shift_pixels = 0i32;
+        if let Some((k, width)) = viewport_shift {
+            shift_pixels = k;
+            p = image_shift_translation(k, width) * p;
         }
         let (view, projection) = match self.lighting {
             Lighting::PerEye => (eye_view, p),
@@ -569,8 +593,75 @@ impl StereoRig {
             mvp: p * eye_view,
             eye_world: eye_view.inverse().transform_point3(Vec3::ZERO),
             frustum: fr,
-            viewport_shift,
+            viewport_shift: shift_pixels,
         }
+    }
+
+    /// `views` cameras evenly spaced along the rig's baseline, index 0 the leftmost: camera `i`
+    /// at [`view_offset`]`(i, views, d)`, adjacent cameras the rig's separation `d` apart, all
+    /// with the rig's zero-parallax plane (off-axis: each frustum sheared to meet it; toe-in:
+    /// each camera turned to the fusion point; parallel: symmetric, zero parallax at infinity).
+    /// Two views are the rig's left and right eyes, the same matrices as
+    /// [`StereoRig::eyes_for_image`] (for [`CameraMode::ImageShift`] too, whose whole-pixel
+    /// split is defined for two eyes only).
+    ///
+    /// # Errors
+    /// `views` outside 2..=[`MAX_VIEWS`]; more than two views of [`CameraMode::ImageShift`];
+    /// as [`StereoRig::eyes`].
+    pub fn views(
+        &self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        views: u32,
+    ) -> Result<Vec<EyeMatrices>> {
+        if !(2..=MAX_VIEWS).contains(&views) {
+            return Err(Error::invalid(
+                "multiview.views",
+                views,
+                format!("must be 2 to {MAX_VIEWS} cameras"),
+            ));
+        }
+        if self.mode == CameraMode::ImageShift {
+            // Its whole-pixel shift is split between two eyes: two views are those eyes.
+            if views == 2 {
+                return Ok(self.eyes_for_image(camera, width, height)?.to_vec());
+            }
+            return Err(Error::invalid(
+                "stereo.mode",
+                "\"image-shift\"",
+                format!(
+                    "splits its whole-pixel shift between two eyes only, so it renders \
+                     multiview.views = 2, not {views}; for more views use \"off-axis\", the \
+                     same geometry without the blank columns"
+                ),
+            ));
+        }
+        camera.validate()?;
+        let aspect = width as f32 / height as f32;
+        let r = self.resolve(camera, aspect)?;
+        let cameras: Vec<EyeMatrices> = (0..views)
+            .map(|i| {
+                let offset = view_offset(i, views, r.eye_separation);
+                self.camera_at(camera, aspect, &r, offset, None)
+            })
+            .collect();
+        if cameras
+            .iter()
+            .any(|e| !(e.view.is_finite() && e.projection.is_finite() && e.mvp.is_finite()))
+        {
+            return Err(Error::invalid(
+                "stereo.eye_separation",
+                r.eye_separation,
+                format!(
+                    "makes the outer multiview cameras' matrices non-finite in single \
+                     precision ({views} views span {} units); use fewer views or a smaller \
+                     separation",
+                    r.eye_separation * (views - 1) as f32
+                ),
+            ));
+        }
+        Ok(cameras)
     }
 
     /// The cyclopean (center) eye: the camera itself, symmetric frustum.

@@ -10,7 +10,19 @@
 use image::RgbaImage;
 
 use crate::render::Frame;
-use stereolab_core::{DrawBuffer, Error, FrameField, FrameSequentialSettings, Result};
+use stereolab_core::{
+    DrawBuffer, Error, FrameField, FrameSequentialSettings, Result, WiggleSettings,
+};
+
+/// The file a [`FrameSequence`] is written as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SequenceFile {
+    /// An animated PNG, lossless, each field's delay as the exact fraction it is.
+    Apng,
+    /// An animated GIF ([`super::wiggle`]): one palette of 256 colours for both eyes, delays in
+    /// 1/100 s.
+    Gif,
+}
 
 /// Both eyes and the order and durations they are shown in.
 #[derive(Clone, Debug, PartialEq)]
@@ -21,6 +33,34 @@ pub struct FrameSequence {
     pub right: RgbaImage,
     /// The fields in display order.
     pub fields: Vec<FrameField>,
+    /// The output's name, for messages.
+    pub name: &'static str,
+    /// The file written: APNG or GIF, looping forever either way.
+    pub file: SequenceFile,
+}
+
+/// `frame`'s two eye buffers with `fields`, written as `file`.
+fn eye_buffers(
+    frame: &Frame,
+    name: &'static str,
+    fields: Vec<FrameField>,
+    file: SequenceFile,
+) -> Result<FrameSequence> {
+    let buffer = |b: DrawBuffer| {
+        frame
+            .draw_buffer(b)
+            .map(|fb| fb.to_rgba_image())
+            .ok_or_else(|| {
+                Error::internal("plan", format!("{name}: {} was not rendered", b.gl_name()))
+            })
+    };
+    Ok(FrameSequence {
+        left: buffer(DrawBuffer::BackLeft)?,
+        right: buffer(DrawBuffer::BackRight)?,
+        fields,
+        name,
+        file,
+    })
 }
 
 impl FrameSequence {
@@ -29,22 +69,26 @@ impl FrameSequence {
     /// # Errors
     /// An eye was not rendered (a plan bug), or settings out of range.
     pub fn from_frame(frame: &Frame, settings: &FrameSequentialSettings) -> Result<FrameSequence> {
-        let buffer = |b: DrawBuffer| {
-            frame
-                .draw_buffer(b)
-                .map(|fb| fb.to_rgba_image())
-                .ok_or_else(|| {
-                    Error::internal(
-                        "plan",
-                        format!("frame_sequential: {} was not rendered", b.gl_name()),
-                    )
-                })
-        };
-        Ok(FrameSequence {
-            left: buffer(DrawBuffer::BackLeft)?,
-            right: buffer(DrawBuffer::BackRight)?,
-            fields: settings.fields()?,
-        })
+        eye_buffers(
+            frame,
+            "frame_sequential",
+            settings.fields()?,
+            SequenceFile::Apng,
+        )
+    }
+
+    /// The wiggle of `frame`'s two eyes under `settings` (StereoPhoto Maker's wiggle export:
+    /// two frames alternating forever), written as `file`; `name` is the output's.
+    ///
+    /// # Errors
+    /// An eye was not rendered (a plan bug), or `wiggle.frame_ms` out of range.
+    pub fn wiggle(
+        frame: &Frame,
+        settings: &WiggleSettings,
+        name: &'static str,
+        file: SequenceFile,
+    ) -> Result<FrameSequence> {
+        eye_buffers(frame, name, settings.fields()?, file)
     }
 
     /// The image shown in `field`.
@@ -55,8 +99,8 @@ impl FrameSequence {
         }
     }
 
-    /// The APNG file's bytes: one full-size frame per field, each with its delay, looping
-    /// forever.
+    /// The file's bytes ([`SequenceFile`]): one full-size frame per field, each with its delay,
+    /// looping forever.
     ///
     /// # Errors
     /// Different eye sizes, no fields, or an encoder error.
@@ -78,7 +122,7 @@ impl FrameSequence {
     ) -> Result<()> {
         if self.left.dimensions() != self.right.dimensions() {
             return Err(Error::invalid(
-                "frame_sequential",
+                self.name,
                 format!(
                     "{:?} and {:?}",
                     self.left.dimensions(),
@@ -90,9 +134,12 @@ impl FrameSequence {
         let n = u32::try_from(self.fields.len())
             .ok()
             .filter(|&n| n > 0)
-            .ok_or_else(|| Error::internal("frame_sequential", "no fields to write"))?;
+            .ok_or_else(|| Error::internal(self.name, "no fields to write"))?;
+        if self.file == SequenceFile::Gif {
+            return super::wiggle::encode_gif(self, out, progress);
+        }
         let png_err =
-            |e: png::EncodingError| Error::internal("frame_sequential APNG", e.to_string());
+            |e: png::EncodingError| Error::internal(format!("{} APNG", self.name), e.to_string());
         {
             let (w, h) = self.left.dimensions();
             let mut enc = png::Encoder::new(out, w, h);

@@ -7,6 +7,7 @@ pub mod report;
 pub mod shear_rotate;
 pub mod sirds;
 pub mod stereo_photo;
+pub mod wiggle;
 
 use std::path::{Path, PathBuf};
 
@@ -17,8 +18,9 @@ use stereo_photo::{PhotoFormat, RigMetadata, StereoPhoto};
 use stereolab_core::{
     AnaglyphKind, Error, Framebuffer, OutputSet, Precision, Result, above_below,
     above_below_squashed, anaglyph, calibration_screen, cancelled, check_output_path,
-    frame_packing, ghosted, half_above_below, half_side_by_side, interleave, occlusion_image,
-    parallax_image, rds_framebuffer, rds_left, rds_right, remap_color, side_by_side,
+    frame_packing, ghosted, half_above_below, half_side_by_side, interleave, lenticular_interleave,
+    occlusion_image, parallax_image, rds_framebuffer, rds_left, rds_right, remap_color,
+    side_by_side, view_tiles,
 };
 
 /// One finished output image.
@@ -32,7 +34,8 @@ pub enum Image {
     WindowDepth(image::ImageBuffer<image::Luma<u16>, Vec<u16>>),
     /// Both eyes in a stereo photo format (MPO, JPS, PNS), encoded when saved.
     Stereo(stereo_photo::StereoPhoto),
-    /// Both eyes alternating in time (`frame_sequential`), an animated PNG when saved.
+    /// Both eyes alternating in time (`frame_sequential`, `wiggle_apng`: an animated PNG when
+    /// saved; `wiggle_gif`: an animated GIF).
     Sequence(frame_sequential::FrameSequence),
 }
 
@@ -237,6 +240,22 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             scene.height,
             scene.blank_interval,
         )?),
+        Output::WiggleGif | Output::WiggleApng => {
+            let file = match output {
+                Output::WiggleGif => frame_sequential::SequenceFile::Gif,
+                _ => frame_sequential::SequenceFile::Apng,
+            };
+            Image::Sequence(frame_sequential::FrameSequence::wiggle(
+                frame,
+                &scene.wiggle,
+                output.name(),
+                file,
+            )?)
+        }
+        Output::ViewTiles(n) => Image::Rgba(view_tiles(&multiview(frame, output, n)?)?),
+        Output::ViewInterleaved(n) => {
+            Image::Rgba(lenticular_interleave(&multiview(frame, output, n)?)?)
+        }
         Output::Sirds => Image::Rgba(sirds::from_frame(frame, scene)?.to_rgba_image()),
         Output::SirdsDepth => Image::Gray16(sirds::scene_depth(frame, scene)?.0.to_image()),
         Output::ShearVsRotate => Image::Rgba(shear_rotate::shear_vs_rotate(frame)?.0),
@@ -255,6 +274,23 @@ pub fn produce(output: Output, frame: &Frame, scene: &Scene) -> Result<Image> {
             })
         }
     })
+}
+
+/// The `n` multiview cameras' framebuffers, index 0 the leftmost.
+fn multiview(frame: &Frame, output: Output, n: u8) -> Result<Vec<&Framebuffer>> {
+    if frame.views.multi.len() != usize::from(n) {
+        return Err(Error::internal(
+            "plan",
+            format!(
+                "{}: {n} views asked for, {} cameras placed (every multiview output carries                  the scene's multiview.views)",
+                output.name(),
+                frame.views.multi.len()
+            ),
+        ));
+    }
+    (0..n)
+        .map(|i| need(frame, View::Multi(i), output))
+        .collect()
 }
 
 /// The right image of the random-dot pair from the frame's two depth passes.

@@ -46,7 +46,7 @@ pub struct Frame {
 }
 
 /// The matrices of every view a frame renders, made once per frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ViewMatrices {
     /// The scene's rig: left and right eye, indexed by [`Eye::index`].
     pub eyes: [EyeMatrices; 2],
@@ -55,6 +55,10 @@ pub struct ViewMatrices {
     /// The [`View::ShearLeft`] … [`View::RotateRight`] passes' eyes, present when the plan runs
     /// them ([`shear_rotate_eyes`]).
     pub shear_rotate: Option<ShearRotate>,
+    /// The [`View::Multi`] cameras, index 0 the leftmost, when the plan runs them
+    /// ([`StereoRig::views`]: as many as the plan's highest multiview pass needs); empty
+    /// otherwise.
+    pub multi: Vec<EyeMatrices>,
 }
 
 /// The scene's rig as off-axis (the SGI course notes' shear) and as toe-in (rotate), each eye
@@ -82,12 +86,27 @@ impl ViewMatrices {
                 View::ShearLeft | View::ShearRight | View::RotateLeft | View::RotateRight
             )
         });
+        // The multiview cameras' count is the plan's: every multiview output carries the
+        // scene's `multiview.views`, and the plan runs that many passes.
+        let views = plan
+            .outputs
+            .iter()
+            .filter_map(|o| o.views())
+            .max()
+            .map(u32::from);
+        let multi = match views {
+            Some(n) => scene
+                .rig
+                .views(&scene.camera, scene.width, scene.height, n)?,
+            None => Vec::new(),
+        };
         Ok(ViewMatrices {
             eyes: scene
                 .rig
                 .eyes_for_image(&scene.camera, scene.width, scene.height)?,
             center: StereoRig::center(&scene.camera, scene.aspect())?,
             shear_rotate: needed.then(|| shear_rotate_eyes(scene)).transpose()?,
+            multi,
         })
     }
 
@@ -104,6 +123,7 @@ impl ViewMatrices {
             View::ShearRight => compare.map(|c| &c.shear[r]),
             View::RotateLeft => compare.map(|c| &c.rotate[l]),
             View::RotateRight => compare.map(|c| &c.rotate[r]),
+            View::Multi(i) => self.multi.get(usize::from(i)),
         }
     }
 

@@ -30,6 +30,47 @@ pub const ORIGIN_PRECISION_WARN: f64 = 1e-4;
 
 /// `[light]`: every factor finite and ≥ 0 (a NaN or negative factor turns objects black
 /// without an error anywhere else).
+/// `[multiview] views`: 2 to [`MAX_VIEWS`](stereolab_core::MAX_VIEWS) cameras (each one a
+/// full pass and an eye-sized image).
+pub(super) fn multiview_views(views: u32) -> Result<u8> {
+    let max = stereolab_core::MAX_VIEWS;
+    u8::try_from(views)
+        .ok()
+        .filter(|n| (2..=max).contains(&u32::from(*n)))
+        .ok_or_else(|| {
+            Error::invalid(
+                "multiview.views",
+                views,
+                format!(
+                    "must be 2 to {max} cameras (2 is the rig's own left/right pair; \
+                     lenticular sheets use about 4 to 12)"
+                ),
+            )
+        })
+}
+
+/// The `view_tiles` image of `views` views of a `width`×`height` image within the output
+/// bounds ([`MAX_OUTPUT_SIDE`](stereolab_core::MAX_OUTPUT_SIDE),
+/// [`MAX_OUTPUT_PIXELS`](stereolab_core::MAX_OUTPUT_PIXELS)).
+pub(super) fn check_view_tiles(views: u8, width: u32, height: u32) -> Result<()> {
+    let (columns, rows) = stereolab_core::view_grid(u32::from(views));
+    let (w, h) = (u64::from(columns * width), u64::from(rows * height));
+    let max_side = u64::from(stereolab_core::MAX_OUTPUT_SIDE);
+    if w > max_side || h > max_side || w * h > stereolab_core::MAX_OUTPUT_PIXELS {
+        return Err(Error::invalid(
+            "multiview.views",
+            views,
+            format!(
+                "tiles a {w}x{h} view_tiles image ({columns}x{rows} views of {width}x{height}), \
+                 over the output limit ({max_side} a side, {} pixels); use fewer views or a \
+                 smaller image",
+                stereolab_core::MAX_OUTPUT_PIXELS
+            ),
+        ));
+    }
+    Ok(())
+}
+
 pub(super) fn check_light(l: &LightSpec) -> Result<()> {
     for (name, v) in [
         ("light.ambient", l.ambient),

@@ -42,11 +42,34 @@ pub(crate) struct SceneFile {
     /// Frame-sequential animation options (`frame_sequential`).
     #[serde(default)]
     pub frame_sequential: stereolab_core::FrameSequentialSettings,
+    /// Wiggle animation options (`wiggle_gif`, `wiggle_apng`).
+    #[serde(default)]
+    pub wiggle: stereolab_core::WiggleSettings,
+    /// Multiview options (`view_tiles`, `view_interleaved`).
+    #[serde(default)]
+    pub multiview: MultiviewSpec,
     /// Objects, in `[[mesh]]` tables.
     #[serde(default, rename = "mesh")]
     pub meshes: Vec<MeshSpec>,
     /// Requested outputs by name.
     pub outputs: Vec<String>,
+}
+
+/// `[multiview]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct MultiviewSpec {
+    /// Cameras on the rig's baseline, 2 to `MAX_VIEWS`, adjacent ones the rig's separation
+    /// apart.
+    pub views: u32,
+}
+
+impl Default for MultiviewSpec {
+    fn default() -> Self {
+        MultiviewSpec {
+            views: u32::from(crate::plan::DEFAULT_VIEWS),
+        }
+    }
 }
 
 /// `[image]`.

@@ -78,6 +78,11 @@ pub struct Scene {
     pub ghosting: stereolab_core::GhostingSettings,
     /// Frame-sequential options (`[frame_sequential]`).
     pub frame_sequential: stereolab_core::FrameSequentialSettings,
+    /// Wiggle options (`[wiggle]`).
+    pub wiggle: stereolab_core::WiggleSettings,
+    /// Cameras on the rig's baseline for the multiview outputs (`[multiview] views`, 2 to
+    /// [`MAX_VIEWS`](stereolab_core::MAX_VIEWS)); the scene's multiview outputs carry it.
+    pub views: u8,
     /// What loading read in an unusual way and accepted, each naming its file and line (an
     /// OBJ coordinate such as `3.1+e2`, read as assimp reads it); `stereolab render` prints
     /// them.
@@ -258,11 +263,19 @@ impl Scene {
                 "leaves no rows for the two views",
             ));
         }
+        let views = checks::multiview_views(f.multiview.views)?;
         let outputs = f
             .outputs
             .iter()
-            .map(|o| Output::parse(o))
+            .map(|o| Output::parse(o).map(|o| o.with_views(views)))
             .collect::<Result<Vec<_>>>()?;
+        if outputs.contains(&Output::ViewTiles(views)) {
+            checks::check_view_tiles(views, f.image.width, f.image.height)?;
+        }
+        if outputs.iter().any(|o| o.views().is_some()) {
+            // Image-shift's refusal and the outer cameras' matrices, before anything renders.
+            rig.views(&f.camera, f.image.width, f.image.height, u32::from(views))?;
+        }
         if outputs.is_empty() {
             return Err(Error::invalid(
                 "outputs",
@@ -274,6 +287,7 @@ impl Scene {
         f.rds.validate()?;
         f.ghosting.validate()?;
         f.frame_sequential.validate()?;
+        f.wiggle.validate()?;
         let mut notes = Vec::new();
         let objects = f
             .meshes
@@ -328,6 +342,8 @@ impl Scene {
             rds: f.rds,
             ghosting: f.ghosting,
             frame_sequential: f.frame_sequential,
+            wiggle: f.wiggle,
+            views,
             notes,
         };
         let warnings = checks::precision_warnings(&scene)?;
@@ -357,6 +373,9 @@ impl Scene {
         self.width = width;
         self.height = height;
         self.rig.eyes_for_image(&self.camera, width, height)?;
+        if self.outputs.contains(&Output::ViewTiles(self.views)) {
+            checks::check_view_tiles(self.views, width, height)?;
+        }
         Ok(())
     }
 
