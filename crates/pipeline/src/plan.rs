@@ -3,15 +3,13 @@
 
 use std::fmt::Write as _;
 
-<<<<<<< HEAD
-use stereolab_core::{AnaglyphGlasses, AnaglyphKind, AnaglyphMethod, Error, Eye, Result};
-=======
-use stereolab_core::{AnaglyphKind, Error, Eye, MAX_VIEWS, Result};
+use stereolab_core::{
+    AnaglyphGlasses, AnaglyphKind, AnaglyphMethod, Error, Eye, MAX_VIEWS, Result,
+};
 
 /// The views a multiview output renders when the scene has no `[multiview]` section: the rig's
 /// own two eyes (Blender's default multi-view setup, "Stereo 3D", is the left/right pair).
 pub const DEFAULT_VIEWS: u8 = 2;
->>>>>>> views
 
 /// Everything a scene can ask `stereolab render` to write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
