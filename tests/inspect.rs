@@ -620,3 +620,53 @@ fn vertical_disparity_names_toe_in_misalignment_and_rotation() {
     assert!((fit.rotation.abs() - t.tan() * cx).abs() < 0.25, "{fit:?}");
     assert!(!text.contains("toe-in"), "{text}");
 }
+
+/// Animations read as their first two frames: the wiggle GIF and APNG, and the frame-sequential
+/// APNG, each as `stereolab render` writes it.
+#[test]
+fn animations_read_as_their_first_two_frames() {
+    let dir = out_dir("inspect_animations");
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let scene = asset("scenes/wiggle.toml");
+    run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        "outputs=[\"left\",\"right\",\"wiggle_gif\",\"wiggle_apng\",\"frame_sequential\"]",
+    ]);
+    let open = |name: &str| image::open(dir.join(name)).unwrap().to_rgba8();
+    let (left, right) = (open("left.png"), open("right.png"));
+    for (file, exact) in [
+        ("wiggle_apng.png", true),
+        ("frame_sequential.png", true),
+        ("wiggle_gif.gif", false),
+    ] {
+        let views = read(&[dir.join(file)], None).unwrap();
+        assert_eq!(views.layout, Layout::Animation, "{file}");
+        let (dl, dr) = (differ(&views.left, &left), differ(&views.right, &right));
+        if exact {
+            assert_eq!((dl.0, dr.0), (0, 0), "{file}");
+        } else {
+            // One 256-colour palette for both frames.
+            assert!(
+                dl.1 < 0.5 && dr.1 < 0.5 && dl.0 <= 12 && dr.0 <= 12,
+                "{file}: {dl:?} {dr:?}"
+            );
+        }
+    }
+    // A still PNG is no animation: the single view is refused as before.
+    let err = read(&[dir.join("left.png")], None).unwrap_err().to_string();
+    assert!(err.contains("no stereo layout found"), "{err}");
+}

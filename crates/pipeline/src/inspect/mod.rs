@@ -56,6 +56,9 @@ pub enum Layout {
     Jps,
     /// A PNG stereo file (`.pns`): right | left.
     Pns,
+    /// An animated GIF or PNG (a wiggle, a frame-sequential animation): its first two frames,
+    /// left then right.
+    Animation,
 }
 
 impl Layout {
@@ -97,6 +100,7 @@ impl Layout {
             Layout::Mpo => "mpo",
             Layout::Jps => "jps",
             Layout::Pns => "pns",
+            Layout::Animation => "animation",
         }
     }
 
@@ -213,6 +217,19 @@ fn read_one(path: &Path, layout: Option<Layout>) -> Result<Views> {
             evidence: format!("the .{} container", format.extension()),
         });
     }
+    if layout.is_none()
+        && let Some((left, right, frames)) = first_two_frames(path)?
+    {
+        return Ok(Views {
+            left,
+            right,
+            layout: Layout::Animation,
+            evidence: format!(
+                "an animation of {frames} frames: the first two, left first (a wiggle started \
+                 on the right reads as swapped eyes)"
+            ),
+        });
+    }
     let img = open(path)?;
     let (layout, evidence) = match layout {
         Some(Layout::Pair) => {
@@ -239,6 +256,70 @@ fn read_one(path: &Path, layout: Option<Layout>) -> Result<Views> {
         layout,
         evidence,
     })
+}
+
+/// The first two frames of an animated GIF or PNG and how many frames were read (at most 64),
+/// or `None` for a still picture. The size is checked against the largest output stereolab
+/// writes before a frame is decoded.
+fn first_two_frames(path: &Path) -> Result<Option<(RgbaImage, RgbaImage, usize)>> {
+    use image::AnimationDecoder;
+    use image::codecs::gif::GifDecoder;
+    use image::codecs::png::PngDecoder;
+    use std::io::BufReader;
+    let reader = || {
+        std::fs::File::open(path)
+            .map(BufReader::new)
+            .map_err(|e| Error::io(path, e))
+    };
+    let format = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| Error::io(path, e))?
+        .format();
+    let bad =
+        |e: image::ImageError| Error::parse(path, None, format!("cannot read the animation: {e}"));
+    let frames: Vec<image::Frame> = match format {
+        Some(image::ImageFormat::Gif) => {
+            let d = GifDecoder::new(reader()?).map_err(bad)?;
+            check_frame_size(path, image::ImageDecoder::dimensions(&d))?;
+            d.into_frames()
+                .take(64)
+                .collect::<std::result::Result<_, _>>()
+                .map_err(bad)?
+        }
+        Some(image::ImageFormat::Png) => {
+            let d = PngDecoder::new(reader()?).map_err(bad)?;
+            if !d.is_apng().map_err(bad)? {
+                return Ok(None);
+            }
+            check_frame_size(path, image::ImageDecoder::dimensions(&d))?;
+            d.apng()
+                .map_err(bad)?
+                .into_frames()
+                .take(64)
+                .collect::<std::result::Result<_, _>>()
+                .map_err(bad)?
+        }
+        _ => return Ok(None),
+    };
+    let n = frames.len();
+    let mut it = frames.into_iter().map(image::Frame::into_buffer);
+    Ok(match (it.next(), it.next()) {
+        (Some(a), Some(b)) if n >= 2 => Some((a, b, n)),
+        _ => None,
+    })
+}
+
+fn check_frame_size(path: &Path, (w, h): (u32, u32)) -> Result<()> {
+    use stereolab_core::{MAX_OUTPUT_PIXELS, MAX_OUTPUT_SIDE};
+    if w > MAX_OUTPUT_SIDE || h > MAX_OUTPUT_SIDE || u64::from(w) * u64::from(h) > MAX_OUTPUT_PIXELS
+    {
+        return Err(Error::parse(
+            path,
+            None,
+            format!("{w}×{h}: more than the largest picture stereolab reads"),
+        ));
+    }
+    Ok(())
 }
 
 fn open(path: &Path) -> Result<RgbaImage> {
@@ -340,7 +421,7 @@ pub fn split(img: &RgbaImage, layout: Layout) -> Result<(RgbaImage, RgbaImage)> 
         Layout::AnaglyphRedCyan => (channels(img, [1, 0, 0]), channels(img, [0, 1, 1])),
         Layout::AnaglyphGreenMagenta => (channels(img, [0, 1, 0]), channels(img, [1, 0, 1])),
         Layout::AnaglyphAmberBlue => (channels(img, [1, 1, 0]), channels(img, [0, 0, 1])),
-        Layout::Pair | Layout::Mpo => {
+        Layout::Pair | Layout::Mpo | Layout::Animation => {
             return Err(Error::invalid(
                 "--layout",
                 layout.name(),
