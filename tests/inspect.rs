@@ -670,3 +670,81 @@ fn animations_read_as_their_first_two_frames() {
     let err = read(&[dir.join("left.png")], None).unwrap_err().to_string();
     assert!(err.contains("no stereo layout found"), "{err}");
 }
+
+/// The random-dot scene with its near square moved onto the left edge is named as a window
+/// violation at the left edge, on about as many rows as the square covers there; the scene as
+/// shipped (the square inside the frame) has none. (Random dots: every surface has texture to
+/// match, where a shaded box's flat faces have none.)
+#[test]
+fn window_violations_are_found_at_the_edge_they_touch() {
+    use stereolab::inspect::{Views, describe, measure, window_violations};
+    use stereolab::plan::View;
+    use stereolab_core::parallax_map;
+    let views_of = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let scene = Scene::load(&asset("scenes/rds_planes.toml"), &sets).unwrap();
+        let outputs = [Output::RdsLeft, Output::RdsRight];
+        let frame = render(&scene, &Plan::new(&outputs)).unwrap();
+        let img = |o: Output| rgba(&produce(o, &frame, &scene).unwrap()).clone();
+        let exact = parallax_map(
+            frame.view(View::Left).unwrap(),
+            &scene.parallax_rig().unwrap(),
+        )
+        .unwrap();
+        // The rows whose edge pixel shows negative parallax, exactly.
+        let w = scene.width as usize;
+        let rows = (0..scene.height as usize)
+            .filter(|y| exact[y * w].is_some_and(|p| p < 0.0))
+            .count();
+        (
+            Views {
+                left: img(Output::RdsLeft),
+                right: img(Output::RdsRight),
+                layout: Layout::Pair,
+                evidence: String::new(),
+            },
+            rows,
+        )
+    };
+    let (views, exact_rows) = views_of(&["mesh.2.translate=[-1.7, 0.0, 1.5]"]);
+    let m = measure(&views).unwrap();
+    let (left, right) = window_violations(&m);
+    eprintln!(
+        "window violation: {} rows found at the left edge, {exact_rows} exactly; {} at the right",
+        left.len(),
+        right.len()
+    );
+    assert!(exact_rows > 20);
+    // The matcher blurs the square's top and bottom rows: within 15% of the exact count.
+    assert!(
+        left.len().abs_diff(exact_rows) * 100 <= 15 * exact_rows,
+        "{} against {exact_rows}",
+        left.len()
+    );
+    // A few stray matches at the right edge stay under the finding's one row in fifty.
+    assert!(right.len() * 50 < 240, "{right:?}");
+    let text = describe(&m);
+    assert!(!text.contains("right edge"), "{text}");
+    assert!(
+        text.contains("finding: window violation") && text.contains("left edge"),
+        "{text}"
+    );
+    // The square on the right edge instead.
+    let (views, _) = views_of(&["mesh.2.translate=[1.7, 0.0, 1.5]"]);
+    let m = measure(&views).unwrap();
+    let (left, right) = window_violations(&m);
+    eprintln!(
+        "square at the right edge: {} rows at the left edge, {} at the right",
+        left.len(),
+        right.len()
+    );
+    let text = describe(&m);
+    assert!(
+        text.contains("right edge") && !text.contains("left edge"),
+        "{text}"
+    );
+    let (views, exact_rows) = views_of(&[]);
+    assert_eq!(exact_rows, 0);
+    let text = describe(&measure(&views).unwrap());
+    assert!(!text.contains("window violation"), "{text}");
+}

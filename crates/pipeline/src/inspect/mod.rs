@@ -931,6 +931,52 @@ pub fn measure(views: &Views) -> Result<Measured> {
 /// best disparity is hardly better than another (a flat surface, a repeated pattern).
 pub const MIN_CONFIDENCE: f32 = 0.1;
 
+/// The rows where something in front of the screen meets the left or the right edge (the
+/// StereoGraphics guide's window violation), as `(left rows, right rows)`: per row, the
+/// first (last) matched pixel within [`window_margin`] columns of the edge has a parallax
+/// under −½ px. At the left edge a pixel with parallax −p has no match in the right view (it
+/// leaves it), so the margin there also reaches past the map's 1st percentile of negative
+/// parallax, where the nearest matched pixel stands for the edge. At the right edge negative
+/// parallax stays inside the other view, but positive parallax leaves it: the last columns
+/// (as many as the 99th percentile of positive parallax) hold only mismatches and are skipped.
+pub fn window_violations(m: &Measured) -> (Vec<u32>, Vec<u32>) {
+    let (w, h) = (m.map.width, m.map.height);
+    let mut negative: Vec<f32> = m.map.valid().filter(|d| *d < 0.0).collect();
+    negative.sort_by(f32::total_cmp);
+    let reach = negative
+        .get(negative.len() / 100)
+        .map_or(0, |d| (-d / m.scale as f32).ceil() as u32);
+    let mut positive: Vec<f32> = m.map.valid().filter(|d| *d > 0.0).collect();
+    positive.sort_by(f32::total_cmp);
+    let skip = positive
+        .get(positive.len() * 99 / 100)
+        .map_or(0, |d| (d / m.scale as f32).ceil() as u32);
+    let left_margin = (window_margin(w) + reach).min(w);
+    let right_end = w.saturating_sub(skip).max(1);
+    let right_start = right_end.saturating_sub(window_margin(w));
+    let d = |x: u32, y: u32| m.map.disparity[(y * w + x) as usize];
+    let mut out = (Vec::new(), Vec::new());
+    for y in 0..h {
+        let first = (0..left_margin).map(|x| d(x, y)).find(|v| !v.is_nan());
+        let last = (right_start..right_end)
+            .rev()
+            .map(|x| d(x, y))
+            .find(|v| !v.is_nan());
+        if first.is_some_and(|v| v < -0.5) {
+            out.0.push(y);
+        }
+        if last.is_some_and(|v| v < -0.5) {
+            out.1.push(y);
+        }
+    }
+    out
+}
+
+/// How far from the edge [`window_violations`] looks: 1/40 of the width, at least 4 columns.
+pub fn window_margin(width: u32) -> u32 {
+    (width / 40).max(4)
+}
+
 /// The StereoGraphics guide's comfortable parallax: ±3% of the width.
 pub const BUDGET_SHARE: f64 = 0.03;
 
@@ -962,6 +1008,18 @@ pub fn describe(m: &Measured) -> String {
     if hi - lo < 1.0 {
         s += "  finding: no visible depth: the parallax range is under 1 px; increase the \
               separation (or these are two copies of one view)\n";
+    }
+    let (left, right) = window_violations(m);
+    for (rows, edge) in [(&left, "left"), (&right, "right")] {
+        // One row in fifty: a few stray matches at the edge are no violation.
+        if rows.len() as u32 * 50 >= m.map.height.max(1) {
+            s += &format!(
+                "  finding: window violation: something in front of the screen meets the {edge} \
+                 edge on {} rows (marked in disparity.png); move the zero-parallax plane nearer \
+                 or keep near objects off the edges\n",
+                rows.len()
+            );
+        }
     }
     let budget = BUDGET_SHARE * f64::from(m.width);
     if lo < -budget || hi > budget {
@@ -1003,6 +1061,20 @@ pub fn disparity_image(m: &Measured) -> Result<RgbaImage> {
             }
         })
         .collect();
+    // The window violations: a band along each violating row from its edge, in the parallax
+    // output's violation colour.
+    let (left, right) = window_violations(m);
+    let band = window_margin(w).min(w);
+    // (A band of the fixed margin: the violation's own depth is in the map beside it.)
+    for (rows, from_left) in [(&left, true), (&right, false)] {
+        for &y in rows.iter() {
+            for k in 0..band {
+                let x = if from_left { k } else { w - 1 - k };
+                let i = 4 * (y * w + x) as usize;
+                bytes[i..i + 4].copy_from_slice(&stereolab_core::PARALLAX_VIOLATION_COLOR);
+            }
+        }
+    }
     bytes.extend_from_slice(legend.data());
     RgbaImage::from_raw(w, h + legend.height(), bytes)
         .ok_or_else(|| Error::internal("inspect", "map and legend size mismatch"))
