@@ -528,6 +528,11 @@ fn measured_parallax_lies_in_the_exact_range_and_copies_show_no_depth() {
         100.0 * m.matched
     );
     assert!(lo - 0.5 <= p5 && p95 <= hi + 0.5 && p5 < p50 && p50 < p95);
+    // Where the screen lies: the share of drawn pixels in front of it, exactly and measured.
+    let front = exact.iter().filter(|p| **p < 0.0).count() as f64 / exact.len() as f64;
+    let measured = stereolab::inspect::in_front_share(&m);
+    eprintln!("in front of the screen: exactly {front:.3}, measured {measured:.3}");
+    assert!((front - measured).abs() < 0.1, "{front} against {measured}");
     // Only the model is matched: the flat background has nothing to match.
     let drawn = exact.len() as f64 / f64::from(320 * 240);
     assert!(m.matched <= drawn + 0.02, "{} of {drawn}", m.matched);

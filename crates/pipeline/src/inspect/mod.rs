@@ -927,6 +927,19 @@ pub fn measure(views: &Views) -> Result<Measured> {
     })
 }
 
+/// The share of matched pixels in front of the zero-parallax plane (parallax below zero):
+/// where the screen lies in the scene's depth (0 when nothing matched).
+pub fn in_front_share(m: &Measured) -> f64 {
+    let (front, all) = m.map.valid().fold((0usize, 0usize), |(f, a), d| {
+        (f + usize::from(d < 0.0), a + 1)
+    });
+    if all == 0 {
+        0.0
+    } else {
+        front as f64 / all as f64
+    }
+}
+
 /// The least [`disparity::DisparityMap::confidence`] a match needs to count: below it the
 /// best disparity is hardly better than another (a flat surface, a repeated pattern).
 pub const MIN_CONFIDENCE: f32 = 0.1;
@@ -1004,6 +1017,11 @@ pub fn describe(m: &Measured) -> String {
          width), median {mid:.1} px; negative is in front of the screen\n",
         pct(lo),
         pct(hi)
+    );
+    s += &format!(
+        "  zero-parallax plane: {:.0}% of the matched pixels in front of it, {:.0}% behind\n",
+        100.0 * in_front_share(m),
+        100.0 * (1.0 - in_front_share(m))
     );
     if hi - lo < 1.0 {
         s += "  finding: no visible depth: the parallax range is under 1 px; increase the \
