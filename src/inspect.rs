@@ -20,6 +20,14 @@ pub struct InspectArgs {
     /// anaglyph_amber_blue.
     #[arg(long)]
     pub layout: Option<String>,
+    /// A scene whose rig the pair should have: its exact parallax is compared with the
+    /// measured one, and a disagreement named (swapped eyes, a shift, a wrong separation or
+    /// zero-parallax distance).
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// With --scene: override a scene field (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE", requires = "scene")]
+    pub sets: Vec<String>,
     /// Folder for the two views read back (`left.png`, `right.png`) and the disparity map
     /// with its legend (`disparity.png`).
     #[arg(long)]
@@ -54,6 +62,16 @@ pub fn run(args: InspectArgs) -> Result<()> {
     let samples = inspect::vertical_samples(&views, &measured);
     let fit = inspect::fit_vertical(&samples, w, h);
     out!("{}", inspect::describe_vertical(fit.as_ref(), w));
+    if let Some(path) = &args.scene {
+        let scene = super::load_scene(path, &args.sets, None)?;
+        let (reference, at_infinity) = inspect::reference_parallax(&scene, w, h)?;
+        match inspect::compare_reference(&measured, &reference, at_infinity) {
+            Some(r) => out!("{}", inspect::describe_reference(&r)),
+            None => outln!(
+                "  against the scene: fewer than 100 pixels both matched and drawn by the scene"
+            ),
+        }
+    }
     if let Some(dir) = &args.out {
         let paths = [
             dir.join("left.png"),

@@ -753,3 +753,98 @@ fn window_violations_are_found_at_the_edge_they_touch() {
     let text = describe(&measure(&views).unwrap());
     assert!(!text.contains("window violation"), "{text}");
 }
+
+/// `inspect PAIR --scene SCENE`: pairs rendered with a planted mistake, each compared with the
+/// right scene, are named by that mistake and by no other; the right pair agrees. (The
+/// random-dot scene: every surface has texture to match.)
+#[test]
+fn planted_mistakes_are_named_against_the_scene() {
+    use stereolab::inspect::{
+        Views, compare_reference, describe_reference, describe_vertical, fit_vertical, measure,
+        reference_parallax, vertical_samples,
+    };
+    let right_scene = Scene::load(&asset("scenes/rds_planes.toml"), &[]).unwrap();
+    let (w, h) = (right_scene.width, right_scene.height);
+    let (reference, at_infinity) = reference_parallax(&right_scene, w, h).unwrap();
+    let pair = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let scene = Scene::load(&asset("scenes/rds_planes.toml"), &sets).unwrap();
+        let outputs = [Output::RdsLeft, Output::RdsRight];
+        let frame = render(&scene, &Plan::new(&outputs)).unwrap();
+        let img = |o: Output| rgba(&produce(o, &frame, &scene).unwrap()).clone();
+        (img(Output::RdsLeft), img(Output::RdsRight))
+    };
+    let report = |left: RgbaImage, right: RgbaImage| {
+        let views = Views {
+            left,
+            right,
+            layout: Layout::Pair,
+            evidence: String::new(),
+        };
+        let m = measure(&views).unwrap();
+        let fit = compare_reference(&m, &reference, at_infinity).unwrap();
+        let vertical = fit_vertical(&vertical_samples(&views, &m), w, h);
+        (
+            fit,
+            describe_reference(&fit) + &describe_vertical(vertical.as_ref(), w),
+        )
+    };
+    let names = [
+        "eyes swapped",
+        "wrong eye separation",
+        "wrong zero-parallax distance",
+        "half a pixel",
+        "toe-in",
+    ];
+    let only = |text: &str, want: Option<&str>| {
+        for n in names {
+            assert_eq!(text.contains(n), Some(n) == want, "{want:?}: {text}");
+        }
+    };
+    let (left, right) = pair(&[]);
+    let (fit, text) = report(left.clone(), right.clone());
+    eprintln!("right pair: {fit:?}");
+    assert!(text.contains("agrees with the scene's rig"), "{text}");
+    only(&text, None);
+
+    let (_, text) = report(right.clone(), left.clone());
+    only(&text, Some("eyes swapped"));
+
+    let (l, r) = pair(&["stereo.eye_separation=0.375"]);
+    let (fit, text) = report(l, r);
+    only(&text, Some("wrong eye separation"));
+    assert!((fit.factors().0 - 1.5).abs() < 0.05, "{fit:?}");
+
+    let (l, r) = pair(&["stereo.zero_parallax=6.0"]);
+    let (fit, text) = report(l, r);
+    only(&text, Some("wrong zero-parallax distance"));
+    assert!((fit.factors().1 - 1.2).abs() < 0.05, "{fit:?}");
+
+    // The right view moved half a pixel left: each pixel the mean of itself and its right
+    // neighbour.
+    let half = RgbaImage::from_fn(w, h, |x, y| {
+        let (a, b) = (
+            right.get_pixel(x, y).0,
+            right.get_pixel((x + 1).min(w - 1), y).0,
+        );
+        image::Rgba(std::array::from_fn(|c| {
+            (u16::from(a[c]) + u16::from(b[c])).div_ceil(2) as u8
+        }))
+    });
+    let (fit, text) = report(left, half);
+    only(&text, Some("half a pixel"));
+    assert!((fit.offset + 0.5).abs() < 0.15, "{fit:?}");
+
+    // Toe-in is named by its keystone; the rig's horizontal parallax moves a little too
+    // (separation 0.94×), which is no other mistake's name.
+    let (l, r) = pair(&["stereo.mode=\"toe-in\""]);
+    let (_, text) = report(l, r);
+    assert!(text.contains("toe-in"), "{text}");
+    for n in [
+        "eyes swapped",
+        "half a pixel",
+        "wrong zero-parallax distance",
+    ] {
+        assert!(!text.contains(n), "{n}: {text}");
+    }
+}

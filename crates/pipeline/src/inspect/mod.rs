@@ -1351,3 +1351,165 @@ pub fn describe_vertical(fit: Option<&VerticalFit>, width: u32) -> String {
     }
     s
 }
+
+/// The measured parallax against a scene's exact parallax, pixel by pixel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceFit {
+    /// Pixels with both a match and an exact parallax.
+    pub pixels: usize,
+    /// Median |measured − reference| (px).
+    pub median: f64,
+    /// `measured ≈ slope · reference + offset`, by least squares with the pixels off by more
+    /// than 1.5 px from a first fit left out.
+    pub slope: f64,
+    /// See [`ReferenceFit::slope`] (px).
+    pub offset: f64,
+    /// The reference's parallax at infinity, `b·d·W/Xrange` (px).
+    pub at_infinity: f64,
+}
+
+impl ReferenceFit {
+    /// The separation and zero-parallax factors `(s, t)` that explain the fit. In pixels the
+    /// scene's parallax is `p = C·(b/z0 − 1/z)` (`W/Xrange` shrinks as `z0` grows), so a rig
+    /// with separation `s·d` and zero-parallax distance `t·z0` gives `s·p + s·A·(1/t − 1)`, `A`
+    /// the parallax at infinity: the slope is `s`, and `t = 1/(1 + offset/(s·A))`. A wrong
+    /// zero-parallax distance is a constant shift between the views.
+    pub fn factors(&self) -> (f64, f64) {
+        let s = self.slope;
+        let denominator = 1.0 + self.offset / (s * self.at_infinity);
+        (
+            s,
+            if denominator == 0.0 {
+                f64::INFINITY
+            } else {
+                1.0 / denominator
+            },
+        )
+    }
+}
+
+/// Least squares of `y ≈ a·x + b` over `pairs`; `None` when the x are all equal.
+fn line_fit(pairs: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let n = pairs.len() as f64;
+    let (sx, sy) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+    let (mx, my) = (sx / n, sy / n);
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    for (x, y) in pairs {
+        sxx += (x - mx) * (x - mx);
+        sxy += (x - mx) * (y - my);
+    }
+    (sxx > 1e-12 * n).then(|| {
+        let a = sxy / sxx;
+        (a, my - a * mx)
+    })
+}
+
+/// Compares the measured parallax with `reference` (the scene's exact parallax of each left
+/// pixel, `None` on the background; full size), whose parallax at infinity is `at_infinity` px.
+/// `None` under 100 pixels with both, or when the reference is flat (one depth).
+pub fn compare_reference(
+    m: &Measured,
+    reference: &[Option<f64>],
+    at_infinity: f64,
+) -> Option<ReferenceFit> {
+    let (w, h) = (m.width, m.map.height * m.scale);
+    let mut pairs = Vec::new();
+    for y in 0..m.map.height {
+        for x in 0..m.map.width {
+            let d = m.map.disparity[(y * m.map.width + x) as usize];
+            let (fx, fy) = (x * m.scale + m.scale / 2, y * m.scale + m.scale / 2);
+            if d.is_nan() || fx >= w || fy >= h {
+                continue;
+            }
+            if let Some(p) = reference.get((fy * w + fx) as usize).copied().flatten() {
+                pairs.push((p, f64::from(d)));
+            }
+        }
+    }
+    if pairs.len() < 100 {
+        return None;
+    }
+    let (a, b) = line_fit(&pairs)?;
+    let kept: Vec<(f64, f64)> = pairs
+        .iter()
+        .copied()
+        .filter(|(x, y)| (y - (a * x + b)).abs() <= 1.5)
+        .collect();
+    let (slope, offset) = if kept.len() >= 100 {
+        line_fit(&kept)?
+    } else {
+        (a, b)
+    };
+    let mut errors: Vec<f64> = pairs.iter().map(|(x, y)| (y - x).abs()).collect();
+    errors.sort_by(f64::total_cmp);
+    Some(ReferenceFit {
+        pixels: pairs.len(),
+        median: errors[errors.len() / 2],
+        slope,
+        offset,
+        at_infinity,
+    })
+}
+
+/// The report's lines about the pair against the scene: the agreement, and the mistake that
+/// explains a disagreement, by name: eyes swapped (the slope negative), a wrong separation
+/// (the slope more than 5% off 1), half a pixel's shift (0.35–0.65 px at a slope within 5% of
+/// 1: a pixel-centre convention), a wrong zero-parallax distance (a shift that makes it more
+/// than 5% off). Toe-in is named by the vertical disparity.
+pub fn describe_reference(fit: &ReferenceFit) -> String {
+    let mut s = format!(
+        "  against the scene: median |measured − reference| {:.2} px over {} px; measured ≈ \
+         {:.3} × reference {:+.2} px\n",
+        fit.median, fit.pixels, fit.slope, fit.offset
+    );
+    if fit.slope < 0.0 {
+        s += "  finding: eyes swapped: the parallax is the scene's turned around; swap the views \
+              (or the cameras)\n";
+        return s;
+    }
+    let (sep, zp) = fit.factors();
+    if (sep - 1.0).abs() > 0.05 {
+        s += &format!("  finding: wrong eye separation: the pair's is {sep:.2} × the scene's\n");
+    }
+    if (sep - 1.0).abs() <= 0.05 && (fit.offset.abs() - 0.5).abs() <= 0.15 {
+        s += &format!(
+            "  finding: the views are shifted half a pixel ({:+.2} px) against each other: a \
+             pixel-centre convention (corner against centre)\n",
+            fit.offset
+        );
+    } else if (zp - 1.0).abs() > 0.05 {
+        s += &format!(
+            "  finding: wrong zero-parallax distance: the pair's is {zp:.2} × the scene's (the \
+             views shifted {:+.2} px against each other)\n",
+            fit.offset
+        );
+    }
+    if !s.contains("finding") && fit.median <= 0.5 {
+        s += "  the pair agrees with the scene's rig\n";
+    }
+    s
+}
+
+/// The exact parallax of `scene`'s left eye at `width`×`height` (each pixel's, `None` on the
+/// background) and its parallax at infinity (px): the reference [`compare_reference`] takes.
+///
+/// # Errors
+/// The scene's rig or size is invalid, or its render fails.
+pub fn reference_parallax(
+    scene: &crate::scene::Scene,
+    width: u32,
+    height: u32,
+) -> Result<(Vec<Option<f64>>, f64)> {
+    use crate::plan::{Output, Plan, View};
+    let mut scene = scene.clone();
+    scene.set_size(width, height)?;
+    let frame = crate::render::render(&scene, &Plan::new(&[Output::LeftDepth]))?;
+    let left = frame
+        .view(View::Left)
+        .ok_or_else(|| Error::internal("inspect", "the left depth pass was not run"))?;
+    let rig = scene.parallax_rig()?;
+    let map = stereolab_core::parallax_map(left, &rig)?;
+    Ok((map, rig.eye_separation * rig.balance * rig.pixels_per_unit))
+}
