@@ -218,16 +218,15 @@ fn read_one(path: &Path, layout: Option<Layout>) -> Result<Views> {
         });
     }
     if layout.is_none()
-        && let Some((left, right, frames)) = first_two_frames(path)?
+        && let Some((left, right)) = first_two_frames(path)?
     {
         return Ok(Views {
             left,
             right,
             layout: Layout::Animation,
-            evidence: format!(
-                "an animation of {frames} frames: the first two, left first (a wiggle started \
-                 on the right reads as swapped eyes)"
-            ),
+            evidence: "an animation: its first two frames, left first (a wiggle started on the \
+                       right reads as swapped eyes)"
+                .into(),
         });
     }
     let img = open(path)?;
@@ -258,10 +257,10 @@ fn read_one(path: &Path, layout: Option<Layout>) -> Result<Views> {
     })
 }
 
-/// The first two frames of an animated GIF or PNG and how many frames were read (at most 64),
-/// or `None` for a still picture. The size is checked against the largest output stereolab
-/// writes before a frame is decoded.
-fn first_two_frames(path: &Path) -> Result<Option<(RgbaImage, RgbaImage, usize)>> {
+/// The first two frames of an animated GIF or PNG (no more are decoded), or `None` for a
+/// still picture. The size is checked against the largest output stereolab writes before a
+/// frame is decoded.
+fn first_two_frames(path: &Path) -> Result<Option<(RgbaImage, RgbaImage)>> {
     use image::AnimationDecoder;
     use image::codecs::gif::GifDecoder;
     use image::codecs::png::PngDecoder;
@@ -282,7 +281,7 @@ fn first_two_frames(path: &Path) -> Result<Option<(RgbaImage, RgbaImage, usize)>
             let d = GifDecoder::new(reader()?).map_err(bad)?;
             check_frame_size(path, image::ImageDecoder::dimensions(&d))?;
             d.into_frames()
-                .take(64)
+                .take(2)
                 .collect::<std::result::Result<_, _>>()
                 .map_err(bad)?
         }
@@ -295,16 +294,15 @@ fn first_two_frames(path: &Path) -> Result<Option<(RgbaImage, RgbaImage, usize)>
             d.apng()
                 .map_err(bad)?
                 .into_frames()
-                .take(64)
+                .take(2)
                 .collect::<std::result::Result<_, _>>()
                 .map_err(bad)?
         }
         _ => return Ok(None),
     };
-    let n = frames.len();
     let mut it = frames.into_iter().map(image::Frame::into_buffer);
     Ok(match (it.next(), it.next()) {
-        (Some(a), Some(b)) if n >= 2 => Some((a, b, n)),
+        (Some(a), Some(b)) => Some((a, b)),
         _ => None,
     })
 }
