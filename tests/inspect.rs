@@ -57,6 +57,55 @@ fn rgba(i: &Image) -> &RgbaImage {
     }
 }
 
+/// The random-dot scene (`rds_planes.toml` with `sets`: dots on every surface, so every
+/// surface has texture to match): its left and right images, gray (the green channel) as
+/// well, and the left eye's exact parallax per pixel.
+struct Rds {
+    left: RgbaImage,
+    right: RgbaImage,
+    exact: Vec<Option<f64>>,
+}
+
+impl Rds {
+    fn new(sets: &[&str]) -> Rds {
+        use stereolab::plan::View;
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let scene = Scene::load(&asset("scenes/rds_planes.toml"), &sets).unwrap();
+        let frame = render(&scene, &Plan::new(&[Output::RdsLeft, Output::RdsRight])).unwrap();
+        let img = |o: Output| rgba(&produce(o, &frame, &scene).unwrap()).clone();
+        let exact = stereolab_core::parallax_map(
+            frame.view(View::Left).unwrap(),
+            &scene.parallax_rig().unwrap(),
+        )
+        .unwrap();
+        Rds {
+            left: img(Output::RdsLeft),
+            right: img(Output::RdsRight),
+            exact,
+        }
+    }
+
+    fn gray(img: &RgbaImage) -> Vec<u8> {
+        img.pixels().map(|p| p.0[1]).collect()
+    }
+}
+
+/// [`Rds::new`]'s two images.
+fn rds_images(sets: &[&str]) -> (RgbaImage, RgbaImage) {
+    let rds = Rds::new(sets);
+    (rds.left, rds.right)
+}
+
+/// Two images as a left/right pair.
+fn pair(left: RgbaImage, right: RgbaImage) -> stereolab::inspect::Views {
+    stereolab::inspect::Views {
+        left,
+        right,
+        layout: Layout::Pair,
+        evidence: String::new(),
+    }
+}
+
 #[test]
 fn every_layout_stereolab_writes_is_detected_and_split_back() {
     // (output, the layout detection must find, views exact?)
@@ -350,24 +399,9 @@ fn the_command_reports_the_layout_and_writes_the_views() {
 #[test]
 fn sgm_finds_the_exact_parallax_of_a_random_dot_pair() {
     use stereolab::inspect::disparity::{SgmSettings, sgm};
-    use stereolab::plan::View;
-    use stereolab_core::parallax_map;
-    let scene = Scene::load(&asset("scenes/rds_planes.toml"), &[]).unwrap();
-    let outputs = [Output::RdsLeft, Output::RdsRight];
-    let frame = render(&scene, &Plan::new(&outputs)).unwrap();
-    let gray = |o: Output| -> Vec<u8> {
-        rgba(&produce(o, &frame, &scene).unwrap())
-            .pixels()
-            .map(|p| p.0[1])
-            .collect()
-    };
-    let (l, r) = (gray(Output::RdsLeft), gray(Output::RdsRight));
-    let exact = parallax_map(
-        frame.view(View::Left).unwrap(),
-        &scene.parallax_rig().unwrap(),
-    )
-    .unwrap();
-    let (w, h) = (scene.width, scene.height);
+    let rds = Rds::new(&[]);
+    let (l, r, exact) = (Rds::gray(&rds.left), Rds::gray(&rds.right), &rds.exact);
+    let (w, h) = rds.left.dimensions();
     let range = exact
         .iter()
         .flatten()
@@ -377,7 +411,7 @@ fn sgm_finds_the_exact_parallax_of_a_random_dot_pair() {
     let map = sgm(&l, &r, w, h, SgmSettings::symmetric(range)).unwrap();
     let mut errors: Vec<f64> = Vec::new();
     let mut visible = 0;
-    for (d, p) in map.disparity.iter().zip(&exact) {
+    for (d, p) in map.disparity.iter().zip(exact) {
         if let Some(p) = p {
             visible += 1;
             if !d.is_nan() {
@@ -422,26 +456,24 @@ fn python_with_opencv() -> Option<String> {
 #[test]
 fn sgm_agrees_with_opencvs_stereo_sgbm() {
     use stereolab::inspect::disparity::{SgmSettings, sgm};
-    use stereolab::plan::View;
-    use stereolab_core::parallax_map;
     let Some(python) = python_with_opencv() else {
         return;
     };
     let dir = out_dir("inspect_opencv");
-    let scene = Scene::load(&asset("scenes/rds_planes.toml"), &[]).unwrap();
-    let outputs = [Output::RdsLeft, Output::RdsRight];
-    let frame = render(&scene, &Plan::new(&outputs)).unwrap();
+    let rds = Rds::new(&[]);
     let (lp, rp) = (dir.join("left.png"), dir.join("right.png"));
-    let (li, ri) = (
-        produce(Output::RdsLeft, &frame, &scene).unwrap(),
-        produce(Output::RdsRight, &frame, &scene).unwrap(),
-    );
-    rgba(&li).save(&lp).unwrap();
-    rgba(&ri).save(&rp).unwrap();
-    let gray = |i: &Image| -> Vec<u8> { rgba(i).pixels().map(|p| p.0[1]).collect() };
+    rds.left.save(&lp).unwrap();
+    rds.right.save(&rp).unwrap();
     let range = 12;
-    let (w, h) = (scene.width, scene.height);
-    let ours = sgm(&gray(&li), &gray(&ri), w, h, SgmSettings::symmetric(range)).unwrap();
+    let (w, h) = rds.left.dimensions();
+    let ours = sgm(
+        &Rds::gray(&rds.left),
+        &Rds::gray(&rds.right),
+        w,
+        h,
+        SgmSettings::symmetric(range),
+    )
+    .unwrap();
     let out = dir.join("opencv.f32");
     let run = Command::new(&python)
         .arg(crate::common::root().join("tests/data/inspect/opencv_sgbm.py"))
@@ -461,18 +493,13 @@ fn sgm_agrees_with_opencvs_stereo_sgbm() {
         .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
         .collect();
     assert_eq!(theirs.len(), ours.disparity.len());
-    let exact = parallax_map(
-        frame.view(View::Left).unwrap(),
-        &scene.parallax_rig().unwrap(),
-    )
-    .unwrap();
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
     let mut both = Vec::new();
     let (mut ours_exact, mut theirs_exact) = (Vec::new(), Vec::new());
-    for ((a, b), p) in ours.disparity.iter().zip(&theirs).zip(&exact) {
+    for ((a, b), p) in ours.disparity.iter().zip(&theirs).zip(&rds.exact) {
         if !a.is_nan() && !b.is_nan() {
             both.push(f64::from((a - b).abs()));
             if let Some(p) = p {
@@ -550,28 +577,15 @@ fn measured_parallax_lies_in_the_exact_range_and_copies_show_no_depth() {
 /// right view 2 px lower, the right view rotated by 0.4°.
 #[test]
 fn vertical_disparity_names_toe_in_misalignment_and_rotation() {
-    use stereolab::inspect::{Views, describe_vertical, fit_vertical, measure, vertical_samples};
-    let pair = |sets: &[&str]| {
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        let scene = Scene::load(&asset("scenes/rds_planes.toml"), &sets).unwrap();
-        let outputs = [Output::RdsLeft, Output::RdsRight];
-        let frame = render(&scene, &Plan::new(&outputs)).unwrap();
-        let img = |o: Output| rgba(&produce(o, &frame, &scene).unwrap()).clone();
-        (img(Output::RdsLeft), img(Output::RdsRight))
-    };
+    use stereolab::inspect::{describe_vertical, fit_vertical, measure, vertical_samples};
     let findings = |left: RgbaImage, right: RgbaImage| {
         let (w, h) = left.dimensions();
-        let views = Views {
-            left,
-            right,
-            layout: Layout::Pair,
-            evidence: String::new(),
-        };
+        let views = pair(left, right);
         let m = measure(&views).unwrap();
         let fit = fit_vertical(&vertical_samples(&views, &m), w, h).unwrap();
         (fit, describe_vertical(Some(&fit), w))
     };
-    let (left, right) = pair(&[]);
+    let (left, right) = rds_images(&[]);
     let (w, h) = left.dimensions();
     let (fit, text) = findings(left.clone(), right.clone());
     assert!(!text.contains("finding"), "{text}");
@@ -582,7 +596,7 @@ fn vertical_disparity_names_toe_in_misalignment_and_rotation() {
 
     // Toe-in: the keystone at the corners is the rig's largest vertical parallax (`info`
     // prints 1.006% of the height for this scene: 2.41 px).
-    let (tl, tr) = pair(&["stereo.mode=\"toe-in\""]);
+    let (tl, tr) = rds_images(&["stereo.mode=\"toe-in\""]);
     let (fit, text) = findings(tl, tr);
     assert!(text.contains("finding: toe-in"), "{text}");
     assert!(
@@ -682,34 +696,15 @@ fn animations_read_as_their_first_two_frames() {
 /// match, where a shaded box's flat faces have none.)
 #[test]
 fn window_violations_are_found_at_the_edge_they_touch() {
-    use stereolab::inspect::{Views, describe, measure, window_violations};
-    use stereolab::plan::View;
-    use stereolab_core::parallax_map;
+    use stereolab::inspect::{describe, measure, window_violations};
     let views_of = |sets: &[&str]| {
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        let scene = Scene::load(&asset("scenes/rds_planes.toml"), &sets).unwrap();
-        let outputs = [Output::RdsLeft, Output::RdsRight];
-        let frame = render(&scene, &Plan::new(&outputs)).unwrap();
-        let img = |o: Output| rgba(&produce(o, &frame, &scene).unwrap()).clone();
-        let exact = parallax_map(
-            frame.view(View::Left).unwrap(),
-            &scene.parallax_rig().unwrap(),
-        )
-        .unwrap();
+        let rds = Rds::new(sets);
         // The rows whose edge pixel shows negative parallax, exactly.
-        let w = scene.width as usize;
-        let rows = (0..scene.height as usize)
-            .filter(|y| exact[y * w].is_some_and(|p| p < 0.0))
+        let w = rds.left.width() as usize;
+        let rows = (0..rds.left.height() as usize)
+            .filter(|y| rds.exact[y * w].is_some_and(|p| p < 0.0))
             .count();
-        (
-            Views {
-                left: img(Output::RdsLeft),
-                right: img(Output::RdsRight),
-                layout: Layout::Pair,
-                evidence: String::new(),
-            },
-            rows,
-        )
+        (pair(rds.left, rds.right), rows)
     };
     let (views, exact_rows) = views_of(&["mesh.2.translate=[-1.7, 0.0, 1.5]"]);
     let m = measure(&views).unwrap();
@@ -760,27 +755,14 @@ fn window_violations_are_found_at_the_edge_they_touch() {
 #[test]
 fn planted_mistakes_are_named_against_the_scene() {
     use stereolab::inspect::{
-        Views, compare_reference, describe_reference, describe_vertical, fit_vertical, measure,
+        compare_reference, describe_reference, describe_vertical, fit_vertical, measure,
         reference_parallax, vertical_samples,
     };
     let right_scene = Scene::load(&asset("scenes/rds_planes.toml"), &[]).unwrap();
     let (w, h) = (right_scene.width, right_scene.height);
     let (reference, at_infinity) = reference_parallax(&right_scene, w, h).unwrap();
-    let pair = |sets: &[&str]| {
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        let scene = Scene::load(&asset("scenes/rds_planes.toml"), &sets).unwrap();
-        let outputs = [Output::RdsLeft, Output::RdsRight];
-        let frame = render(&scene, &Plan::new(&outputs)).unwrap();
-        let img = |o: Output| rgba(&produce(o, &frame, &scene).unwrap()).clone();
-        (img(Output::RdsLeft), img(Output::RdsRight))
-    };
     let report = |left: RgbaImage, right: RgbaImage| {
-        let views = Views {
-            left,
-            right,
-            layout: Layout::Pair,
-            evidence: String::new(),
-        };
+        let views = pair(left, right);
         let m = measure(&views).unwrap();
         let fit = compare_reference(&m, &reference, at_infinity).unwrap();
         let vertical = fit_vertical(&vertical_samples(&views, &m), w, h);
@@ -801,7 +783,7 @@ fn planted_mistakes_are_named_against_the_scene() {
             assert_eq!(text.contains(n), Some(n) == want, "{want:?}: {text}");
         }
     };
-    let (left, right) = pair(&[]);
+    let (left, right) = rds_images(&[]);
     let (fit, text) = report(left.clone(), right.clone());
     eprintln!("right pair: {fit:?}");
     assert!(text.contains("agrees with the scene's rig"), "{text}");
@@ -810,12 +792,12 @@ fn planted_mistakes_are_named_against_the_scene() {
     let (_, text) = report(right.clone(), left.clone());
     only(&text, Some("eyes swapped"));
 
-    let (l, r) = pair(&["stereo.eye_separation=0.375"]);
+    let (l, r) = rds_images(&["stereo.eye_separation=0.375"]);
     let (fit, text) = report(l, r);
     only(&text, Some("wrong eye separation"));
     assert!((fit.factors().0 - 1.5).abs() < 0.05, "{fit:?}");
 
-    let (l, r) = pair(&["stereo.zero_parallax=6.0"]);
+    let (l, r) = rds_images(&["stereo.zero_parallax=6.0"]);
     let (fit, text) = report(l, r);
     only(&text, Some("wrong zero-parallax distance"));
     assert!((fit.factors().1 - 1.2).abs() < 0.05, "{fit:?}");
@@ -837,7 +819,7 @@ fn planted_mistakes_are_named_against_the_scene() {
 
     // Toe-in is named by its keystone; the rig's horizontal parallax moves a little too
     // (separation 0.94×), which is no other mistake's name.
-    let (l, r) = pair(&["stereo.mode=\"toe-in\""]);
+    let (l, r) = rds_images(&["stereo.mode=\"toe-in\""]);
     let (_, text) = report(l, r);
     assert!(text.contains("toe-in"), "{text}");
     for n in [

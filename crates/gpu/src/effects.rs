@@ -85,7 +85,7 @@ impl GpuFinalize {
         options: AnaglyphOptions,
     ) -> Result<RgbaImage> {
         check_same_size(left, right)?;
-        if options.anti_rivalry {
+        if !has_wgsl_anaglyph(options) {
             return Err(Error::invalid(
                 "finalize.anti_rivalry",
                 "true",
@@ -188,6 +188,12 @@ impl GpuFinalize {
     }
 }
 
+/// Whether anaglyph.wgsl mirrors the anaglyph with `options`: every kind and mode but
+/// Rendepth's gamma stage (`anti_rivalry`), which the CPU applies to the GPU's eyes instead.
+pub fn has_wgsl_anaglyph(options: AnaglyphOptions) -> bool {
+    !options.anti_rivalry
+}
+
 /// anaglyph.wgsl's parameters: the kind's ML and MR rows.
 pub(super) fn anaglyph_params(kind: AnaglyphKind) -> Vec<f32> {
     let m = kind.matrices();
@@ -240,7 +246,7 @@ pub fn produce_wgsl(
     let mvps = [&frame.views.eyes[0].mvp, &frame.views.eyes[1].mvp];
     Ok(Some(match output {
         // Rendepth's gamma stage has no WGSL mirror: the CPU mixes the GPU's eyes.
-        Output::Anaglyph(_) if scene.finalize.anti_rivalry => return Ok(None),
+        Output::Anaglyph(_) if !has_wgsl_anaglyph(scene.finalize) => return Ok(None),
         Output::Anaglyph(kind) => {
             fin.anaglyph(r, eye(View::Left)?, eye(View::Right)?, kind, scene.finalize)?
         }

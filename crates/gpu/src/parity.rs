@@ -82,7 +82,7 @@ pub fn compare_finalize(
     for &o in &frame.plan.outputs {
         let (cpu, gpu) = match o {
             // Rendepth's gamma stage has no WGSL mirror: the GPU path leaves it to the CPU.
-            Output::Anaglyph(_) if scene.finalize.anti_rivalry => continue,
+            Output::Anaglyph(_) if !crate::effects::has_wgsl_anaglyph(scene.finalize) => continue,
             Output::Anaglyph(kind) => (
                 anaglyph(left, right, kind, scene.finalize)?,
                 fin.anaglyph(r, left, right, kind, scene.finalize)?,

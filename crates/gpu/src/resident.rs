@@ -60,7 +60,7 @@ fn folds(scene: &Scene, plan: &Plan, passes: &[(EyeMatrices, Shading)]) -> bool 
             .iter()
             .all(|(m, shading)| *shading == Shading::Color && m.drawn_columns(scene.width) == full)
         && !scene.finalize.swap_eyes
-        && !scene.finalize.anti_rivalry
+        && crate::effects::has_wgsl_anaglyph(scene.finalize)
 }
 
 impl GpuRenderer {

@@ -264,6 +264,11 @@ pub struct EyeMatrices {
 }
 
 impl EyeMatrices {
+    /// Whether every matrix is finite (an overflowing rig gives NaN or infinite cameras).
+    pub fn is_finite(&self) -> bool {
+        self.view.is_finite() && self.projection.is_finite() && self.mvp.is_finite()
+    }
+
     /// The columns `x0..x1` of a `width`-pixel image that this eye draws: all of them, but for
     /// [`CameraMode::ImageShift`], whose shifted viewport leaves `|viewport_shift|` columns on
     /// one side blank (the right side of the left eye, the left side of the right eye).
@@ -500,10 +505,7 @@ impl StereoRig {
         ];
         // Every range check can pass and the matrices still overflow (toe-in's look-at squares
         // the eye offset): refuse them here, before anything renders with NaN cameras.
-        if eyes
-            .iter()
-            .any(|e| !(e.view.is_finite() && e.projection.is_finite() && e.mvp.is_finite()))
-        {
+        if eyes.iter().any(|e| !e.is_finite()) {
             return Err(Error::invalid(
                 "stereo.eye_separation",
                 r.eye_separation,
@@ -646,10 +648,7 @@ impl StereoRig {
                 self.camera_at(camera, aspect, &r, offset, None)
             })
             .collect();
-        if cameras
-            .iter()
-            .any(|e| !(e.view.is_finite() && e.projection.is_finite() && e.mvp.is_finite()))
-        {
+        if cameras.iter().any(|e| !e.is_finite()) {
             return Err(Error::invalid(
                 "stereo.eye_separation",
                 r.eye_separation,

@@ -14,6 +14,7 @@ pub mod disparity;
 
 use std::path::{Path, PathBuf};
 
+use glam::{DMat4, DVec4};
 use image::{Rgba, RgbaImage};
 use stereolab_core::{Error, Result, frame_packing_active_space};
 
@@ -542,10 +543,10 @@ fn ncc(a: &[f32], b: &[f32]) -> Option<f64> {
     (aa > 1e-9 * n && bb > 1e-9 * n).then(|| ab / (aa * bb).sqrt())
 }
 
-/// `img` box-filtered to at most `side` pixels on its longer side, as luma.
-fn small_luma(img: &RgbaImage, side: u32) -> (Vec<f32>, u32, u32) {
+/// The luma of `img` box-filtered by `f` (each output pixel the mean of an `f`×`f` block;
+/// the last partial blocks left out).
+fn box_luma(img: &RgbaImage, f: u32) -> (Vec<f32>, u32, u32) {
     let (w, h) = img.dimensions();
-    let f = w.max(h).div_ceil(side).max(1);
     let (sw, sh) = (w / f, h / f);
     let full = luma(img);
     let mut out = vec![0f32; (sw * sh) as usize];
@@ -557,6 +558,12 @@ fn small_luma(img: &RgbaImage, side: u32) -> (Vec<f32>, u32, u32) {
     let k = (f * f) as f32;
     out.iter_mut().for_each(|v| *v /= k);
     (out, sw, sh)
+}
+
+/// `img`'s luma box-filtered to at most `side` pixels on its longer side.
+fn small_luma(img: &RgbaImage, side: u32) -> (Vec<f32>, u32, u32) {
+    let (w, h) = img.dimensions();
+    box_luma(img, w.max(h).div_ceil(side).max(1))
 }
 
 /// How alike the two views of `layout` are, seen at 64 px: the correlation of their lumas.
@@ -841,24 +848,10 @@ pub fn row_shift(left: &RgbaImage, right: &RgbaImage) -> i32 {
         .0
 }
 
-/// The gray (Rec. 601 luma) of `img` box-filtered by `scale`.
+/// The gray (Rec. 601 luma, 8 bits) of `img` box-filtered by `scale`.
 fn gray_at(img: &RgbaImage, scale: u32) -> (Vec<u8>, u32, u32) {
-    let (w, h) = img.dimensions();
-    let (sw, sh) = (w / scale, h / scale);
-    let l = luma(img);
-    let mut out = Vec::with_capacity((sw * sh) as usize);
-    for y in 0..sh {
-        for x in 0..sw {
-            let mut s = 0f32;
-            for dy in 0..scale {
-                for dx in 0..scale {
-                    s += l[((y * scale + dy) * w + x * scale + dx) as usize];
-                }
-            }
-            out.push((s / (scale * scale) as f32).round() as u8);
-        }
-    }
-    (out, sw, sh)
+    let (l, sw, sh) = box_luma(img, scale);
+    (l.iter().map(|v| v.round() as u8).collect(), sw, sh)
 }
 
 /// Matches the two views: parallax searched over ±⅛ of the width (at least 8 px), at the
@@ -1232,7 +1225,7 @@ pub fn vertical_samples(views: &Views, m: &Measured) -> Vec<VerticalSample> {
 }
 
 /// The least-squares fit of [`VerticalFit`]'s model to `samples`: the normal equations
-/// `NᵀN c = Nᵀv` solved by inverting `NᵀN` (Gauss-Jordan), whose diagonal with the residual
+/// `NᵀN c = Nᵀv` solved by inverting `NᵀN` (glam's `DMat4`), whose diagonal with the residual
 /// variance gives each term's standard error; `None` under 12 samples or for a singular system
 /// (samples on a line).
 pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Option<VerticalFit> {
@@ -1242,54 +1235,29 @@ pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Opti
     let (cx, cy) = (f64::from(width) / 2.0, f64::from(height) / 2.0);
     let basis = |s: &VerticalSample| {
         let (x, y) = ((s.x - cx) / cx, (s.y - cy) / cy);
-        [1.0, x, y, x * y]
+        DVec4::new(1.0, x, y, x * y)
     };
-    // [NᵀN | I], reduced to [I | (NᵀN)⁻¹].
-    let mut a = [[0.0f64; 8]; 4];
-    let mut rhs = [0.0f64; 4];
-    let mut extent = [0.0f64; 4];
+    // NᵀN (symmetric: each sample's outer product) and Nᵀv.
+    let (mut normal, mut rhs, mut extent) = (DMat4::ZERO, DVec4::ZERO, DVec4::ZERO);
     for s in samples {
         let f = basis(s);
-        for i in 0..4 {
-            for j in 0..4 {
-                a[i][j] += f[i] * f[j];
-            }
-            rhs[i] += f[i] * s.v;
-            extent[i] = extent[i].max(f[i].abs());
-        }
+        normal += DMat4::from_cols(f * f.x, f * f.y, f * f.z, f * f.w);
+        rhs += f * s.v;
+        extent = extent.max(f.abs());
     }
-    for (i, row) in a.iter_mut().enumerate() {
-        row[4 + i] = 1.0;
+    // Samples on a line (or a point) leave NᵀN singular.
+    if normal.determinant().abs() < 1e-9 * normal.x_axis.x.powi(4) {
+        return None;
     }
-    for col in 0..4 {
-        let pivot = (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[pivot][col].abs() < 1e-9 {
-            return None;
-        }
-        a.swap(col, pivot);
-        let p = a[col][col];
-        a[col].iter_mut().for_each(|v| *v /= p);
-        let pivot_row = a[col];
-        for (row, r) in a.iter_mut().enumerate() {
-            if row != col {
-                let f = r[col];
-                for (v, p) in r.iter_mut().zip(&pivot_row) {
-                    *v -= f * p;
-                }
-            }
-        }
-    }
-    let coef: [f64; 4] = std::array::from_fn(|i| (0..4).map(|j| a[i][4 + j] * rhs[j]).sum());
+    let inverse = normal.inverse();
+    let coef = inverse * rhs;
     let rss: f64 = samples
         .iter()
-        .map(|s| {
-            let f = basis(s);
-            let model: f64 = (0..4).map(|i| coef[i] * f[i]).sum();
-            (s.v - model).powi(2)
-        })
+        .map(|s| (s.v - coef.dot(basis(s))).powi(2))
         .sum();
     let variance = rss / (samples.len() - 4) as f64;
-    let se: [f64; 4] = std::array::from_fn(|i| (variance * a[i][4 + i]).max(0.0).sqrt());
+    let se: [f64; 4] = std::array::from_fn(|i| (variance * inverse.col(i)[i]).max(0.0).sqrt());
+    let (coef, extent) = (coef.to_array(), extent.to_array());
     Some(VerticalFit {
         offset: coef[0],
         rotation: coef[1],
