@@ -38,3 +38,23 @@ pub fn names(dir: &Path) -> Vec<String> {
     n.sort();
     n
 }
+
+/// Runs netpbm's `pamstereogram` with `args` and writes what it prints to `out`; fails clearly
+/// when netpbm is missing.
+pub fn pamstereogram<S: AsRef<std::ffi::OsStr>>(args: &[S], out: &Path) {
+    let result = std::process::Command::new("pamstereogram")
+        .args(args)
+        .output();
+    let output = result.unwrap_or_else(|e| {
+        panic!("pamstereogram could not run ({e}): install Debian's netpbm (.ci/run does)")
+    });
+    assert!(
+        output.status.success(),
+        "pamstereogram {:?}: {}",
+        args.iter()
+            .map(|a| a.as_ref().to_string_lossy())
+            .collect::<Vec<_>>(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    std::fs::write(out, &output.stdout).expect("write stereogram");
+}

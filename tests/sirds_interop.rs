@@ -59,18 +59,11 @@ fn rgba(img: image::DynamicImage) -> (Vec<[u8; 4]>, u32, u32) {
     (img.pixels().map(|p| p.0).collect(), w, h)
 }
 
-/// Runs netpbm's `pamstereogram` with `args` on `depth`; fails clearly when netpbm is missing.
+/// Runs netpbm's `pamstereogram` with `args` on `depth` ([`common::pamstereogram`]).
 fn pamstereogram(depth: &Path, args: &[&str], out: &Path) {
-    let result = Command::new("pamstereogram").args(args).arg(depth).output();
-    let output = result.unwrap_or_else(|e| {
-        panic!("pamstereogram could not run ({e}): install Debian's netpbm (.ci/run does)")
-    });
-    assert!(
-        output.status.success(),
-        "pamstereogram {args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    std::fs::write(out, &output.stdout).expect("write stereogram");
+    let mut all: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
+    all.push(depth.as_os_str());
+    common::pamstereogram(&all, out);
 }
 
 /// A foreign stereogram decoded untold. `pamstereogram` (netpbm 10.x, its

@@ -3,7 +3,6 @@
 //! `pamstereogram` itself where it makes the same kind.
 
 use std::path::Path;
-use std::process::Command;
 
 use stereolab::fixtures::sphere_over_ramp;
 use stereolab::output::sirds::from_frame;
@@ -169,20 +168,6 @@ fn mapped_texture_decodes_to_its_depth() {
     assert!(shares[0] >= shares[1] - 0.05, "{report}");
 }
 
-/// Runs netpbm's `pamstereogram`; fails clearly when netpbm is missing.
-fn pamstereogram(args: &[&str], out: &Path) {
-    let result = Command::new("pamstereogram").args(args).output();
-    let output = result.unwrap_or_else(|e| {
-        panic!("pamstereogram could not run ({e}): install Debian's netpbm (.ci/run does)")
-    });
-    assert!(
-        output.status.success(),
-        "pamstereogram {args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    std::fs::write(out, &output.stdout).expect("write stereogram");
-}
-
 fn rgba_of(path: &Path) -> (Vec<[u8; 4]>, u32, u32) {
     let img = image::open(path)
         .expect("the image crate reads PAM")
@@ -216,7 +201,7 @@ fn pamstereograms_mapped_texture_decodes_with_stereolab() {
     std::fs::write(&map, pgm).expect("map");
     std::fs::write(&tex, ppm).expect("texture");
     let tex_arg = format!("-texfile={}", tex.display());
-    pamstereogram(
+    common::pamstereogram(
         &["-randomseed=1", &tex_arg, map.to_str().expect("utf-8")],
         &out,
     );
@@ -506,7 +491,7 @@ fn pamstereograms_planes_decode_to_far_minus_near_plus_one_levels() {
     pgm.extend((0..h).flat_map(|y| (0..w).map(move |_| y as u8)));
     let (map, out) = (dir.join("ramp.pgm"), dir.join("planes.pam"));
     std::fs::write(&map, pgm).expect("map");
-    pamstereogram(
+    common::pamstereogram(
         &[
             "-randomseed=1",
             "-planes=40,50",
@@ -566,7 +551,7 @@ fn guide_boxes_match_pamstereograms_band() {
     ] {
         let out = dir.join(format!("{flag}.pam"));
         let size_arg = format!("-guidesize={size}");
-        pamstereogram(
+        common::pamstereogram(
             &[
                 "-randomseed=1",
                 flag,
