@@ -886,12 +886,16 @@ pub fn measure(views: &Views) -> Result<Measured> {
     let (l, sw, sh) = gray_at(&views.left, scale);
     // The right view moved back by the whole rows it is shifted (edge rows repeated), so the
     // matcher compares the same rows.
-    let unshifted = RgbaImage::from_fn(w, h, |x, y| {
-        *views
-            .right
-            .get_pixel(x, (y as i32 + shift).clamp(0, h as i32 - 1) as u32)
-    });
-    let (r, ..) = gray_at(&unshifted, scale);
+    let (r, ..) = if shift == 0 {
+        gray_at(&views.right, scale)
+    } else {
+        let unshifted = RgbaImage::from_fn(w, h, |x, y| {
+            *views
+                .right
+                .get_pixel(x, (y as i32 + shift).clamp(0, h as i32 - 1) as u32)
+        });
+        gray_at(&unshifted, scale)
+    };
     let r_scaled = (range as u32).div_ceil(scale) as i32;
     let mut map = disparity::sgm(&l, &r, sw, sh, disparity::SgmSettings::symmetric(r_scaled))?;
     // Full-size pixels; a match no better than its rivals (flat, untextured areas) is none.
