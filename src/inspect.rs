@@ -28,17 +28,21 @@ pub struct InspectArgs {
     /// With --scene: override a scene field (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE", requires = "scene")]
     pub sets: Vec<String>,
+    /// Warnings (parallax past the guide's budget, window violations) fail the run too.
+    #[arg(long)]
+    pub strict: bool,
     /// Folder for the two views read back (`left.png`, `right.png`) and the disparity map
     /// with its legend (`disparity.png`).
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
 
-/// Runs `stereolab inspect`.
+/// Runs `stereolab inspect`: `Ok(false)` when a finding is an error (or, with `--strict`, a
+/// warning), so the exit status tells another project's CI.
 ///
 /// # Errors
 /// An unreadable picture, a layout that does not fit it, or none found.
-pub fn run(args: InspectArgs) -> Result<()> {
+pub fn run(args: InspectArgs) -> Result<bool> {
     let layout = args.layout.as_deref().map(Layout::parse).transpose()?;
     let views = inspect::read(&args.images, layout)?;
     let names: Vec<String> = args
@@ -59,14 +63,23 @@ pub fn run(args: InspectArgs) -> Result<()> {
     );
     let measured = inspect::measure(&views)?;
     out!("{}", inspect::describe(&measured));
+    let mut findings = inspect::findings(&measured);
     let samples = inspect::vertical_samples(&views, &measured);
     let fit = inspect::fit_vertical(&samples, w, h);
     out!("{}", inspect::describe_vertical(fit.as_ref(), w));
+    findings.extend(inspect::vertical_findings(fit.as_ref(), w));
+    let order = inspect::eyes::eye_order(&views, &measured);
+    out!("{}", order.describe());
+    out!("{}", inspect::findings::lines(&order.findings()));
+    findings.extend(order.findings());
     if let Some(path) = &args.scene {
         let scene = super::load_scene(path, &args.sets, None)?;
         let (reference, at_infinity) = inspect::reference_parallax(&scene, w, h)?;
         match inspect::compare_reference(&measured, &reference, at_infinity) {
-            Some(r) => out!("{}", inspect::describe_reference(&r)),
+            Some(r) => {
+                out!("{}", inspect::describe_reference(&r));
+                findings.extend(inspect::reference_findings(&r));
+            }
             None => outln!(
                 "  against the scene: fewer than 100 pixels both matched and drawn by the scene"
             ),
@@ -90,5 +103,7 @@ pub fn run(args: InspectArgs) -> Result<()> {
             outln!("  wrote {}", p.display());
         }
     }
-    Ok(())
+    let (verdict, passed) = inspect::findings::verdict(&findings, args.strict);
+    out!("{verdict}");
+    Ok(passed)
 }

@@ -247,7 +247,7 @@ fn is_closed_pipe(e: &Error) -> bool {
 }
 
 /// Runs the command; `Ok(false)` is a run that worked and says no (a grading verdict of NOT
-/// PASSED).
+/// PASSED, an inspected pair with an error among its findings).
 fn run(cli: Cli) -> Result<bool> {
     let done = match cli.command {
         Command::Grade(args) => return grade::run(args),
@@ -255,7 +255,7 @@ fn run(cli: Cli) -> Result<bool> {
         Command::Compare(args) => compare::run(args),
         Command::Exercises { command } => exercises::run(command),
         Command::Info(args) => info::run(args),
-        Command::Inspect(args) => inspect::run(args),
+        Command::Inspect(args) => return inspect::run(args),
         Command::Figures(args) => figures::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Sirds(args) => sirds::run(&args),

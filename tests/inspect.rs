@@ -830,3 +830,79 @@ fn planted_mistakes_are_named_against_the_scene() {
         assert!(!text.contains(n), "{n}: {text}");
     }
 }
+
+/// Pairs made by another program: `tests/data/inspect/threejs_pairs.py` ray casts a textured
+/// sphere and box before a textured wall in numpy through three.js's StereoCamera matrices,
+/// correct and with planted mistakes. The command names each mistake, exits 3 on an error and
+/// 0 on the correct pair (and on a warning alone, unless `--strict`). The eyes' order comes
+/// from the occlusions alone: no scene is given.
+#[test]
+fn pairs_made_outside_stereolab_are_named_by_their_mistakes() {
+    let Some(python) = python_with_opencv() else {
+        return;
+    };
+    let dir = out_dir("inspect_threejs");
+    let made = Command::new(&python)
+        .arg(crate::common::root().join("tests/data/inspect/threejs_pairs.py"))
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let inspect = |name: &str, extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+            .arg("inspect")
+            .arg(dir.join(format!("{name}_left.png")))
+            .arg(dir.join(format!("{name}_right.png")))
+            .args(extra)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        (out.status.code(), text)
+    };
+    let errors = [
+        "eyes swapped",
+        "toe-in",
+        "vertical misalignment",
+        "rotation between the views",
+        "one view is larger",
+        "no visible depth",
+    ];
+    let expect = |name: &str, want: Option<&str>| {
+        let (code, text) = inspect(name, &[]);
+        eprintln!("{name}:\n{text}");
+        for e in errors {
+            assert_eq!(
+                text.contains(&format!("finding: {e}")),
+                Some(e) == want,
+                "{name}, {e}: {text}"
+            );
+        }
+        assert_eq!(code, Some(if want.is_some() { 3 } else { 0 }), "{text}");
+        text
+    };
+    let text = expect("correct", None);
+    assert!(text.contains("eye order: left, then right"), "{text}");
+    assert!(text.contains("result: 0 errors, 0 warnings"), "{text}");
+    let text = expect("swapped", Some("eyes swapped"));
+    assert!(text.contains("eye order: swapped"), "{text}");
+    expect("toe_in", Some("toe-in"));
+    let text = expect("misaligned", Some("vertical misalignment"));
+    // A 0.4° pitch at 360 rows and a 50° field of view: 360/2 · tan 0.4° / tan 25° ≈ 2.7 px.
+    assert!(text.contains("the right view is 2.9 px lower"), "{text}");
+    let text = expect("rotated", Some("rotation between the views"));
+    assert!(text.contains("+0.37°") || text.contains("+0.36°"), "{text}");
+    expect("flat", Some("no visible depth"));
+    // A window violation is a warning: exit 0, and 3 with --strict.
+    let text = expect("window", None);
+    assert!(
+        text.contains("finding: window violation (warning)") && text.contains("left edge"),
+        "{text}"
+    );
+    let (code, text) = inspect("window", &["--strict"]);
+    assert_eq!(code, Some(3), "{text}");
+    assert!(text.contains("fails (--strict)"), "{text}");
+}

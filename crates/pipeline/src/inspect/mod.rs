@@ -11,6 +11,10 @@
 //! halves that show the same scene. A picture with none of these is refused, never guessed.
 
 pub mod disparity;
+pub mod eyes;
+pub mod findings;
+
+pub use findings::{Finding, Severity};
 
 use std::path::{Path, PathBuf};
 
@@ -989,7 +993,7 @@ pub fn window_margin(width: u32) -> u32 {
 pub const BUDGET_SHARE: f64 = 0.03;
 
 /// The report's lines about a measurement: coverage, the parallax range against the guide's
-/// budget, and whether there is depth to see at all.
+/// budget, and whether there is depth to see at all ([`findings`]).
 pub fn describe(m: &Measured) -> String {
     let mut s = format!(
         "  disparity: semi-global matching (census 5×5, 8 paths), {:.1}% of pixels matched \
@@ -1018,30 +1022,51 @@ pub fn describe(m: &Measured) -> String {
         100.0 * in_front_share(m),
         100.0 * (1.0 - in_front_share(m))
     );
+    s += &findings::lines(&findings(m));
+    s
+}
+
+/// The findings of a measurement: no visible depth (a parallax range under 1 px, an error: the
+/// pair shows no stereo effect), window violations and parallax beyond the StereoGraphics
+/// guide's ±3% (warnings: comfort guidelines).
+pub fn findings(m: &Measured) -> Vec<Finding> {
+    let mut out = Vec::new();
+    let Some([lo, _, hi]) = m.percentiles else {
+        return out;
+    };
     if hi - lo < 1.0 {
-        s += "  finding: no visible depth: the parallax range is under 1 px; increase the \
-              separation (or these are two copies of one view)\n";
+        out.push(Finding::error(
+            "no visible depth",
+            "the parallax range is under 1 px; increase the separation (or these are two \
+             copies of one view)",
+        ));
     }
     let (left, right) = window_violations(m);
     for (rows, edge) in [(&left, "left"), (&right, "right")] {
         // One row in fifty: a few stray matches at the edge are no violation.
         if rows.len() as u32 * 50 >= m.map.height.max(1) {
-            s += &format!(
-                "  finding: window violation: something in front of the screen meets the {edge} \
-                 edge on {} rows (marked in disparity.png); move the zero-parallax plane nearer \
-                 or keep near objects off the edges\n",
-                rows.len()
-            );
+            out.push(Finding::warning(
+                "window violation",
+                format!(
+                    "something in front of the screen meets the {edge} edge on {} rows \
+                     (marked in disparity.png); move the zero-parallax plane nearer or keep \
+                     near objects off the edges",
+                    rows.len()
+                ),
+            ));
         }
     }
     let budget = BUDGET_SHARE * f64::from(m.width);
     if lo < -budget || hi > budget {
-        s += &format!(
-            "  finding: parallax beyond the StereoGraphics guide's ±3% ({budget:.1} px): move \
-             the zero-parallax plane toward the scene's middle or reduce the separation\n"
-        );
+        out.push(Finding::warning(
+            "parallax beyond the StereoGraphics guide's ±3%",
+            format!(
+                "{lo:.1} to {hi:.1} px against ±{budget:.1} px; move the zero-parallax plane \
+                 toward the scene's middle or reduce the separation"
+            ),
+        ));
     }
-    s
+    out
 }
 
 /// The disparity map as a picture: stereolab's parallax colours (blue in front of the
@@ -1121,6 +1146,8 @@ pub struct VerticalFit {
     pub keystone: f64,
     /// The samples fitted.
     pub samples: usize,
+    /// The samples left out as outliers of a first fit ([`fit_vertical`]).
+    pub rejected: usize,
     /// Root-mean-square residual of the fit (px).
     pub rms: f64,
     /// Each term's standard error (offset, rotation, scale, keystone; px).
@@ -1173,6 +1200,7 @@ pub fn vertical_samples(views: &Views, m: &Measured) -> Vec<VerticalSample> {
                 let xr = x + d.round() as i32;
                 let yr = y + m.row_shift;
                 if hi_v - lo > 8.0
+                    && two_dimensional(&l, wi, x, y, R)
                     && xr - R > 0
                     && xr + R + 1 < wi
                     && yr - R - reach >= 0
@@ -1228,11 +1256,71 @@ pub fn vertical_samples(views: &Views, m: &Measured) -> Vec<VerticalSample> {
     out
 }
 
+/// Whether the block of radius `r` around `(x, y)` has texture in two directions, so that a
+/// vertical shift cannot pass for a horizontal one: the smaller eigenvalue of the gradient's
+/// structure tensor `Σ [gx², gx·gy; gx·gy, gy²]` (central differences) is at least a quarter
+/// of the larger (Shi and Tomasi, "Good Features to Track", CVPR 1994). A block on one
+/// straight edge (the aperture problem) fails.
+fn two_dimensional(img: &[f32], w: i32, x: i32, y: i32, r: i32) -> bool {
+    let at = |x: i32, y: i32| f64::from(img[(y * w + x) as usize]);
+    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+    for yy in y - r + 1..y + r {
+        for xx in x - r + 1..x + r {
+            let gx = (at(xx + 1, yy) - at(xx - 1, yy)) / 2.0;
+            let gy = (at(xx, yy + 1) - at(xx, yy - 1)) / 2.0;
+            a += gx * gx;
+            b += gx * gy;
+            c += gy * gy;
+        }
+    }
+    let (mean, root) = ((a + c) / 2.0, (((a - c) / 2.0).powi(2) + b * b).sqrt());
+    let (small, large) = (mean - root, mean + root);
+    large > 0.0 && small >= 0.25 * large
+}
+
+/// [`VerticalFit`]'s model fitted to `samples` twice: once to all, then to the samples within
+/// [`VERTICAL_OUTLIER`] px of the first fit (blocks matched on smooth shading or a repeated
+/// pattern land anywhere); `None` under 12 samples or for a singular system (samples on a
+/// line). [`VerticalFit::reliable`] says whether the second fit explains the blocks.
+pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Option<VerticalFit> {
+    let first = fit_once(samples, width, height)?;
+    let kept: Vec<VerticalSample> = samples
+        .iter()
+        .copied()
+        .filter(|s| (s.v - first.at(s, width, height)).abs() <= VERTICAL_OUTLIER)
+        .collect();
+    let mut fit = fit_once(&kept, width, height).unwrap_or(first);
+    fit.rejected = samples.len() - fit.samples;
+    Some(fit)
+}
+
+/// How far (px) a block may lie from the first fit and still count in the second.
+pub const VERTICAL_OUTLIER: f64 = 1.5;
+
+/// The most fit residual (px, root mean square) a reliable fit has: the correct and planted
+/// pairs of textured scenes fit within 0.3 px; smooth shading without texture leaves 0.6–4 px.
+pub const VERTICAL_MAX_RMS: f64 = 0.5;
+
+impl VerticalFit {
+    /// The fitted vertical disparity at a sample's place.
+    pub fn at(&self, s: &VerticalSample, width: u32, height: u32) -> f64 {
+        let (cx, cy) = (f64::from(width) / 2.0, f64::from(height) / 2.0);
+        let (x, y) = ((s.x - cx) / cx, (s.y - cy) / cy);
+        self.offset + self.rotation * x + self.scale * y + self.keystone * x * y
+    }
+
+    /// Whether the fit explains the blocks well enough for findings: at least 30 blocks kept,
+    /// at most one in five left out, and a residual within [`VERTICAL_MAX_RMS`].
+    pub fn reliable(&self) -> bool {
+        self.samples >= 30 && 4 * self.rejected <= self.samples && self.rms <= VERTICAL_MAX_RMS
+    }
+}
+
 /// The least-squares fit of [`VerticalFit`]'s model to `samples`: the normal equations
 /// `NᵀN c = Nᵀv` solved by inverting `NᵀN` (glam's `DMat4`), whose diagonal with the residual
 /// variance gives each term's standard error; `None` under 12 samples or for a singular system
 /// (samples on a line).
-pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Option<VerticalFit> {
+fn fit_once(samples: &[VerticalSample], width: u32, height: u32) -> Option<VerticalFit> {
     if samples.len() < 12 {
         return None;
     }
@@ -1268,6 +1356,7 @@ pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Opti
         scale: coef[2],
         keystone: coef[3],
         samples: samples.len(),
+        rejected: 0,
         rms: (rss / samples.len() as f64).sqrt(),
         standard_error: se,
         extent,
@@ -1278,48 +1367,74 @@ pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Opti
 /// pixel, about what the eyes stop fusing comfortably at small sizes.
 pub const VERTICAL_FINDING: f64 = 0.5;
 
-/// The report's lines about the vertical disparity and its findings.
+/// The report's lines about the vertical disparity and its findings ([`vertical_findings`]).
 pub fn describe_vertical(fit: Option<&VerticalFit>, width: u32) -> String {
     let Some(f) = fit else {
         return "  vertical disparity: too few textured blocks to measure\n".into();
     };
     let mut s = format!(
-        "  vertical disparity ({} blocks, fit residual {:.2} px): {:+.2} px at the centre, \
-         {:+.2} px at the right edge (rotation), {:+.2} px at the bottom edge (size), {:+.2} px \
-         at the bottom-right corner (keystone)\n",
-        f.samples, f.rms, f.offset, f.rotation, f.scale, f.keystone
+        "  vertical disparity ({} blocks, {} left out, fit residual {:.2} px): {:+.2} px at the \
+         centre, {:+.2} px at the right edge (rotation), {:+.2} px at the bottom edge (size), \
+         {:+.2} px at the bottom-right corner (keystone)\n",
+        f.samples, f.rejected, f.rms, f.offset, f.rotation, f.scale, f.keystone
     );
+    if !f.reliable() {
+        s += "  vertical disparity unreliable (under 30 blocks kept, over one in five left out, \
+              or a residual over 0.5 px: too little texture to match): no finding from it\n";
+    }
+    s += &findings::lines(&vertical_findings(fit, width));
+    s
+}
+
+/// The findings of the vertical disparity's fit, all errors: toe-in (the keystone), a
+/// vertical misalignment (the offset), a rotation, one view larger (the size term); none
+/// without a fit.
+pub fn vertical_findings(fit: Option<&VerticalFit>, width: u32) -> Vec<Finding> {
+    let mut out = Vec::new();
+    let Some(f) = fit.filter(|f| f.reliable()) else {
+        return out;
+    };
     if f.significant(3) {
-        s += &format!(
-            "  finding: toe-in: vertical disparity grows toward the corners in the keystone \
-             pattern, up to {:.1} px; render with parallel axes and sheared frusta (off-axis)\n",
-            f.keystone.abs()
-        );
+        out.push(Finding::error(
+            "toe-in",
+            format!(
+                "vertical disparity grows toward the corners in the keystone pattern, up to \
+                 {:.1} px; render with parallel axes and sheared frusta (off-axis)",
+                f.keystone.abs()
+            ),
+        ));
     }
     if f.significant(0) {
-        s += &format!(
-            "  finding: vertical misalignment: the right view is {:.1} px {} than the left; \
-             shift it back\n",
-            f.offset.abs(),
-            if f.offset > 0.0 { "lower" } else { "higher" }
-        );
+        out.push(Finding::error(
+            "vertical misalignment",
+            format!(
+                "the right view is {:.1} px {} than the left; shift it back",
+                f.offset.abs(),
+                if f.offset > 0.0 { "lower" } else { "higher" }
+            ),
+        ));
     }
     if f.significant(1) {
         let degrees = (f.rotation / (f64::from(width) / 2.0)).atan().to_degrees();
-        s += &format!(
-            "  finding: rotation between the views: {degrees:+.2}° (±{:.1} px at the edges); \
-             level the cameras or rotate one view back\n",
-            f.rotation.abs()
-        );
+        out.push(Finding::error(
+            "rotation between the views",
+            format!(
+                "{degrees:+.2}° (±{:.1} px at the edges); level the cameras or rotate one view \
+                 back",
+                f.rotation.abs()
+            ),
+        ));
     }
     if f.significant(2) {
-        s += &format!(
-            "  finding: one view is larger: ±{:.1} px at the top and bottom; match the cameras' \
-             fields of view\n",
-            f.scale.abs()
-        );
+        out.push(Finding::error(
+            "one view is larger",
+            format!(
+                "±{:.1} px at the top and bottom; match the cameras' fields of view",
+                f.scale.abs()
+            ),
+        ));
     }
-    s
+    out
 }
 
 /// The measured parallax against a scene's exact parallax, pixel by pixel.
@@ -1424,42 +1539,61 @@ pub fn compare_reference(
 }
 
 /// The report's lines about the pair against the scene: the agreement, and the mistake that
-/// explains a disagreement, by name: eyes swapped (the slope negative), a wrong separation
-/// (the slope more than 5% off 1), half a pixel's shift (0.35–0.65 px at a slope within 5% of
-/// 1: a pixel-centre convention), a wrong zero-parallax distance (a shift that makes it more
-/// than 5% off). Toe-in is named by the vertical disparity.
+/// explains a disagreement ([`reference_findings`]).
 pub fn describe_reference(fit: &ReferenceFit) -> String {
     let mut s = format!(
         "  against the scene: median |measured − reference| {:.2} px over {} px; measured ≈ \
          {:.3} × reference {:+.2} px\n",
         fit.median, fit.pixels, fit.slope, fit.offset
     );
-    if fit.slope < 0.0 {
-        s += "  finding: eyes swapped: the parallax is the scene's turned around; swap the views \
-              (or the cameras)\n";
-        return s;
-    }
-    let (sep, zp) = fit.factors();
-    if (sep - 1.0).abs() > 0.05 {
-        s += &format!("  finding: wrong eye separation: the pair's is {sep:.2} × the scene's\n");
-    }
-    if (sep - 1.0).abs() <= 0.05 && (fit.offset.abs() - 0.5).abs() <= 0.15 {
-        s += &format!(
-            "  finding: the views are shifted half a pixel ({:+.2} px) against each other: a \
-             pixel-centre convention (corner against centre)\n",
-            fit.offset
-        );
-    } else if (zp - 1.0).abs() > 0.05 {
-        s += &format!(
-            "  finding: wrong zero-parallax distance: the pair's is {zp:.2} × the scene's (the \
-             views shifted {:+.2} px against each other)\n",
-            fit.offset
-        );
-    }
-    if !s.contains("finding") && fit.median <= 0.5 {
+    let found = reference_findings(fit);
+    s += &findings::lines(&found);
+    if found.is_empty() && fit.median <= 0.5 {
         s += "  the pair agrees with the scene's rig\n";
     }
     s
+}
+
+/// The mistake that explains the pair's disagreement with the scene, by name (all errors):
+/// eyes swapped (the slope negative), a wrong separation (the slope more than 5% off 1), half
+/// a pixel's shift (0.35–0.65 px at a slope within 5% of 1: a pixel-centre convention), a wrong
+/// zero-parallax distance (a shift that makes it more than 5% off). Toe-in is named by the
+/// vertical disparity.
+pub fn reference_findings(fit: &ReferenceFit) -> Vec<Finding> {
+    if fit.slope < 0.0 {
+        return vec![Finding::error(
+            "eyes swapped",
+            "the parallax is the scene's turned around; swap the views (or the cameras)",
+        )];
+    }
+    let mut out = Vec::new();
+    let (sep, zp) = fit.factors();
+    if (sep - 1.0).abs() > 0.05 {
+        out.push(Finding::error(
+            "wrong eye separation",
+            format!("the pair's is {sep:.2} × the scene's"),
+        ));
+    }
+    if (sep - 1.0).abs() <= 0.05 && (fit.offset.abs() - 0.5).abs() <= 0.15 {
+        out.push(Finding::error(
+            "half a pixel's shift",
+            format!(
+                "the views are shifted half a pixel ({:+.2} px) against each other: a \
+                 pixel-centre convention (corner against centre)",
+                fit.offset
+            ),
+        ));
+    } else if (zp - 1.0).abs() > 0.05 {
+        out.push(Finding::error(
+            "wrong zero-parallax distance",
+            format!(
+                "the pair's is {zp:.2} × the scene's (the views shifted {:+.2} px against each \
+                 other)",
+                fit.offset
+            ),
+        ));
+    }
+    out
 }
 
 /// The exact parallax of `scene`'s left eye at `width`×`height` (each pixel's, `None` on the
