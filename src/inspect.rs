@@ -68,6 +68,13 @@ pub fn run(args: InspectArgs) -> Result<bool> {
     let fit = inspect::fit_vertical(&samples, w, h);
     out!("{}", inspect::describe_vertical(fit.as_ref(), w));
     findings.extend(inspect::vertical_findings(fit.as_ref(), w));
+    if views.layout.gray_views()
+        && let [picture] = args.images.as_slice()
+    {
+        let img = inspect::open(picture)?;
+        let estimate = inspect::anaglyph::estimate(&img, views.layout, inspect::reach(&measured));
+        out!("{}", estimate.describe());
+    }
     let order = inspect::eyes::eye_order(&views, &measured);
     out!("{}", order.describe());
     out!("{}", inspect::findings::lines(&order.findings()));

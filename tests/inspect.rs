@@ -906,3 +906,57 @@ fn pairs_made_outside_stereolab_are_named_by_their_mistakes() {
     assert_eq!(code, Some(3), "{text}");
     assert!(text.contains("fails (--strict)"), "{text}");
 }
+
+/// The anaglyph method estimated from the channels of a picture whose views are unknown: on the
+/// TV-formats scene (coloured spheres on gray), each of stereolab's anaglyphs is either named
+/// most likely (the gray, true and optimized methods, whose colours span a line or a plane) or
+/// is among the methods that produce its colours, and the narrow methods are never claimed for
+/// a full-colour anaglyph.
+#[test]
+fn the_anaglyph_method_is_estimated_from_the_channels() {
+    use stereolab::inspect::anaglyph::estimate;
+    let mut scene = Scene::load(&asset("scenes/tv_formats.toml"), &[]).unwrap();
+    scene.set_size(640, 360).unwrap();
+    let kinds = stereolab_core::AnaglyphKind::ALL;
+    let outputs: Vec<Output> = kinds
+        .iter()
+        .map(|k| Output::parse(k.output_name()).unwrap())
+        .collect();
+    let frame = render(&scene, &Plan::new(&outputs)).unwrap();
+    for (kind, output) in kinds.iter().zip(&outputs) {
+        let img = rgba(&produce(*output, &frame, &scene).unwrap()).clone();
+        let name = kind.output_name();
+        let layout = match name {
+            "anaglyph_green_magenta" => Layout::AnaglyphGreenMagenta,
+            "anaglyph_amber_blue" => Layout::AnaglyphAmberBlue,
+            _ => Layout::AnaglyphRedCyan,
+        };
+        let e = estimate(&img, layout, 24);
+        let text = e.describe();
+        eprintln!("{name}: {text}");
+        let explaining: Vec<String> = e.explaining().iter().map(|f| f.name()).collect();
+        if text.contains("too few uniform areas") {
+            continue;
+        }
+        assert!(explaining.contains(&name.to_string()), "{name}: {text}");
+        let narrow = ["anaglyph_true", "anaglyph_gray", "anaglyph_optimized"];
+        if narrow.contains(&name) {
+            assert!(
+                text.contains(&format!("most likely {name}")),
+                "{name}: {text}"
+            );
+        } else {
+            assert!(!text.contains("most likely"), "{name}: {text}");
+        }
+    }
+    // The gray anaglyph's colours (green equals blue) rule out the colour-keeping methods'
+    // narrow cousins: the true anaglyph (green 0) cannot produce them.
+    let gray = rgba(&produce(outputs[1], &frame, &scene).unwrap()).clone();
+    let e = estimate(&gray, Layout::AnaglyphRedCyan, 24);
+    let true_fit = e
+        .fits
+        .iter()
+        .find(|f| f.kind == stereolab_core::AnaglyphKind::True && !f.linear_light)
+        .unwrap();
+    assert!(true_fit.explained < 0.5, "{true_fit:?}");
+}

@@ -10,6 +10,7 @@
 //! different places in different channels, the comb of interleaved rows or columns; then two
 //! halves that show the same scene. A picture with none of these is refused, never guessed.
 
+pub mod anaglyph;
 pub mod disparity;
 pub mod eyes;
 pub mod findings;
@@ -325,7 +326,11 @@ fn check_frame_size(path: &Path, (w, h): (u32, u32)) -> Result<()> {
     Ok(())
 }
 
-fn open(path: &Path) -> Result<RgbaImage> {
+/// A picture read as RGBA 8-bit.
+///
+/// # Errors
+/// An unreadable or undecodable file, named.
+pub fn open(path: &Path) -> Result<RgbaImage> {
     Ok(stereolab_core::open_output_image(path, "stereo picture")?.to_rgba8())
 }
 
@@ -923,6 +928,14 @@ pub fn measure(views: &Views) -> Result<Measured> {
         matched,
         percentiles,
         width: w,
+    })
+}
+
+/// The largest parallax to expect (px): the larger of the 5th and 95th percentiles'
+/// magnitudes plus 2, or the whole search range when nothing matched.
+pub fn reach(m: &Measured) -> u32 {
+    m.percentiles.map_or(m.range.unsigned_abs(), |[lo, _, hi]| {
+        (lo.abs().max(hi.abs()) + 2.0).ceil() as u32
     })
 }
 
