@@ -32,6 +32,11 @@ pub struct InspectArgs {
     /// with its legend (`disparity.png`).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Then open the viewer on the pair (`stereolab view --images`): anaglyphs, side by side,
+    /// the disparity map, the image shift.
+    #[cfg(feature = "viewer")]
+    #[arg(long)]
+    pub view: bool,
 }
 
 /// Runs `stereolab inspect`.
@@ -89,6 +94,10 @@ pub fn run(args: InspectArgs) -> Result<()> {
         for p in set.commit()? {
             outln!("  wrote {}", p.display());
         }
+    }
+    #[cfg(feature = "viewer")]
+    if args.view {
+        return super::view::view_inspected(views, &args.images, measured);
     }
     Ok(())
 }
