@@ -44,7 +44,7 @@ use stereolab_core::{Error, Result};
 #[derive(Clone, Debug, Default)]
 pub struct ViewOptions {
     /// Where the screenshot key writes (`None`: beside the scene file, so the TOML's relative
-    /// model paths still hold).
+    /// model paths still hold; for a pair, beside its first image).
     pub shots: Option<PathBuf>,
     /// A JSON file rewritten with the readouts after every frame shown (for scripts and tests).
     pub state_file: Option<PathBuf>,

@@ -283,7 +283,7 @@ mod tests {
                 >> 24) as u8;
             Rgba([v, 255 - v, v / 2, 255])
         };
-        let left = RgbaImage::from_fn(w, h, |x, y| band(x, y));
+        let left = RgbaImage::from_fn(w, h, band);
         let right = RgbaImage::from_fn(w, h, |x, y| {
             if x >= parallax {
                 band(x - parallax, y)
