@@ -215,7 +215,9 @@ impl PairApp {
         // Every press counts, also several within one frame.
         let presses = |k: Key| ctx.input(|i| i.num_presses(k)) as i32;
         let step = presses(Key::ArrowRight) - presses(Key::ArrowLeft);
-        if step != 0 {
+        // A focused slider moves with the arrow keys itself.
+        let focused = ctx.memory(|m| m.focused().is_some());
+        if step != 0 && !focused {
             self.set_shift(self.params.shift + step);
         }
         if pressed(Key::R) {
