@@ -35,6 +35,11 @@ pub struct InspectArgs {
     /// with its legend (`disparity.png`).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Then open the viewer on the pair (`stereolab view --images`): anaglyphs, side by side,
+    /// the disparity map, the image shift.
+    #[cfg(feature = "viewer")]
+    #[arg(long)]
+    pub view: bool,
 }
 
 /// Runs `stereolab inspect`: `Ok(false)` when a finding is an error (or, with `--strict`, a
@@ -112,5 +117,9 @@ pub fn run(args: InspectArgs) -> Result<bool> {
     }
     let (verdict, passed) = inspect::findings::verdict(&findings, args.strict);
     out!("{verdict}");
+    #[cfg(feature = "viewer")]
+    if args.view {
+        super::view::view_inspected(views, &args.images, measured)?;
+    }
     Ok(passed)
 }

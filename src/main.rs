@@ -96,7 +96,8 @@ enum Command {
     /// Autostereograms (SIRDS): from a scene, from a depth map (--depth), animated (--frames),
     /// or decoded back to depth (--decode).
     Sirds(sirds::SirdsArgs),
-    /// The interactive viewer: any output live, camera, rig, readouts, screenshots.
+    /// The interactive viewer: any output live, camera, rig, readouts, screenshots; or a
+    /// stereo pair (--images) as anaglyphs, side by side, its disparity, with an image shift.
     #[cfg(feature = "viewer")]
     View(view::ViewArgs),
 }
@@ -240,6 +241,17 @@ fn require_extension(flag: &str, path: &Path, accepted: &[&str]) -> Result<()> {
     ))
 }
 
+/// Whether the command opens the viewer's window (`view`, `inspect --view`), whose event loop
+/// must run on the main thread.
+#[cfg(feature = "viewer")]
+fn opens_window(command: &Command) -> bool {
+    match command {
+        Command::View(_) => true,
+        Command::Inspect(args) => args.view,
+        _ => false,
+    }
+}
+
 /// Whether `e` is a write to standard output whose reader went away (`stereolab info … | head`):
 /// the normal end of a pipeline, not a failure.
 fn is_closed_pipe(e: &Error) -> bool {
@@ -373,7 +385,7 @@ fn main() -> ExitCode {
         // A window's event loop belongs on the main thread (winit's rule); the viewer's frames
         // render on its own worker thread, in rayon's global pool.
         #[cfg(feature = "viewer")]
-        _ if matches!(cli.command, Command::View(_)) => run(cli),
+        _ if opens_window(&cli.command) => run(cli),
         Ok(pool) => pool.install(|| run(cli)),
         Err(_) => run(cli),
     };

@@ -47,5 +47,7 @@ mod stability;
 mod stereo_photo;
 #[cfg(feature = "viewer")]
 mod viewer;
+#[cfg(feature = "viewer")]
+mod viewer_pair;
 mod views;
 mod zero_parallax;

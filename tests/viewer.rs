@@ -12,12 +12,12 @@ use std::time::{Duration, Instant};
 
 use crate::common::{asset, out_dir};
 
-fn stereolab() -> Command {
+pub(crate) fn stereolab() -> Command {
     Command::new(env!("CARGO_BIN_EXE_stereolab"))
 }
 
 /// The path of `tool` on PATH, or a failure naming the Debian package that has it.
-fn need(tool: &str, package: &str) -> PathBuf {
+pub(crate) fn need(tool: &str, package: &str) -> PathBuf {
     std::env::var_os("PATH")
         .and_then(|paths| {
             std::env::split_paths(&paths)
@@ -30,7 +30,7 @@ fn need(tool: &str, package: &str) -> PathBuf {
 }
 
 /// A child process killed when dropped.
-struct Killed(Child);
+pub(crate) struct Killed(pub(crate) Child);
 
 impl Drop for Killed {
     fn drop(&mut self) {
@@ -40,12 +40,12 @@ impl Drop for Killed {
 }
 
 /// A virtual X server on a free display number.
-struct Xvfb {
+pub(crate) struct Xvfb {
     _server: Killed,
-    display: String,
+    pub(crate) display: String,
 }
 
-fn start_xvfb() -> Xvfb {
+pub(crate) fn start_xvfb() -> Xvfb {
     let xvfb = need("Xvfb", "xvfb");
     let xdotool = need("xdotool", "xdotool");
     let first = 70 + std::process::id() % 100;
@@ -100,10 +100,10 @@ fn start_xvfb() -> Xvfb {
 }
 
 /// The viewer running under Xvfb, its window and its state file.
-struct Viewer<'a> {
+pub(crate) struct Viewer<'a> {
     x: &'a Xvfb,
     _child: Killed,
-    window: String,
+    pub(crate) window: String,
     state: PathBuf,
 }
 
@@ -119,7 +119,7 @@ fn json(path: &Path) -> Option<serde_json::Value> {
 }
 
 impl Viewer<'_> {
-    fn start<'a>(x: &'a Xvfb, out: &Path, args: &[&str]) -> Viewer<'a> {
+    pub(crate) fn start<'a>(x: &'a Xvfb, out: &Path, args: &[&str]) -> Viewer<'a> {
         let state = out.join("state.json");
         let log_path = out.join("viewer.log");
         let _ = std::fs::remove_file(&log_path);
@@ -203,7 +203,7 @@ impl Viewer<'_> {
     }
 
     /// Presses `key` (an X keysym name: KP_Add, 5, s) in the viewer's window.
-    fn key(&self, key: &str) {
+    pub(crate) fn key(&self, key: &str) {
         self.xdotool(&["windowfocus", "--sync", &self.window]);
         self.xdotool(&["key", "--clearmodifiers", key]);
     }
@@ -217,7 +217,11 @@ impl Viewer<'_> {
     }
 
     /// The state once `ready` holds (and the frame shown has caught up with the parameters).
-    fn wait(&self, what: &str, ready: impl Fn(&serde_json::Value) -> bool) -> serde_json::Value {
+    pub(crate) fn wait(
+        &self,
+        what: &str,
+        ready: impl Fn(&serde_json::Value) -> bool,
+    ) -> serde_json::Value {
         let start = Instant::now();
         loop {
             if let Some(s) = json(&self.state)
@@ -239,7 +243,7 @@ impl Viewer<'_> {
     }
 
     /// A screenshot of the window (xwd), cut to the picture's rectangle.
-    fn picture(&self, state: &serde_json::Value) -> image::RgbImage {
+    pub(crate) fn picture(&self, state: &serde_json::Value) -> image::RgbImage {
         let out = Command::new(need("xwd", "x11-apps"))
             .args(["-silent", "-id", &self.window])
             .env("DISPLAY", &self.x.display)
@@ -259,7 +263,7 @@ impl Viewer<'_> {
 
 /// An X window dump (the XWD format xwd writes: a big-endian header, the window name, a color
 /// map, then ZPixmap rows) as RGB.
-fn parse_xwd(b: &[u8]) -> image::RgbImage {
+pub(crate) fn parse_xwd(b: &[u8]) -> image::RgbImage {
     let u = |i: usize| u32::from_be_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
     let (header, width, height) = (u(0) as usize, u(4), u(5));
     let (byte_order, bpp, stride) = (u(7), u(11) as usize, u(12) as usize);
@@ -283,7 +287,7 @@ fn parse_xwd(b: &[u8]) -> image::RgbImage {
 }
 
 /// Mean x of the pixels whose channel `c` differs from the background's by more than 12.
-fn centroid_x(img: &image::RgbImage, c: usize, background: u8) -> f64 {
+pub(crate) fn centroid_x(img: &image::RgbImage, c: usize, background: u8) -> f64 {
     let (mut sum, mut n) = (0.0, 0.0);
     for (x, _, p) in img.enumerate_pixels() {
         if p.0[c].abs_diff(background) > 12 {

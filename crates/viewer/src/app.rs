@@ -137,15 +137,31 @@ struct Job {
     quit: bool,
 }
 
-pub(super) fn run(scene: Scene, session: Session, opts: ViewOptions) -> Result<()> {
-    let title = title(&session.path, session.initial.output);
-    let native = eframe::NativeOptions {
+/// The window's options: its title, 1280×800, OpenGL (glow).
+pub(super) fn native_options(title: String) -> eframe::NativeOptions {
+    eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title(title)
             .with_inner_size([1280.0, 800.0]),
         renderer: eframe::Renderer::Glow,
         ..Default::default()
-    };
+    }
+}
+
+/// A window that could not open, said with what to check.
+pub(super) fn window_error(e: eframe::Error) -> Error {
+    Error::invalid(
+        "DISPLAY",
+        std::env::var("DISPLAY").unwrap_or_default(),
+        format!(
+            "could not open the viewer's window: {e} (is the X server running, and does \
+             Mesa's OpenGL driver exist: apt-get install libgl1-mesa-dri libegl1)"
+        ),
+    )
+}
+
+pub(super) fn run(scene: Scene, session: Session, opts: ViewOptions) -> Result<()> {
+    let native = native_options(title(&session.path, session.initial.output));
     let shared = Arc::new(Shared {
         job: Mutex::new(Job::default()),
         wake: Condvar::new(),
@@ -173,19 +189,10 @@ pub(super) fn run(scene: Scene, session: Session, opts: ViewOptions) -> Result<(
         job.quit = true;
         shared.wake.notify_all();
     }
-    result.map_err(|e| {
-        Error::invalid(
-            "DISPLAY",
-            std::env::var("DISPLAY").unwrap_or_default(),
-            format!(
-                "could not open the viewer's window: {e} (is the X server running, and does \
-                 Mesa's OpenGL driver exist: apt-get install libgl1-mesa-dri libegl1)"
-            ),
-        )
-    })
+    result.map_err(window_error)
 }
 
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+pub(super) fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
@@ -630,6 +637,7 @@ impl App {
         };
         let p = &self.params;
         let mut v = serde_json::json!({
+            "source": "scene",
             "frames": self.frames,
             "output": p.output.name(),
             "mode": mode_name(p.rig.mode),
@@ -936,7 +944,7 @@ impl App {
 
 /// Hands `pixels` to the texture in `slot` (made on first use); the window uploads it when it
 /// paints.
-fn set_texture(
+pub(super) fn set_texture(
     ctx: &egui::Context,
     slot: &mut Option<egui::TextureHandle>,
     name: &str,

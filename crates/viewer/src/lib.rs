@@ -14,18 +14,27 @@
 //!   numbers;
 //! - `app` (private): the window, keys and mouse.
 //!
+//! Without a scene the viewer shows a stereo pair read back by `stereolab inspect`
+//! ([`run_pair`]):
+//! - [`pair`]: the pair, the ways to show it (anaglyphs, side by side, one eye, the disparity
+//!   map) and the horizontal image shift;
+//! - `pair_window` (private): its window, keys and readouts.
+//!
 //! [`benchmark`] renders an orbit without a window (`--benchmark-frames N`).
 
 mod app;
 pub mod frame;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+pub mod pair;
+mod pair_window;
 pub mod session;
 
 use std::path::PathBuf;
 use std::time::Duration;
 
 pub use frame::{Shown, display_image, render_shown};
+pub use pair::{Pair, PairMode, PairParams};
 pub use session::{Params, Session};
 
 use stereolab::scene::Scene;
@@ -35,7 +44,7 @@ use stereolab_core::{Error, Result};
 #[derive(Clone, Debug, Default)]
 pub struct ViewOptions {
     /// Where the screenshot key writes (`None`: beside the scene file, so the TOML's relative
-    /// model paths still hold).
+    /// model paths still hold; for a pair, beside its first image).
     pub shots: Option<PathBuf>,
     /// A JSON file rewritten with the readouts after every frame shown (for scripts and tests).
     pub state_file: Option<PathBuf>,
@@ -49,6 +58,16 @@ pub struct ViewOptions {
 pub fn run(scene: Scene, session: Session, opts: ViewOptions) -> Result<()> {
     check_display(std::env::var_os("DISPLAY"))?;
     app::run(scene, session, opts)
+}
+
+/// Opens the window on a stereo `pair`, first shown as `params` says, and runs until it is
+/// closed.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_pair(pair: Pair, params: PairParams, opts: ViewOptions) -> Result<()> {
+    check_display(std::env::var_os("DISPLAY"))?;
+    pair_window::run(pair, params, opts)
 }
 
 /// The viewer opens an X11 window (on Wayland through XWayland, which sets `DISPLAY`).
