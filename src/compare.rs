@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Args;
+use stereolab::compare::flip::Viewing;
 use stereolab::compare::{self, Comparison, Thresholds};
 use stereolab::output::stereo_photo::PhotoFormat;
 #[cfg(feature = "gpu")]
@@ -26,7 +27,8 @@ pub struct CompareArgs {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Change a limit: coverage=% (0.1), max=0..255 (255), mean=channel (1.0),
-    /// psnr=dB (30), depth=window depth (1e-5). Repeatable.
+    /// psnr=dB (30), depth=window depth (1e-5), flip=mean ꟻLIP 0..1 (none: reported only).
+    /// Repeatable.
     #[arg(long = "threshold", value_name = "KEY=VALUE")]
     pub thresholds: Vec<String>,
     /// Image size WxH, overriding the scene's.
@@ -48,6 +50,18 @@ pub struct CompareArgs {
     /// With --exercise: the folder holding the exercise crates (default: ./exercises or .).
     #[arg(long, requires = "exercise")]
     pub exercises: Option<PathBuf>,
+    /// ꟻLIP's viewing condition: the display's width in metres (default 0.7).
+    #[arg(long, value_name = "METRES")]
+    pub display_width: Option<f64>,
+    /// ꟻLIP's viewing condition: the viewer's distance from the display in metres (default 0.7).
+    #[arg(long, value_name = "METRES")]
+    pub display_distance: Option<f64>,
+    /// ꟻLIP's viewing condition: the display's horizontal resolution in pixels (default 3840).
+    #[arg(long, value_name = "PIXELS")]
+    pub display_resolution: Option<f64>,
+    /// ꟻLIP's pixels per degree, given directly instead of a display (default 67).
+    #[arg(long, value_name = "PPD")]
+    pub ppd: Option<f64>,
 }
 
 /// Runs `stereolab compare`.
@@ -66,15 +80,20 @@ pub fn run(args: CompareArgs) -> Result<()> {
         exercise,
         solution,
         exercises,
+        display_width,
+        display_distance,
+        display_resolution,
+        ppd,
     } = args;
     let mut limits = Thresholds::default();
     for t in &thresholds {
         limits.set(t)?;
     }
+    let viewing = Viewing::from_flags(display_width, display_distance, display_resolution, ppd)?;
     let mut problems = Vec::new();
     // A failure is named by the input judged: the actual image, or the scene.
     let judged = second.clone().unwrap_or_else(|| first.clone());
-    let rows = match second {
+    let mut rows = match second {
         None if exercise.is_some() => {
             let name = exercise.unwrap_or_default();
             let [ex] = grade::Exercise::parse_list(&name)?[..] else {
@@ -115,9 +134,14 @@ pub fn run(args: CompareArgs) -> Result<()> {
             compare_scene(&s, out.as_deref())?
         }
     };
+    compare::add_flip(&mut rows, viewing.ppd, out.as_deref())?;
+    outln!("{}", viewing.describe());
     out!("{}", compare::table(&rows));
     for p in rows.iter().filter_map(|r| r.strip.as_ref()) {
         outln!("  wrote {}", p.display());
+    }
+    for p in rows.iter().filter_map(|r| r.flip.as_ref()?.map.as_ref()) {
+        outln!("  wrote {} (ꟻLIP error map, magma)", p.display());
     }
     for p in &problems {
         outln!("  {p}");

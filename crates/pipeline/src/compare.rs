@@ -1,10 +1,13 @@
 //! Image metrics and diff images: coverage mismatch, channel differences, PSNR, depth error;
 //! the ASCII coverage map and the `expected | diff | actual` PNG strip; thresholds for
-//! `stereolab compare`, and comparing two image files.
+//! `stereolab compare`, and comparing two image files. Beside these exact metrics, the
+//! perceptual ꟻLIP ([`flip`]), reported and not a limit unless asked for (`flip=`).
+
+pub mod flip;
 
 use std::path::{Path, PathBuf};
 
-use image::{Rgba, RgbaImage};
+use image::{RgbImage, Rgba, RgbaImage};
 
 use stereolab_core::{Error, Framebuffer, Result};
 
@@ -206,6 +209,93 @@ pub struct Comparison {
     /// 8-bit steps (fractional), the PSNR against 65535, and the largest difference rounded up
     /// to 8-bit steps (so that any difference shows). `None`: compared at 8 bits.
     pub max_levels_16: Option<u16>,
+    /// The two pictures compared (RGB, 8 bits per channel), kept for ꟻLIP until [`add_flip`]
+    /// measures them; `None` once measured or when not kept.
+    pub pictures: Option<Box<[RgbImage; 2]>>,
+    /// The ꟻLIP of the pair, once [`add_flip`] has measured it.
+    pub flip: Option<FlipResult>,
+}
+
+/// ꟻLIP of one compared pair: the statistics of its error map, and where the map's picture went.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlipResult {
+    /// Mean and percentiles of the per-pixel error.
+    pub stats: flip::FlipStats,
+    /// The error map in the magma color map (`DIR/<row>.flip.png`), when written.
+    pub map: Option<PathBuf>,
+}
+
+/// The pictures of two framebuffers, as [`Comparison::pictures`] keeps them.
+pub fn pictures(expected: &Framebuffer, actual: &Framebuffer) -> Option<Box<[RgbImage; 2]>> {
+    Some(Box::new([flip::rgb(expected), flip::rgb(actual)]))
+}
+
+/// A row's name as a file name: letters, digits, `-` and `.` kept, every other run of
+/// characters one `_` (`anaglyph (wgsl)` → `anaglyph_wgsl`).
+pub fn file_stem_of(name: &str) -> String {
+    let mut s = String::new();
+    for c in name.chars() {
+        if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+            s.push(c);
+        } else if !s.ends_with('_') {
+            s.push('_');
+        }
+    }
+    let s = s.trim_matches('_');
+    if s.is_empty() {
+        "image".into()
+    } else {
+        s.into()
+    }
+}
+
+/// Measures ꟻLIP on every row that kept its pictures ([`Comparison::pictures`], dropped once
+/// measured), at `ppd` pixels per degree. With `out`, each row's error map is written as
+/// `out/<row>.flip.png` in the magma color map ([`file_stem_of`] names it), all of them or
+/// none (one [`OutputSet`](stereolab_core::OutputSet)).
+///
+/// # Errors
+/// Pictures of different sizes, a bad `ppd`, or an unwritable folder.
+pub fn add_flip(rows: &mut [Comparison], ppd: f64, out: Option<&Path>) -> Result<()> {
+    use rayon::prelude::*;
+    let maps = rows
+        .par_iter_mut()
+        .map(|r| {
+            let Some(p) = r.pictures.take() else {
+                return Ok(None);
+            };
+            let [e, a] = *p;
+            let errors = flip::error_map(&e, &a, ppd)?;
+            r.flip = Some(FlipResult {
+                stats: flip::FlipStats::of(&errors),
+                map: None,
+            });
+            let picture = out
+                .map(|_| flip::magma(&errors, e.width(), e.height()))
+                .transpose()?;
+            Ok(picture)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let Some(dir) = out else {
+        return Ok(());
+    };
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let mut set = stereolab_core::OutputSet::new();
+    let mut names = Vec::new();
+    for (i, map) in maps.iter().enumerate() {
+        if let Some(map) = map {
+            let path = dir.join(format!("{}.flip.png", file_stem_of(&rows[i].name)));
+            set.stage_png(&path, map)?;
+            names.push((i, path));
+        }
+    }
+    set.commit()?;
+    for (i, path) in names {
+        if let Some(f) = rows[i].flip.as_mut() {
+            f.map = Some(path);
+        }
+    }
+    Ok(())
 }
 
 /// The comparisons as an aligned table, one row each.
@@ -232,6 +322,14 @@ pub fn table(rows: &[Comparison]) -> String {
             m.psnr,
             depth
         );
+        if let Some(f) = &r.flip {
+            let f = &f.stats;
+            let _ = writeln!(
+                s,
+                "{:<24} ꟻLIP mean {:.4}  median {:.4}  95% {:.4}  99% {:.4}  max {:.4}",
+                "", f.mean, f.p50, f.p95, f.p99, f.max
+            );
+        }
         if let Some(levels) = r.max_levels_16 {
             let _ = writeln!(
                 s,
@@ -257,6 +355,8 @@ pub struct Thresholds {
     pub min_psnr: f64,
     /// Largest depth difference where both cover (`depth=`). Target: 1e-5.
     pub max_depth: f32,
+    /// Largest mean ꟻLIP error, 0..1 (`flip=`); `None`, the default: ꟻLIP is reported only.
+    pub max_flip_mean: Option<f64>,
 }
 
 impl Default for Thresholds {
@@ -267,12 +367,13 @@ impl Default for Thresholds {
             mean_channel: 1.0,
             min_psnr: 30.0,
             max_depth: 1e-5,
+            max_flip_mean: None,
         }
     }
 }
 
 impl Thresholds {
-    /// Applies one `KEY=VALUE` setting (`coverage`, `max`, `mean`, `psnr`, `depth`).
+    /// Applies one `KEY=VALUE` setting (`coverage`, `max`, `mean`, `psnr`, `depth`, `flip`).
     ///
     /// # Errors
     /// An unknown key or a value that is not a number in range.
@@ -295,7 +396,9 @@ impl Thresholds {
             "mean" => self.mean_channel = v,
             "psnr" => self.min_psnr = v,
             "depth" => self.max_depth = v as f32,
-            _ => return Err(bad("known keys: coverage, max, mean, psnr, depth")),
+            "flip" if v <= 1.0 => self.max_flip_mean = Some(v),
+            "flip" => return Err(bad("flip is a mean ꟻLIP error in 0..=1")),
+            _ => return Err(bad("known keys: coverage, max, mean, psnr, depth, flip")),
         }
         Ok(())
     }
@@ -349,6 +452,15 @@ impl Thresholds {
                     m.max_depth_diff,
                     m.max_depth_diff - self.max_depth,
                     self.max_depth
+                ));
+            }
+            if let (Some(limit), Some(f)) = (self.max_flip_mean, &r.flip)
+                && f.stats.mean > limit
+            {
+                fail(format!(
+                    "mean ꟻLIP error {:.4}, {:.4} over the limit of {limit} (flip=)",
+                    f.stats.mean,
+                    f.stats.mean - limit
                 ));
             }
         }
@@ -431,6 +543,8 @@ pub fn compare_images(
         has_depth: false,
         strip,
         max_levels_16,
+        pictures: Some(Box::new([de.to_rgb8(), da.to_rgb8()])),
+        flip: None,
     })
 }
 
@@ -479,6 +593,8 @@ pub fn compare_stereo_photos(
                 has_depth: false,
                 strip,
                 max_levels_16: None,
+                pictures: pictures(&ef, &af),
+                flip: None,
             })
         })
         .collect()
@@ -571,6 +687,8 @@ mod tests {
             has_depth,
             strip: None,
             max_levels_16: None,
+            pictures: None,
+            flip: None,
         }
     }
 
