@@ -324,10 +324,16 @@ pub fn table(rows: &[Comparison]) -> String {
         );
         if let Some(f) = &r.flip {
             let f = &f.stats;
+            let [p50, p95, p99, max] = [f.p50, f.p95, f.p99, f.max].map(f64::from);
             let _ = writeln!(
                 s,
-                "{:<24} ꟻLIP mean {:.4}  median {:.4}  95% {:.4}  99% {:.4}  max {:.4}",
-                "", f.mean, f.p50, f.p95, f.p99, f.max
+                "{:<24} ꟻLIP mean {}  median {}  95% {}  99% {}  max {}",
+                "",
+                flip_figure(f.mean),
+                flip_figure(p50),
+                flip_figure(p95),
+                flip_figure(p99),
+                flip_figure(max)
             );
         }
         if let Some(levels) = r.max_levels_16 {
@@ -339,6 +345,16 @@ pub fn table(rows: &[Comparison]) -> String {
         }
     }
     s
+}
+
+/// A ꟻLIP error (0..1) for the table: four decimals, or three significant digits below 0.001 so
+/// that a difference of a few pixels does not print as zero.
+fn flip_figure(v: f64) -> String {
+    if v == 0.0 || v >= 1e-3 {
+        format!("{v:.4}")
+    } else {
+        format!("{v:.2e}")
+    }
 }
 
 /// Limits past which `stereolab compare` exits non-zero. The defaults are the GPU parity
