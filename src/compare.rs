@@ -7,6 +7,7 @@ use std::time::Duration;
 use clap::Args;
 use stereolab::compare::flip::Viewing;
 use stereolab::compare::{self, Comparison, Thresholds};
+use stereolab::inspect::{Layout, split};
 use stereolab::output::stereo_photo::PhotoFormat;
 #[cfg(feature = "gpu")]
 use stereolab::plan::Plan;
@@ -37,6 +38,10 @@ pub struct CompareArgs {
     /// Override a scene field (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub sets: Vec<String>,
+    /// With two images: both are stereo pictures in this layout (side_by_side, cross_eyed,
+    /// above_below, half_side_by_side, … as `inspect --layout` takes), compared eye by eye.
+    #[arg(long, value_name = "NAME", requires = "second")]
+    pub layout: Option<String>,
     /// Background color R,G,B (0..255) for two images; default: each image's top-left pixel.
     #[arg(long)]
     pub background: Option<String>,
@@ -77,6 +82,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
         size,
         sets,
         background,
+        layout,
         exercise,
         solution,
         exercises,
@@ -103,6 +109,14 @@ pub fn run(args: CompareArgs) -> Result<()> {
             let (rows, p) = compare_exercise(ex, &s, exercises, solution, out.as_deref())?;
             problems = p;
             rows
+        }
+        Some(second) if layout.is_some() => {
+            // One picture holding both views: split each into left and right, one row per eye.
+            let layout = Layout::parse(layout.as_deref().unwrap_or_default())?;
+            let views = |path: &PathBuf| split(&compare::load_image(path)?, layout);
+            let bg = background.as_deref().map(parse_rgb).transpose()?;
+            let pair = [views(&first)?, views(&second)?];
+            compare::compare_views(&first, &second, pair, bg, out.as_deref())?
         }
         Some(second)
             if PhotoFormat::from_path(&first).is_some()

@@ -351,3 +351,71 @@ fn compare_cli_refuses_bad_display_values_by_flag() {
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("--display-width"), "{stderr}");
 }
+
+/// Two side-by-side pictures that differ in the right eye only: `--layout` compares them eye by
+/// eye, and only the right eye's ꟻLIP is above zero.
+#[test]
+fn compare_cli_splits_a_layout_into_eyes_for_flip() {
+    let dir = out_dir("compare_flip_layout");
+    let eye = picture(64, 48);
+    let side_by_side = |right: &RgbImage| {
+        let mut img = RgbImage::new(128, 48);
+        image::imageops::replace(&mut img, &eye, 0, 0);
+        image::imageops::replace(&mut img, right, 64, 0);
+        img
+    };
+    let pa = save(&dir, "expected.png", &side_by_side(&eye));
+    let pb = save(&dir, "actual.png", &side_by_side(&noisy(&eye, 16)));
+    let maps = dir.join("out");
+    let out = stereolab(&[
+        "compare",
+        &pa,
+        &pb,
+        "--layout",
+        "side_by_side",
+        "--threshold",
+        "coverage=100",
+        "--threshold",
+        "psnr=0",
+        "--threshold",
+        "mean=255",
+        "--out",
+        maps.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let flip_line = |row: &str| {
+        let mut lines = stdout.lines().skip_while(|l| !l.starts_with(row));
+        lines.nth(1).unwrap_or_default().to_string()
+    };
+    assert!(
+        flip_line("actual-left ").contains("ꟻLIP mean 0.0000"),
+        "{stdout}"
+    );
+    let right = flip_line("actual-right ");
+    assert!(
+        right.contains("ꟻLIP mean 0.0") && !right.contains("mean 0.0000"),
+        "{stdout}"
+    );
+    for f in ["actual-left.flip.png", "actual-right.flip.png"] {
+        let map = image::open(maps.join(f)).expect(f).to_rgb8();
+        assert_eq!(map.dimensions(), (64, 48), "{f}: one eye's size");
+    }
+    // A layout that does not fit the picture, or is not a layout of one picture, is refused.
+    for (layout, why) in [
+        ("pair", "not a layout of one picture"),
+        ("sideways", "known layouts"),
+    ] {
+        let out = stereolab(&["compare", &pa, &pb, "--layout", layout]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.contains("--layout") && stderr.contains(why),
+            "{stderr}"
+        );
+    }
+}

@@ -566,8 +566,8 @@ pub fn compare_images(
 
 /// Compares two stereo photos (MPO, JPS or PNS, in any combination) eye by eye: each file is
 /// split into its left and right views
-/// ([`read_stereo`](crate::output::stereo_photo::read_stereo)), and each view is compared as
-/// [`compare_images`] compares two files; rows `<actual>-left` and `<actual>-right`.
+/// ([`read_stereo`](crate::output::stereo_photo::read_stereo)), and the views are compared as
+/// [`compare_views`] does; rows `<actual>-left` and `<actual>-right`.
 ///
 /// # Errors
 /// Unreadable files, or views of different sizes.
@@ -579,6 +579,25 @@ pub fn compare_stereo_photos(
 ) -> Result<Vec<Comparison>> {
     use crate::output::stereo_photo::read_stereo;
     let (e, a) = (read_stereo(expected)?, read_stereo(actual)?);
+    compare_views(expected, actual, [e, a], background, out)
+}
+
+/// Compares two stereo pictures eye by eye, given as their views `[(expected left, expected
+/// right), (actual left, actual right)]` (from the files `expected` and `actual`, which name
+/// the rows and errors): each view as [`compare_images`] compares two files; rows
+/// `<actual>-left` and `<actual>-right`, strips `<actual>-left-diff.png` and
+/// `<actual>-right-diff.png`.
+///
+/// # Errors
+/// Views of different sizes, or an unwritable folder.
+pub fn compare_views(
+    expected: &Path,
+    actual: &Path,
+    views: [(RgbaImage, RgbaImage); 2],
+    background: Option<[u8; 4]>,
+    out: Option<&Path>,
+) -> Result<Vec<Comparison>> {
+    let [e, a] = views;
     let stem = actual
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
