@@ -148,7 +148,9 @@ pub fn run(args: CompareArgs) -> Result<()> {
             compare_scene(&s, out.as_deref())?
         }
     };
-    compare::add_flip(&mut rows, viewing.ppd, out.as_deref())?;
+    // Each of the rows measured at once may take its share of the memory budget.
+    let budget = stereolab::memory::default_budget() / rayon::current_num_threads().max(1) as u64;
+    let flip_notes = compare::add_flip(&mut rows, viewing.ppd, out.as_deref(), budget)?;
     outln!("{}", viewing.describe());
     out!("{}", compare::table(&rows));
     for p in rows.iter().filter_map(|r| r.strip.as_ref()) {
@@ -156,6 +158,9 @@ pub fn run(args: CompareArgs) -> Result<()> {
     }
     for p in rows.iter().filter_map(|r| r.flip.as_ref()?.map.as_ref()) {
         outln!("  wrote {} (ꟻLIP error map, magma)", p.display());
+    }
+    for note in &flip_notes {
+        outln!("  {note}");
     }
     for p in &problems {
         outln!("  {p}");

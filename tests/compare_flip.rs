@@ -123,7 +123,8 @@ fn compare_flip_writes_the_error_map_in_magma_at_the_pictures_size() {
         row("left pass", a.clone(), noisy(&a, 32)),
         row("anaglyph (wgsl)", a.clone(), a.clone()),
     ];
-    add_flip(&mut rows, DEFAULT_PPD, Some(&dir)).expect("measured and written");
+    let skipped = add_flip(&mut rows, DEFAULT_PPD, Some(&dir), u64::MAX).expect("written");
+    assert!(skipped.is_empty(), "{skipped:?}");
     let magma = magma_table();
     assert_eq!(magma.len(), 256);
     // ꟻLIP's magma runs from near black to pale yellow.
@@ -319,6 +320,7 @@ fn compare_cli_refuses_bad_display_values_by_flag() {
         (&["--display-resolution", "0"], "--display-resolution"),
         (&["--display-resolution", "1e12"], "--display-resolution"),
         (&["--ppd", "0"], "--ppd"),
+        (&["--ppd", "5000"], "--ppd"),
         (&["--ppd", "67", "--display-width", "0.7"], "--ppd"),
         (&["--threshold", "flip=2"], "--threshold"),
         // Sane values each, but a 0.01 m wide display of 16 px seen from 0.01 m: 0.28 ppd.
@@ -418,4 +420,27 @@ fn compare_cli_splits_a_layout_into_eyes_for_flip() {
             "{stderr}"
         );
     }
+}
+
+/// A pair larger than the memory ꟻLIP may take is not measured, and the note says why; the
+/// other rows are.
+#[test]
+fn compare_flip_skips_a_pair_past_its_memory_budget() {
+    let a = picture(64, 48);
+    let small = picture(8, 8);
+    let mut rows = vec![
+        row("large", a.clone(), a.clone()),
+        row("small", small.clone(), small),
+    ];
+    let budget = 64 * 48 * stereolab::compare::FLIP_BYTES_PER_PIXEL - 1;
+    let skipped = add_flip(&mut rows, DEFAULT_PPD, None, budget).expect("measured");
+    assert_eq!(skipped.len(), 1, "{skipped:?}");
+    assert!(
+        skipped[0].starts_with("large: ꟻLIP not measured: a 64×48 pair"),
+        "{skipped:?}"
+    );
+    assert!(rows[0].flip.is_none() && rows[0].pictures.is_none());
+    assert!(rows[1].flip.is_some());
+    let table = stereolab::compare::table(&rows);
+    assert_eq!(table.matches("ꟻLIP mean").count(), 1, "{table}");
 }

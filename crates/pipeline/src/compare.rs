@@ -249,15 +249,46 @@ pub fn file_stem_of(name: &str) -> String {
     }
 }
 
+/// Bytes ꟻLIP takes for each pixel of a compared pair: its working images (NVIDIA's
+/// implementation holds several float copies of both pictures) and the error map, from the peak
+/// resident memory of `compare` on a 4096×4096 pair (104 bytes a pixel), rounded up.
+pub const FLIP_BYTES_PER_PIXEL: u64 = 128;
+
 /// Measures ꟻLIP on every row that kept its pictures ([`Comparison::pictures`], dropped once
-/// measured), at `ppd` pixels per degree. With `out`, each row's error map is written as
-/// `out/<row>.flip.png` in the magma color map ([`file_stem_of`] names it), all of them or
-/// none (one [`OutputSet`](stereolab_core::OutputSet)).
+/// measured), at `ppd` pixels per degree, several rows at once. A pair that would take more than
+/// `budget` bytes ([`FLIP_BYTES_PER_PIXEL`]) is not measured; the sentences returned say which
+/// and why. With `out`, each row's error map is written as `out/<row>.flip.png` in the magma
+/// color map ([`file_stem_of`] names it), all of them or none (one
+/// [`OutputSet`](stereolab_core::OutputSet)).
 ///
 /// # Errors
 /// Pictures of different sizes, a bad `ppd`, or an unwritable folder.
-pub fn add_flip(rows: &mut [Comparison], ppd: f64, out: Option<&Path>) -> Result<()> {
+pub fn add_flip(
+    rows: &mut [Comparison],
+    ppd: f64,
+    out: Option<&Path>,
+    budget: u64,
+) -> Result<Vec<String>> {
     use rayon::prelude::*;
+    let mut skipped = Vec::new();
+    for r in rows.iter_mut() {
+        let Some([e, _]) = r.pictures.as_deref() else {
+            continue;
+        };
+        let need = u64::from(e.width()) * u64::from(e.height()) * FLIP_BYTES_PER_PIXEL;
+        if need > budget {
+            skipped.push(format!(
+                "{}: ꟻLIP not measured: a {}×{} pair needs about {} MiB, more than the {} MiB \
+                 it may take",
+                r.name,
+                e.width(),
+                e.height(),
+                need >> 20,
+                budget >> 20
+            ));
+            r.pictures = None;
+        }
+    }
     let maps = rows
         .par_iter_mut()
         .map(|r| {
@@ -277,7 +308,7 @@ pub fn add_flip(rows: &mut [Comparison], ppd: f64, out: Option<&Path>) -> Result
         })
         .collect::<Result<Vec<_>>>()?;
     let Some(dir) = out else {
-        return Ok(());
+        return Ok(skipped);
     };
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let mut set = stereolab_core::OutputSet::new();
@@ -295,7 +326,7 @@ pub fn add_flip(rows: &mut [Comparison], ppd: f64, out: Option<&Path>) -> Result
             f.map = Some(path);
         }
     }
-    Ok(())
+    Ok(skipped)
 }
 
 /// The comparisons as an aligned table, one row each.

@@ -42,8 +42,10 @@ const WIDTH_M: (f64, f64) = (0.01, 100.0);
 const DISTANCE_M: (f64, f64) = (0.01, 1000.0);
 const RESOLUTION_X: (f64, f64) = (16.0, 100_000.0);
 /// Bounds of the pixels per degree ꟻLIP is run at: below 1 a pixel spans more than a degree
-/// (no display), above 1000 its filters grow past any picture (and the run time with them).
-const PPD: (f64, f64) = (1.0, 1000.0);
+/// (no display); print at 600 dpi seen from half a metre is about 200, and above 300 ꟻLIP's
+/// filters, as wide as the ppd is large, only make it slow (a 4096×4096 pair: 20 s at 67 ppd,
+/// 3 minutes at 1000).
+const PPD: (f64, f64) = (1.0, 300.0);
 
 impl Display {
     /// ꟻLIP's default display: 0.7 m wide, 3840 pixels across, seen from 0.7 m.
