@@ -66,7 +66,7 @@ impl Display {
 ///
 /// # Errors
 /// NaN, infinite, or out of range.
-pub fn check_flag(flag: &str, value: f64, (lo, hi): (f64, f64), unit: &str) -> Result<f64> {
+fn check_flag(flag: &str, value: f64, (lo, hi): (f64, f64), unit: &str) -> Result<f64> {
     if value.is_finite() && (lo..=hi).contains(&value) {
         Ok(value)
     } else {
