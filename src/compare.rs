@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Args;
+use stereolab::compare::flip::Viewing;
 use stereolab::compare::{self, Comparison, Thresholds};
+use stereolab::inspect::{Layout, split};
 use stereolab::output::stereo_photo::PhotoFormat;
 #[cfg(feature = "gpu")]
 use stereolab::plan::Plan;
@@ -26,7 +28,8 @@ pub struct CompareArgs {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Change a limit: coverage=% (0.1), max=0..255 (255), mean=channel (1.0),
-    /// psnr=dB (30), depth=window depth (1e-5). Repeatable.
+    /// psnr=dB (30), depth=window depth (1e-5), flip=mean ꟻLIP 0..1 (none: reported only).
+    /// Repeatable.
     #[arg(long = "threshold", value_name = "KEY=VALUE")]
     pub thresholds: Vec<String>,
     /// Image size WxH, overriding the scene's.
@@ -35,6 +38,10 @@ pub struct CompareArgs {
     /// Override a scene field (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub sets: Vec<String>,
+    /// With two images: both are stereo pictures in this layout (side_by_side, cross_eyed,
+    /// above_below, half_side_by_side, … as `inspect --layout` takes), compared eye by eye.
+    #[arg(long, value_name = "NAME", requires = "second")]
+    pub layout: Option<String>,
     /// Background color R,G,B (0..255) for two images; default: each image's top-left pixel.
     #[arg(long)]
     pub background: Option<String>,
@@ -48,6 +55,18 @@ pub struct CompareArgs {
     /// With --exercise: the folder holding the exercise crates (default: ./exercises or .).
     #[arg(long, requires = "exercise")]
     pub exercises: Option<PathBuf>,
+    /// ꟻLIP's viewing condition: the display's width in metres (default 0.7).
+    #[arg(long, value_name = "METRES")]
+    pub display_width: Option<f64>,
+    /// ꟻLIP's viewing condition: the viewer's distance from the display in metres (default 0.7).
+    #[arg(long, value_name = "METRES")]
+    pub display_distance: Option<f64>,
+    /// ꟻLIP's viewing condition: the display's horizontal resolution in pixels (default 3840).
+    #[arg(long, value_name = "PIXELS")]
+    pub display_resolution: Option<f64>,
+    /// ꟻLIP's pixels per degree, given directly instead of a display (default 67).
+    #[arg(long, value_name = "PPD")]
+    pub ppd: Option<f64>,
 }
 
 /// Runs `stereolab compare`.
@@ -63,18 +82,24 @@ pub fn run(args: CompareArgs) -> Result<()> {
         size,
         sets,
         background,
+        layout,
         exercise,
         solution,
         exercises,
+        display_width,
+        display_distance,
+        display_resolution,
+        ppd,
     } = args;
     let mut limits = Thresholds::default();
     for t in &thresholds {
         limits.set(t)?;
     }
+    let viewing = Viewing::from_flags(display_width, display_distance, display_resolution, ppd)?;
     let mut problems = Vec::new();
     // A failure is named by the input judged: the actual image, or the scene.
     let judged = second.clone().unwrap_or_else(|| first.clone());
-    let rows = match second {
+    let mut rows = match second {
         None if exercise.is_some() => {
             let name = exercise.unwrap_or_default();
             let [ex] = grade::Exercise::parse_list(&name)?[..] else {
@@ -84,6 +109,14 @@ pub fn run(args: CompareArgs) -> Result<()> {
             let (rows, p) = compare_exercise(ex, &s, exercises, solution, out.as_deref())?;
             problems = p;
             rows
+        }
+        Some(second) if layout.is_some() => {
+            // One picture holding both views: split each into left and right, one row per eye.
+            let layout = Layout::parse(layout.as_deref().unwrap_or_default())?;
+            let views = |path: &PathBuf| split(&compare::load_image(path)?, layout);
+            let bg = background.as_deref().map(parse_rgb).transpose()?;
+            let pair = [views(&first)?, views(&second)?];
+            compare::compare_views(&first, &second, pair, bg, out.as_deref())?
         }
         Some(second)
             if PhotoFormat::from_path(&first).is_some()
@@ -115,9 +148,19 @@ pub fn run(args: CompareArgs) -> Result<()> {
             compare_scene(&s, out.as_deref())?
         }
     };
+    // Each of the rows measured at once may take its share of the memory budget.
+    let budget = stereolab::memory::default_budget() / rayon::current_num_threads().max(1) as u64;
+    let flip_notes = compare::add_flip(&mut rows, viewing.ppd, out.as_deref(), budget)?;
+    outln!("{}", viewing.describe());
     out!("{}", compare::table(&rows));
     for p in rows.iter().filter_map(|r| r.strip.as_ref()) {
         outln!("  wrote {}", p.display());
+    }
+    for p in rows.iter().filter_map(|r| r.flip.as_ref()?.map.as_ref()) {
+        outln!("  wrote {} (ꟻLIP error map, magma)", p.display());
+    }
+    for note in &flip_notes {
+        outln!("  {note}");
     }
     for p in &problems {
         outln!("  {p}");

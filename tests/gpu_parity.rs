@@ -728,6 +728,15 @@ fn cli_renders_on_the_gpu_and_compares_scenes_and_images() {
         "{stdout}"
     );
     assert!(strips.join("left_pass.png").exists() && strips.join("side_by_side.png").exists());
+    // ꟻLIP per eye (the passes) and per output, each with its error map.
+    for map in [
+        "left_pass.flip.png",
+        "right_pass.flip.png",
+        "side_by_side.flip.png",
+    ] {
+        assert!(strips.join(map).exists(), "{map}: {stdout}");
+    }
+    assert_eq!(stdout.matches("ꟻLIP mean").count(), 3, "{stdout}");
 
     // Finalize outputs are also compared on identical inputs (the CPU eyes into both finalizes).
     let anaglyph_scene = common::asset("scenes/anaglyph.toml");

@@ -6,6 +6,7 @@ mod chromadepth;
 mod cli;
 mod clipping;
 mod common;
+mod compare_flip;
 mod conformance;
 mod coverage;
 mod determinism;

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use stereolab::compare::{
-    Comparison, compare, depth_bits_identical, framebuffer_from_image, write_diff_strip,
+    Comparison, compare, depth_bits_identical, framebuffer_from_image, pictures, write_diff_strip,
 };
 use stereolab::output::{Image, produce};
 use stereolab::plan::{Output, Plan, View};
@@ -122,6 +122,8 @@ pub fn compare_finalize(
             has_depth: false,
             strip,
             max_levels_16: None,
+            pictures: pictures(&e, &a),
+            flip: None,
         });
     }
     Ok(rows)
@@ -150,6 +152,8 @@ pub fn compare_frames(
             has_depth: true,
             strip,
             max_levels_16: None,
+            pictures: pictures(&e.framebuffer, &a.framebuffer),
+            flip: None,
         });
     }
     for &o in &expected.plan.outputs {
@@ -175,6 +179,8 @@ pub fn compare_frames(
             has_depth: false,
             strip,
             max_levels_16: None,
+            pictures: pictures(&e, &a),
+            flip: None,
         });
     }
     Ok(rows)

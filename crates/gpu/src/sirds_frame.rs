@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use stereolab::compare::{Comparison, compare, framebuffer_from_image, write_diff_strip};
+use stereolab::compare::{Comparison, compare, framebuffer_from_image, pictures, write_diff_strip};
 use stereolab::output::sirds;
 use stereolab::plan::Output;
 use stereolab::render::Frame;
@@ -73,5 +73,7 @@ pub fn compare_strips(
         has_depth: false,
         strip,
         max_levels_16: None,
+        pictures: pictures(&e, &a),
+        flip: None,
     }])
 }

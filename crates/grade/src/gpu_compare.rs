@@ -13,7 +13,7 @@ use std::path::Path;
 use super::exercise::Eye;
 use super::fixture::{reference_rig, stereo_setup};
 use super::{Exercise, Limits, child, default_work_dir, ex1, submission_binary};
-use stereolab::compare::{Comparison, compare, write_diff_strip};
+use stereolab::compare::{Comparison, compare, pictures, write_diff_strip};
 use stereolab::plan::Shading;
 use stereolab::render::render_view;
 use stereolab::scene::Scene;
@@ -121,6 +121,8 @@ pub fn compare_exercise(
             has_depth: true,
             strip,
             max_levels_16: None,
+            pictures: pictures(&expected, &actual),
+            flip: None,
         });
     }
     Ok(result)

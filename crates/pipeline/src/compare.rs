@@ -1,10 +1,13 @@
 //! Image metrics and diff images: coverage mismatch, channel differences, PSNR, depth error;
 //! the ASCII coverage map and the `expected | diff | actual` PNG strip; thresholds for
-//! `stereolab compare`, and comparing two image files.
+//! `stereolab compare`, and comparing two image files. Beside these exact metrics, the
+//! perceptual ꟻLIP ([`flip`]), reported and not a limit unless asked for (`flip=`).
+
+pub mod flip;
 
 use std::path::{Path, PathBuf};
 
-use image::{Rgba, RgbaImage};
+use image::{RgbImage, Rgba, RgbaImage};
 
 use stereolab_core::{Error, Framebuffer, Result};
 
@@ -206,6 +209,124 @@ pub struct Comparison {
     /// 8-bit steps (fractional), the PSNR against 65535, and the largest difference rounded up
     /// to 8-bit steps (so that any difference shows). `None`: compared at 8 bits.
     pub max_levels_16: Option<u16>,
+    /// The two pictures compared (RGB, 8 bits per channel), kept for ꟻLIP until [`add_flip`]
+    /// measures them; `None` once measured or when not kept.
+    pub pictures: Option<Box<[RgbImage; 2]>>,
+    /// The ꟻLIP of the pair, once [`add_flip`] has measured it.
+    pub flip: Option<FlipResult>,
+}
+
+/// ꟻLIP of one compared pair: the statistics of its error map, and where the map's picture went.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlipResult {
+    /// Mean and percentiles of the per-pixel error.
+    pub stats: flip::FlipStats,
+    /// The error map in the magma color map (`DIR/<row>.flip.png`), when written.
+    pub map: Option<PathBuf>,
+}
+
+/// The pictures of two framebuffers, as [`Comparison::pictures`] keeps them.
+pub fn pictures(expected: &Framebuffer, actual: &Framebuffer) -> Option<Box<[RgbImage; 2]>> {
+    Some(Box::new([flip::rgb(expected), flip::rgb(actual)]))
+}
+
+/// A row's name as a file name: letters, digits, `-` and `.` kept, every other run of
+/// characters one `_` (`anaglyph (wgsl)` → `anaglyph_wgsl`).
+pub fn file_stem_of(name: &str) -> String {
+    let mut s = String::new();
+    for c in name.chars() {
+        if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+            s.push(c);
+        } else if !s.ends_with('_') {
+            s.push('_');
+        }
+    }
+    let s = s.trim_matches('_');
+    if s.is_empty() {
+        "image".into()
+    } else {
+        s.into()
+    }
+}
+
+/// Bytes ꟻLIP takes for each pixel of a compared pair: its working images (NVIDIA's
+/// implementation holds several float copies of both pictures) and the error map, from the peak
+/// resident memory of `compare` on a 4096×4096 pair (104 bytes a pixel), rounded up.
+pub const FLIP_BYTES_PER_PIXEL: u64 = 128;
+
+/// Measures ꟻLIP on every row that kept its pictures ([`Comparison::pictures`], dropped once
+/// measured), at `ppd` pixels per degree, several rows at once. A pair that would take more than
+/// `budget` bytes ([`FLIP_BYTES_PER_PIXEL`]) is not measured; the sentences returned say which
+/// and why. With `out`, each row's error map is written as `out/<row>.flip.png` in the magma
+/// color map ([`file_stem_of`] names it), all of them or none (one
+/// [`OutputSet`](stereolab_core::OutputSet)).
+///
+/// # Errors
+/// Pictures of different sizes, a bad `ppd`, or an unwritable folder.
+pub fn add_flip(
+    rows: &mut [Comparison],
+    ppd: f64,
+    out: Option<&Path>,
+    budget: u64,
+) -> Result<Vec<String>> {
+    use rayon::prelude::*;
+    let mut skipped = Vec::new();
+    for r in rows.iter_mut() {
+        let Some([e, _]) = r.pictures.as_deref() else {
+            continue;
+        };
+        let need = u64::from(e.width()) * u64::from(e.height()) * FLIP_BYTES_PER_PIXEL;
+        if need > budget {
+            skipped.push(format!(
+                "{}: ꟻLIP not measured: a {}×{} pair needs about {} MiB, more than the {} MiB \
+                 it may take",
+                r.name,
+                e.width(),
+                e.height(),
+                need >> 20,
+                budget >> 20
+            ));
+            r.pictures = None;
+        }
+    }
+    let maps = rows
+        .par_iter_mut()
+        .map(|r| {
+            let Some(p) = r.pictures.take() else {
+                return Ok(None);
+            };
+            let [e, a] = *p;
+            let errors = flip::error_map(&e, &a, ppd)?;
+            r.flip = Some(FlipResult {
+                stats: flip::FlipStats::of(&errors),
+                map: None,
+            });
+            let picture = out
+                .map(|_| flip::magma(&errors, e.width(), e.height()))
+                .transpose()?;
+            Ok(picture)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let Some(dir) = out else {
+        return Ok(skipped);
+    };
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let mut set = stereolab_core::OutputSet::new();
+    let mut names = Vec::new();
+    for (i, map) in maps.iter().enumerate() {
+        if let Some(map) = map {
+            let path = dir.join(format!("{}.flip.png", file_stem_of(&rows[i].name)));
+            set.stage_png(&path, map)?;
+            names.push((i, path));
+        }
+    }
+    set.commit()?;
+    for (i, path) in names {
+        if let Some(f) = rows[i].flip.as_mut() {
+            f.map = Some(path);
+        }
+    }
+    Ok(skipped)
 }
 
 /// The comparisons as an aligned table, one row each.
@@ -232,6 +353,20 @@ pub fn table(rows: &[Comparison]) -> String {
             m.psnr,
             depth
         );
+        if let Some(f) = &r.flip {
+            let f = &f.stats;
+            let [p50, p95, p99, max] = [f.p50, f.p95, f.p99, f.max].map(f64::from);
+            let _ = writeln!(
+                s,
+                "{:<24} ꟻLIP mean {}  median {}  95% {}  99% {}  max {}",
+                "",
+                flip_figure(f.mean),
+                flip_figure(p50),
+                flip_figure(p95),
+                flip_figure(p99),
+                flip_figure(max)
+            );
+        }
         if let Some(levels) = r.max_levels_16 {
             let _ = writeln!(
                 s,
@@ -241,6 +376,16 @@ pub fn table(rows: &[Comparison]) -> String {
         }
     }
     s
+}
+
+/// A ꟻLIP error (0..1) for the table: four decimals, or three significant digits below 0.001 so
+/// that a difference of a few pixels does not print as zero.
+fn flip_figure(v: f64) -> String {
+    if v == 0.0 || v >= 1e-3 {
+        format!("{v:.4}")
+    } else {
+        format!("{v:.2e}")
+    }
 }
 
 /// Limits past which `stereolab compare` exits non-zero. The defaults are the GPU parity
@@ -257,6 +402,8 @@ pub struct Thresholds {
     pub min_psnr: f64,
     /// Largest depth difference where both cover (`depth=`). Target: 1e-5.
     pub max_depth: f32,
+    /// Largest mean ꟻLIP error, 0..1 (`flip=`); `None`, the default: ꟻLIP is reported only.
+    pub max_flip_mean: Option<f64>,
 }
 
 impl Default for Thresholds {
@@ -267,12 +414,13 @@ impl Default for Thresholds {
             mean_channel: 1.0,
             min_psnr: 30.0,
             max_depth: 1e-5,
+            max_flip_mean: None,
         }
     }
 }
 
 impl Thresholds {
-    /// Applies one `KEY=VALUE` setting (`coverage`, `max`, `mean`, `psnr`, `depth`).
+    /// Applies one `KEY=VALUE` setting (`coverage`, `max`, `mean`, `psnr`, `depth`, `flip`).
     ///
     /// # Errors
     /// An unknown key or a value that is not a number in range.
@@ -295,7 +443,9 @@ impl Thresholds {
             "mean" => self.mean_channel = v,
             "psnr" => self.min_psnr = v,
             "depth" => self.max_depth = v as f32,
-            _ => return Err(bad("known keys: coverage, max, mean, psnr, depth")),
+            "flip" if v <= 1.0 => self.max_flip_mean = Some(v),
+            "flip" => return Err(bad("flip is a mean ꟻLIP error in 0..=1")),
+            _ => return Err(bad("known keys: coverage, max, mean, psnr, depth, flip")),
         }
         Ok(())
     }
@@ -349,6 +499,15 @@ impl Thresholds {
                     m.max_depth_diff,
                     m.max_depth_diff - self.max_depth,
                     self.max_depth
+                ));
+            }
+            if let (Some(limit), Some(f)) = (self.max_flip_mean, &r.flip)
+                && f.stats.mean > limit
+            {
+                fail(format!(
+                    "mean ꟻLIP error {:.4}, {:.4} over the limit of {limit} (flip=)",
+                    f.stats.mean,
+                    f.stats.mean - limit
                 ));
             }
         }
@@ -431,13 +590,15 @@ pub fn compare_images(
         has_depth: false,
         strip,
         max_levels_16,
+        pictures: Some(Box::new([de.to_rgb8(), da.to_rgb8()])),
+        flip: None,
     })
 }
 
 /// Compares two stereo photos (MPO, JPS or PNS, in any combination) eye by eye: each file is
 /// split into its left and right views
-/// ([`read_stereo`](crate::output::stereo_photo::read_stereo)), and each view is compared as
-/// [`compare_images`] compares two files; rows `<actual>-left` and `<actual>-right`.
+/// ([`read_stereo`](crate::output::stereo_photo::read_stereo)), and the views are compared as
+/// [`compare_views`] does; rows `<actual>-left` and `<actual>-right`.
 ///
 /// # Errors
 /// Unreadable files, or views of different sizes.
@@ -449,6 +610,25 @@ pub fn compare_stereo_photos(
 ) -> Result<Vec<Comparison>> {
     use crate::output::stereo_photo::read_stereo;
     let (e, a) = (read_stereo(expected)?, read_stereo(actual)?);
+    compare_views(expected, actual, [e, a], background, out)
+}
+
+/// Compares two stereo pictures eye by eye, given as their views `[(expected left, expected
+/// right), (actual left, actual right)]` (from the files `expected` and `actual`, which name
+/// the rows and errors): each view as [`compare_images`] compares two files; rows
+/// `<actual>-left` and `<actual>-right`, strips `<actual>-left-diff.png` and
+/// `<actual>-right-diff.png`.
+///
+/// # Errors
+/// Views of different sizes, or an unwritable folder.
+pub fn compare_views(
+    expected: &Path,
+    actual: &Path,
+    views: [(RgbaImage, RgbaImage); 2],
+    background: Option<[u8; 4]>,
+    out: Option<&Path>,
+) -> Result<Vec<Comparison>> {
+    let [e, a] = views;
     let stem = actual
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -479,6 +659,8 @@ pub fn compare_stereo_photos(
                 has_depth: false,
                 strip,
                 max_levels_16: None,
+                pictures: pictures(&ef, &af),
+                flip: None,
             })
         })
         .collect()
@@ -571,6 +753,8 @@ mod tests {
             has_depth,
             strip: None,
             max_levels_16: None,
+            pictures: None,
+            flip: None,
         }
     }
 
