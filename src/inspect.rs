@@ -31,8 +31,9 @@ pub struct InspectArgs {
     /// Warnings (parallax past the guide's budget, window violations) fail the run too.
     #[arg(long)]
     pub strict: bool,
-    /// Folder for the two views read back (`left.png`, `right.png`) and the disparity map
-    /// with its legend (`disparity.png`).
+    /// Folder for the two views read back (`left.png`, `right.png`), the disparity map with
+    /// its legend (`disparity.png`), and both beside the left view with the findings drawn on
+    /// it (`inspect.png`: vertical disparity as arrows, window violations).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Then open the viewer on the pair (`stereolab view --images`): anaglyphs, side by side,
@@ -102,6 +103,7 @@ pub fn run(args: InspectArgs) -> Result<bool> {
             dir.join("left.png"),
             dir.join("right.png"),
             dir.join("disparity.png"),
+            dir.join("inspect.png"),
         ];
         for p in &paths {
             stereolab_core::check_output_path(p)?;
@@ -111,6 +113,9 @@ pub fn run(args: InspectArgs) -> Result<bool> {
         set.stage_png(&paths[0], &views.left)?;
         set.stage_png(&paths[1], &views.right)?;
         set.stage_png(&paths[2], &inspect::disparity_image(&measured)?)?;
+        let picture =
+            inspect::picture::findings_picture(&views.left, &measured, &samples, &findings)?;
+        set.stage_png(&paths[3], &picture)?;
         for p in set.commit()? {
             outln!("  wrote {}", p.display());
         }

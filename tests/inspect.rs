@@ -905,6 +905,24 @@ fn pairs_made_outside_stereolab_are_named_by_their_mistakes() {
     let (code, text) = inspect("window", &["--strict"]);
     assert_eq!(code, Some(3), "{text}");
     assert!(text.contains("fails (--strict)"), "{text}");
+    // The picture beside the report: the view with the findings drawn, and the map. A yellow
+    // arrow points at the left edge where the sphere violates the window, none at the right.
+    let pictures = dir.join("window_out");
+    let (code, _) = inspect("window", &["--out", pictures.to_str().unwrap()]);
+    assert_eq!(code, Some(0));
+    let img = image::open(pictures.join("inspect.png")).unwrap().to_rgba8();
+    assert_eq!(img.width(), 2 * 480 + 8);
+    let yellow = |x0: u32, x1: u32| {
+        (x0..x1)
+            .flat_map(|x| (0..360).map(move |y| (x, y)))
+            .filter(|&(x, y)| {
+                let p = img.get_pixel(x, y).0;
+                p[0] > 230 && p[1] > 200 && p[2] < 60
+            })
+            .count()
+    };
+    assert!(yellow(0, 40) > 50, "{}", yellow(0, 40));
+    assert_eq!(yellow(440, 480), 0);
 }
 
 /// The anaglyph method estimated from the channels of a picture whose views are unknown: on the

@@ -14,6 +14,7 @@ pub mod anaglyph;
 pub mod disparity;
 pub mod eyes;
 pub mod findings;
+pub mod picture;
 
 pub use findings::{Finding, Severity};
 
