@@ -1007,7 +1007,7 @@ pub fn window_margin(width: u32) -> u32 {
 pub const BUDGET_SHARE: f64 = 0.03;
 
 /// The report's lines about a measurement: coverage, the parallax range against the guide's
-/// budget, and whether there is depth to see at all ([`findings`]).
+/// budget, and whether there is depth to see at all ([`findings()`]).
 pub fn describe(m: &Measured) -> String {
     let mut s = format!(
         "  disparity: semi-global matching (census 5×5, 8 paths), {:.1}% of pixels matched \
