@@ -923,7 +923,7 @@ fn pairs_made_outside_stereolab_are_named_by_their_mistakes() {
             })
             .count()
     };
-    assert!(yellow(0, 40) > 50, "{}", yellow(0, 40));
+    assert!(yellow(0, 40) > 20, "{}", yellow(0, 40));
     assert_eq!(yellow(440, 480), 0);
 }
 
@@ -979,4 +979,47 @@ fn the_anaglyph_method_is_estimated_from_the_channels() {
         .find(|f| f.kind == stereolab_core::AnaglyphKind::True && !f.linear_light)
         .unwrap();
     assert!(true_fit.explained < 0.5, "{true_fit:?}");
+}
+
+/// No mistake named on a correct pair: every shipped scene's left and right views (at 480
+/// pixels across, the scene's aspect kept) inspected with the findings that are errors. Smooth,
+/// untextured shading gives the matchers little to hold on to; the findings must then stay
+/// silent rather than guess.
+#[test]
+fn shipped_scenes_pairs_show_no_mistake() {
+    use stereolab::inspect::{
+        eyes::eye_order, findings, fit_vertical, measure, vertical_findings, vertical_samples,
+    };
+    let dir = crate::common::root().join("assets/scenes");
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 30, "{}", names.len());
+    let mut inspected = 0;
+    for path in &names {
+        let mut scene = Scene::load(path, &[]).unwrap();
+        let h = (480 * scene.height / scene.width).max(16);
+        scene.set_size(480, h).unwrap();
+        let frame = render(&scene, &Plan::new(&[Output::Left, Output::Right])).unwrap();
+        let views = pair(
+            rgba(&produce(Output::Left, &frame, &scene).unwrap()).clone(),
+            rgba(&produce(Output::Right, &frame, &scene).unwrap()).clone(),
+        );
+        let m = measure(&views).unwrap();
+        let fit = fit_vertical(&vertical_samples(&views, &m), 480, h);
+        let mut found = findings(&m);
+        found.extend(vertical_findings(fit.as_ref(), 480));
+        found.extend(eye_order(&views, &m).findings());
+        let errors: Vec<&str> = found
+            .iter()
+            .filter(|f| f.severity == stereolab::inspect::Severity::Error)
+            .map(|f| f.name)
+            .collect();
+        assert!(errors.is_empty(), "{}: {errors:?} {fit:?}", path.display());
+        inspected += 1;
+    }
+    assert_eq!(inspected, names.len());
 }

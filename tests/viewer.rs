@@ -46,9 +46,17 @@ pub(crate) struct Xvfb {
 }
 
 pub(crate) fn start_xvfb() -> Xvfb {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicU32, Ordering};
+    // Tests in this process start their servers one at a time, each on a display number no
+    // other test here has tried: two servers started at once on one free number would both
+    // see the winner's socket serving, and two tests would share a screen.
+    static STARTING: Mutex<()> = Mutex::new(());
+    static TRIED: AtomicU32 = AtomicU32::new(0);
+    let _one_at_a_time = STARTING.lock().unwrap_or_else(|e| e.into_inner());
     let xvfb = need("Xvfb", "xvfb");
     let xdotool = need("xdotool", "xdotool");
-    let first = 70 + std::process::id() % 100;
+    let first = 70 + std::process::id() % 100 + TRIED.fetch_add(40, Ordering::SeqCst);
     for n in first..first + 40 {
         if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
             || Path::new(&format!("/tmp/.X{n}-lock")).exists()

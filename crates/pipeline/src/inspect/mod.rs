@@ -1308,6 +1308,10 @@ pub fn fit_vertical(samples: &[VerticalSample], width: u32, height: u32) -> Opti
     Some(fit)
 }
 
+/// The fewest blocks a reliable fit keeps: a textured 480×360 pair gives 700–1 000, smooth
+/// shading a few dozen at the silhouettes.
+pub const VERTICAL_MIN_BLOCKS: usize = 100;
+
 /// How far (px) a block may lie from the first fit and still count in the second.
 pub const VERTICAL_OUTLIER: f64 = 1.5;
 
@@ -1323,10 +1327,13 @@ impl VerticalFit {
         self.offset + self.rotation * x + self.scale * y + self.keystone * x * y
     }
 
-    /// Whether the fit explains the blocks well enough for findings: at least 30 blocks kept,
-    /// at most one in five left out, and a residual within [`VERTICAL_MAX_RMS`].
+    /// Whether the fit explains the blocks well enough for findings: at least
+    /// [`VERTICAL_MIN_BLOCKS`] blocks kept, at most one in five left out, and a residual within
+    /// [`VERTICAL_MAX_RMS`].
     pub fn reliable(&self) -> bool {
-        self.samples >= 30 && 4 * self.rejected <= self.samples && self.rms <= VERTICAL_MAX_RMS
+        self.samples >= VERTICAL_MIN_BLOCKS
+            && 4 * self.rejected <= self.samples
+            && self.rms <= VERTICAL_MAX_RMS
     }
 }
 
@@ -1393,7 +1400,7 @@ pub fn describe_vertical(fit: Option<&VerticalFit>, width: u32) -> String {
         f.samples, f.rejected, f.rms, f.offset, f.rotation, f.scale, f.keystone
     );
     if !f.reliable() {
-        s += "  vertical disparity unreliable (under 30 blocks kept, over one in five left out, \
+        s += "  vertical disparity unreliable (under 100 blocks kept, over one in five left out, \
               or a residual over 0.5 px: too little texture to match): no finding from it\n";
     }
     s += &findings::lines(&vertical_findings(fit, width));
