@@ -87,7 +87,8 @@ enum Command {
     },
     /// Print the derived cameras and the scene's parallax range.
     Info(info::InfoArgs),
-    /// Read another program's stereo picture back as two views: its layout given or detected.
+    /// Check another program's stereo picture: read back as two views (layout given or
+    /// detected), matched, its mistakes named; exits 3 when a finding is an error.
     Inspect(inspect::InspectArgs),
     /// Draw the slides' figures (rig top views, parallax plot) for a scene.
     Figures(figures::FiguresArgs),
