@@ -58,3 +58,21 @@ pub fn pamstereogram<S: AsRef<std::ffi::OsStr>>(args: &[S], out: &Path) {
     );
     std::fs::write(out, &output.stdout).expect("write stereogram");
 }
+
+/// `python3` when it imports `modules` (`.ci/run` puts a virtual environment with PyPI's
+/// opencv-python-headless, flip-evaluator, numpy and Pillow first on the path); `None`, with the
+/// reason and `install` printed, when it does not, which under CI is a broken setup and fails.
+pub fn python_with(modules: &str, install: &str) -> Option<String> {
+    let python = "python3".to_string();
+    let ok = std::process::Command::new(&python)
+        .args(["-c", &format!("import {modules}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if ok {
+        return Some(python);
+    }
+    let why = format!("{python} cannot import {modules} ({install})");
+    assert!(std::env::var_os("CI").is_none(), "{why}");
+    eprintln!("skipped: {why}");
+    None
+}

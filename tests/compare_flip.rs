@@ -159,22 +159,12 @@ fn compare_flip_writes_the_error_map_in_magma_at_the_pictures_size() {
     );
 }
 
-/// `python3` when it has ꟻLIP's Python package (`.ci/run` installs PyPI's flip-evaluator in
-/// the virtual environment it puts first on the path); `None`, with the reason printed, when it
-/// has not, which under CI is a broken setup and fails.
+/// [`crate::common::python_with`] for flip_evaluator, numpy, PIL.
 fn python_with_flip() -> Option<String> {
-    let python = "python3".to_string();
-    let ok = Command::new(&python)
-        .args(["-c", "import flip_evaluator, numpy, PIL"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        return Some(python);
-    }
-    let why = format!("{python} has no flip_evaluator (pip install flip-evaluator numpy Pillow)");
-    assert!(std::env::var_os("CI").is_none(), "{why}");
-    eprintln!("skipped: {why}");
-    None
+    crate::common::python_with(
+        "flip_evaluator, numpy, PIL",
+        "pip install flip-evaluator numpy Pillow",
+    )
 }
 
 /// stereolab's ꟻLIP (NVIDIA's C++ through nv-flip) against ꟻLIP's own Python package, at two

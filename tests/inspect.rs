@@ -433,22 +433,12 @@ fn sgm_finds_the_exact_parallax_of_a_random_dot_pair() {
     assert!(matched >= 0.85, "{matched}");
 }
 
-/// `python3` when it has OpenCV (`.ci/run` puts a virtual environment with PyPI's
-/// opencv-python-headless first on the path); `None`, with the reason printed, when it has
-/// not, which under CI is a broken setup and fails.
+/// [`crate::common::python_with`] for cv2, numpy, PIL.
 fn python_with_opencv() -> Option<String> {
-    let python = "python3".to_string();
-    let ok = Command::new(&python)
-        .args(["-c", "import cv2, numpy"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        return Some(python);
-    }
-    let why = format!("{python} has no cv2/numpy (pip install opencv-python-headless)");
-    assert!(std::env::var_os("CI").is_none(), "{why}");
-    eprintln!("skipped: {why}");
-    None
+    crate::common::python_with(
+        "cv2, numpy, PIL",
+        "pip install opencv-python-headless numpy Pillow",
+    )
 }
 
 /// stereolab's matcher against OpenCV's StereoSGBM (an independent implementation of the same
