@@ -272,8 +272,8 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
         rows.push(with_throughput(r, linear_copy));
     }
     // The frame's background is one color in both eyes, which the AVX2 rows compute once per
-    // run of equal pixels: the same kind on two eyes of pseudo-random colors (no two
-    // neighbours equal) shows the rate of the arithmetic itself.
+    // run of equal pixels: each kind on two eyes of pseudo-random colors (no two neighbours
+    // equal) shows the rate of the arithmetic itself, and Dubois on the scalar loop beside it.
     let kind = AnaglyphKind::DuboisRedCyan;
     let noise = |seed: u64| -> Result<Framebuffer> {
         let mut fb = Framebuffer::new(left.width(), left.height(), [0, 0, 0, 255])?;
@@ -288,7 +288,11 @@ fn anaglyph_rows(left: &Framebuffer, right: &Framebuffer, iters: usize) -> Resul
         Ok(fb)
     };
     let (noise_l, noise_r) = (noise(0x2545_f491_4f6c_dd1d)?, noise(0x9e37_79b9_7f4a_7c15)?);
-    for (simd, label) in [(true, ""), (false, " scalar")] {
+    let noise_runs = AnaglyphKind::ALL
+        .into_iter()
+        .map(|k| (k, true, ""))
+        .chain([(kind, false, " scalar")]);
+    for (kind, simd, label) in noise_runs {
         let (ms, copy) = with_copy(iters, px * 8, &mut || {
             let options = AnaglyphOptions::default();
             if simd {

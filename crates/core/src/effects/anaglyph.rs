@@ -518,6 +518,34 @@ pub fn anaglyph_pixel_with(
     [to_u8(out[0]), to_u8(out[1]), to_u8(out[2]), 255]
 }
 
+/// The guard of the AVX2 loop's fused path for one output channel with coefficients `c`
+/// (`ML`'s row, then `MR`'s): wherever `t = ½ + Σ c_j·v_j`, computed with six fused
+/// multiply-adds on the 8-bit values `v_j`, lies at least this far from every integer, `⌊t⌋`
+/// saturated to 0..255 is [`anaglyph_pixel`]'s byte. With `K = Σ|c_j|` and `u = 2⁻²⁴` (f32's
+/// unit roundoff):
+///
+/// `g = 2·(E_fused + E_pixel)`, `E_fused = 6.0001·u·(255·K + ½)`,
+/// `E_pixel = u·(7.0001·255·K + 511)`.
+///
+/// Each `E` bounds one computation's distance to the exact `t* = ½ + Σ c_j·v_j` (Higham,
+/// *Accuracy and Stability of Numerical Algorithms*, 2nd ed., §3.1: `n` roundings of relative
+/// size `u` multiply by at most `1 + γ_n`, `γ_n = n·u/(1 − n·u)`). The fused chain rounds six
+/// times, each by at most `u` times a partial sum no larger than `255·K + ½`. The pixel
+/// function rounds `v/255` and the product (two per term) and sums left to right (five more):
+/// its sum is within `γ_7·K` of `Σ c_j·v_j/255`, within `γ_7·255·K` after `·255`, whose
+/// rounding adds at most `255·u`, and `+ ½` at most `256·u`. So when `t` is `g > E_fused +
+/// E_pixel` from every integer, `t*` is farther than both `E` from one, and both round down to
+/// the same integer. Where the clamp acts (the sum below 0 or above 1) the byte is 0 or 255,
+/// and `t` is below 1 or above 255, which saturate to the same. The factor 2 is margin.
+pub(crate) fn fused_guard(c: [f32; 6]) -> f32 {
+    let u = 2f64.powi(-24);
+    let k: f64 = c.iter().map(|c| f64::from(c.abs())).sum();
+    let e_fused = 6.0001 * u * (255.0 * k + 0.5);
+    let e_pixel = u * (7.0001 * 255.0 * k + 511.0);
+    // Rounded up, so the f32 guard is no smaller.
+    ((2.0 * (e_fused + e_pixel)) as f32).next_up()
+}
+
 /// A left and a right eye's pixel.
 type PixelPair = ([u8; 4], [u8; 4]);
 
@@ -615,14 +643,16 @@ fn anaglyph_on(
         let avx2 = kernels.avx2();
         #[cfg(not(target_arch = "x86_64"))]
         let _ = avx2;
+        #[cfg(target_arch = "x86_64")]
+        let fused = avx2::Fused::new(&m);
         let fill = |y: usize, out: &mut [MaybeUninit<[u8; 4]>]| {
             let (l, r) = eyes(y, out.len());
             #[cfg(target_arch = "x86_64")]
             if avx2 {
-                // SAFETY: `avx2::row` requires AVX2 (its only safety condition), which
-                // `Kernels::avx2` found on this CPU. The same bytes as the loop below
+                // SAFETY: `avx2::row` requires AVX2 and FMA (its only safety condition),
+                // which `Kernels::avx2` found on this CPU. The same bytes as the loop below
                 // (`avx2_rows_match_anaglyph_pixel`).
-                unsafe { avx2::row(&m, l, r, out) };
+                unsafe { avx2::row(&m, &fused, l, r, out) };
                 return;
             }
             for (out, (l, r)) in out.iter_mut().zip(l.iter().zip(r)) {
@@ -672,6 +702,45 @@ mod tests {
                             right.color[i],
                             options,
                         );
+                        assert_eq!(px.0, want, "{kind:?} {options:?} {kernels:?}: pixel {i}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// On random colours (no two neighbours equal, so no result is reused), every kind with
+    /// every option gives `anaglyph_pixel_with`'s bytes on both loops, on a width that ends
+    /// mid-vector.
+    #[test]
+    fn random_colors_give_anaglyph_pixel_with_every_option() {
+        let (w, h) = (203, 5);
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut eye = || {
+            let mut fb = Framebuffer::new(w, h, [0, 0, 0, 255]).unwrap();
+            for c in &mut fb.color {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let b = state.to_le_bytes();
+                *c = [b[0], b[1], b[2], b[3]];
+            }
+            fb
+        };
+        let (left, right) = (eye(), eye());
+        for kind in AnaglyphKind::ALL.into_iter().chain(AnaglyphKind::THREE_JS) {
+            for bits in 0..8 {
+                let options = AnaglyphOptions {
+                    linear_light: bits & 1 != 0,
+                    swap_eyes: bits & 2 != 0,
+                    anti_rivalry: bits & 4 != 0,
+                };
+                let (a, b) = options.eyes(&left, &right);
+                for kernels in [Kernels::Avx2, Kernels::Scalar] {
+                    let img = anaglyph_on(&left, &right, kind, options, kernels).unwrap();
+                    for (i, px) in img.pixels().enumerate() {
+                        let want =
+                            anaglyph_pixel_with(&kind.matrices(), a.color[i], b.color[i], options);
                         assert_eq!(px.0, want, "{kind:?} {options:?} {kernels:?}: pixel {i}");
                     }
                 }
