@@ -910,7 +910,9 @@ fn pairs_made_outside_stereolab_are_named_by_their_mistakes() {
     let pictures = dir.join("window_out");
     let (code, _) = inspect("window", &["--out", pictures.to_str().unwrap()]);
     assert_eq!(code, Some(0));
-    let img = image::open(pictures.join("inspect.png")).unwrap().to_rgba8();
+    let img = image::open(pictures.join("inspect.png"))
+        .unwrap()
+        .to_rgba8();
     assert_eq!(img.width(), 2 * 480 + 8);
     let yellow = |x0: u32, x1: u32| {
         (x0..x1)
