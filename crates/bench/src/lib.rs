@@ -5,6 +5,7 @@ pub mod accuracy;
 mod chromadepth;
 pub mod cost;
 pub mod depth;
+pub mod doc;
 mod finalize;
 #[cfg(feature = "gpu")]
 mod gpu;
