@@ -1,8 +1,8 @@
 //! The `cost` group: how the frame's time grows with the work, on the CPU and on lavapipe.
 //!
 //! Each point is the CPU stereo pair + Dubois anaglyph (`render`, then `produce`) beside the
-//! plain wgpu program of `gpu_oneshot.rs` (both eyes, the anaglyph pass,
-//! one submission, one readback) on the same scene, the two timed in turns:
+//! plain wgpu program of `gpu_oneshot.rs` (both eyes, the anaglyph pass, one submission, one
+//! readback) on the same scene, the two timed in turns:
 //! - **triangles**: a height-field grid of 10 000 … 4 000 000 triangles at 1024×768 (the
 //!   pixels stay the same);
 //! - **pixels**: the real model at 512² … 4096² (the triangles stay the same).

@@ -131,6 +131,20 @@ fn thread_pairs(rows: &[Row]) -> Vec<(String, &Row, &Row)> {
 /// One cost point: its setting, its `cpu` row and its measured `wgpu` row.
 type CostPoint<'a> = (String, &'a Row, Option<&'a Row>);
 
+/// The register-only loop's speed-up in a 2-thread row's note (`scaling.rs`).
+fn yardstick(two: &Row) -> Option<f64> {
+    number_after(&two.note, "in the same turns: ")
+}
+
+/// The number just after `marker` in `note`.
+fn number_after(note: &str, marker: &str) -> Option<f64> {
+    let tail = &note[note.find(marker)? + marker.len()..];
+    tail.split(|c: char| c != '.' && !c.is_ascii_digit())
+        .next()?
+        .parse()
+        .ok()
+}
+
 /// The cost points of `knob`.
 fn cost_points<'a>(rows: &'a [Row], knob: &str) -> Vec<CostPoint<'a>> {
     rows.iter()
@@ -346,12 +360,8 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
         }
     }
     for (what, one, two) in thread_pairs(rows) {
-        let yard = two
-            .note
-            .split("in the same turns: ")
-            .nth(1)
-            .and_then(|t| t.split(|c: char| c != '.' && !c.is_ascii_digit()).next())
-            .map(|y| format!(" (a register-only loop in the same turns: {y})"))
+        let yard = yardstick(two)
+            .map(|y| format!(" (a register-only loop in the same turns: {y:.2})"))
             .unwrap_or_default();
         let _ = writeln!(
             s,
@@ -449,10 +459,20 @@ pub fn readme_paragraph(rows: &[Row], run: &RunInfo) -> String {
         .iter()
         .filter_map(|(_, hz, full, _)| full.map(|f| 1e3 / f.ms / hz))
         .fold(f64::INFINITY, f64::min);
-    let threads: Vec<String> = thread_pairs(rows)
+    let pairs = thread_pairs(rows);
+    let mut threads: Vec<String> = pairs
         .iter()
         .map(|(w, a, b)| format!("{} {:.2}", w.split(',').next().unwrap_or(w), a.ms / b.ms))
         .collect();
+    let yards: Vec<f64> = pairs.iter().filter_map(|p| yardstick(p.2)).collect();
+    if !yards.is_empty() {
+        let lo = yards.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = yards.iter().copied().fold(0.0, f64::max);
+        threads.push(format!(
+            "a register-only loop timed in the same turns {lo:.2}–{hi:.2} (what the machine's \
+             second core gave)"
+        ));
+    }
     let mut s = format!(
         "On a shared 2-core machine (load average {} at the start), the CPU stereo pair + Dubois \
          anaglyph takes {r} of a plain wgpu program's time on lavapipe",
@@ -584,7 +604,13 @@ mod tests {
                 0.5,
             ),
         ];
+        let mut rows = rows;
+        rows[5].note = "speed-up = 1.60; a register-only loop in the same turns: 1.97".into();
         let s = section(&rows, &run(), Some("p.png"));
+        assert!(
+            s.contains("(a register-only loop in the same turns: 1.97)"),
+            "{s}"
+        );
         assert!(s.contains("= **0.25** | ≤ 0.5"), "{s}");
         assert!(
             s.contains("real model at 4096×4096 | 30.00 ms / — = **—**"),
