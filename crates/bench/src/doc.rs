@@ -371,6 +371,12 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
             one.ms / two.ms
         );
     }
+    if let Some(st) = rows
+        .iter()
+        .find(|r| r.area == "scaling" && r.knob == "stages")
+    {
+        let _ = writeln!(s, "\nStage by stage ({}): {}.", st.setting, st.note);
+    }
     if let Some(w) = rows
         .iter()
         .find(|r| r.area == "scaling" && r.knob == "work split")

@@ -175,6 +175,7 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             ),
         ));
     }
+    rows.push(sirds_stages(&pool_1, &pool_2, iters.max(300))?);
     rows.push(work_split(scene)?);
     Ok(rows)
 }
@@ -296,6 +297,75 @@ fn work_split(scene: &Scene) -> Result<Row> {
             predict(4),
             predict(8),
             predict(16)
+        ),
+    ))
+}
+
+/// Table 1's row 1 stage by stage on `pool_1` and `pool_2` (median of `frames` frames each):
+/// the depth pass, the depth range, the strip geometry (one loop over the vertices, serial)
+/// and the strips; the note gives each stage's speed-up and the serial stage's share.
+fn sirds_stages(
+    pool_1: &rayon::ThreadPool,
+    pool_2: &rayon::ThreadPool,
+    frames: usize,
+) -> Result<Row> {
+    let (w, h, tris, k, _) = TABLE_1[0];
+    let s = table_scene(w, h, tris, k)?;
+    let center = StereoRig::center(&s.camera, s.aspect())?;
+    let d = s.sirds.geometry.to_pixels()?;
+    let stages = |pool: &rayon::ThreadPool| -> Result<[f64; 4]> {
+        pool.install(|| {
+            let mut t: Vec<Vec<f64>> = (0..4).map(|_| Vec::with_capacity(frames)).collect();
+            for i in 0..=frames {
+                let t0 = Instant::now();
+                let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
+                let t1 = Instant::now();
+                let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
+                let t2 = Instant::now();
+                let g = StripGeometry::new(&s.strip_objects(), &center, &range, &d, false);
+                let t3 = Instant::now();
+                std::hint::black_box(per_vertex(
+                    &g,
+                    w,
+                    h,
+                    &d,
+                    &s.sirds.pattern,
+                    &s.sirds.per_vertex,
+                    false,
+                )?);
+                let t4 = Instant::now();
+                if i > 0 {
+                    for (v, (a, b)) in t.iter_mut().zip([(t0, t1), (t1, t2), (t2, t3), (t3, t4)]) {
+                        v.push((b - a).as_secs_f64() * 1e3);
+                    }
+                }
+            }
+            let mut m = [0.0; 4];
+            for (m, mut v) in m.iter_mut().zip(t) {
+                v.sort_by(f64::total_cmp);
+                *m = v[v.len() / 2];
+            }
+            Ok(m)
+        })
+    };
+    let one = stages(pool_1)?;
+    let two = stages(pool_2)?;
+    let names = ["depth pass", "depth range", "strip geometry", "strips"];
+    let parts: Vec<String> = names
+        .iter()
+        .zip(one.iter().zip(&two))
+        .map(|(n, (a, b))| format!("{n} {a:.3} -> {b:.3} ms ({:.2}x)", a / b))
+        .collect();
+    let (sum_1, sum_2) = (one.iter().sum::<f64>(), two.iter().sum::<f64>());
+    Ok(row(
+        "stages",
+        format!("sirds, Table 1 {w}x{h} {tris} tris k={k}, 1 -> 2 threads"),
+        sum_2,
+        format!(
+            "{}; sum of medians {sum_1:.3} -> {sum_2:.3} ms; the serial strip geometry is \
+             {:.1}% of the 1-thread frame",
+            parts.join(", "),
+            100.0 * one[2] / sum_1
         ),
     ))
 }
