@@ -51,13 +51,13 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::internal("bench scaling", format!("thread pool: {e}")))
 }
 
-/// Median ms of `f` and of [`yardstick`] inside `pool`, timed in turns (blocks of 10, at least
-/// `iters` runs of each).
+/// Median ms of `f`, of [`yardstick`] and of [`wide_yardstick`] inside `pool`, timed in turns
+/// (blocks of 10, at least `iters` runs of each).
 fn on_pool(
     pool: &rayon::ThreadPool,
     iters: usize,
     f: &(dyn Fn() -> bool + Sync),
-) -> Result<(f64, f64)> {
+) -> Result<(f64, f64, f64)> {
     const BLOCK: usize = 10;
     let t = pool.install(|| {
         interleaved_medians(
@@ -72,10 +72,14 @@ fn on_pool(
                     std::hint::black_box(yardstick());
                     Ok(())
                 },
+                &mut || {
+                    std::hint::black_box(wide_yardstick());
+                    Ok(())
+                },
             ],
         )
     })?;
-    Ok((t[0], t[1]))
+    Ok((t[0], t[1], t[2]))
 }
 
 /// Work that scales by construction: two halves of a register-only loop (no memory traffic,
@@ -91,6 +95,26 @@ fn yardstick() -> u64 {
             x ^= x << 17;
         }
         x
+    };
+    let (a, b) = rayon::join(half, half);
+    a ^ b
+}
+
+/// [`yardstick`] with eight independent chains instead of one: it keeps the core's execution
+/// units busy instead of waiting on one chain's latency. Two hardware threads of one core
+/// (SMT siblings) share those units, so this loop scales on two cores but hardly on two
+/// siblings, where the one-chain loop scales on both.
+fn wide_yardstick() -> u64 {
+    let half = || {
+        let mut x: [u64; 8] = std::hint::black_box(std::array::from_fn(|i| 0x9E37_79B9 + i as u64));
+        for _ in 0..50_000 {
+            for v in &mut x {
+                *v ^= *v << 13;
+                *v ^= *v >> 7;
+                *v ^= *v << 17;
+            }
+        }
+        x.iter().fold(0, |a, v| a ^ v)
     };
     let (a, b) = rayon::join(half, half);
     a ^ b
@@ -155,8 +179,8 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         // machine (with 40, the speed-ups read 1.1–1.5 where 300 give 1.9–2.0 in the same
         // hour), and short frames need many to steady the median.
         let n = iters.max(300);
-        let (one, yard_one) = on_pool(&pool_1, n, f)?;
-        let (two, yard_two) = on_pool(&pool_2, n, f)?;
+        let (one, yard_one, wide_one) = on_pool(&pool_1, n, f)?;
+        let (two, yard_two, wide_two) = on_pool(&pool_2, n, f)?;
         rows.push(row(
             "threads",
             format!("{what}, {setting}, 1 thread"),
@@ -169,9 +193,10 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             two,
             format!(
                 "speed-up 1 -> 2 threads = {:.2} (goal >= 1.8; {cores} cores seen); \
-                 a register-only loop in the same turns: {:.2}",
+                 a register-only loop in the same turns: {:.2}, with eight chains: {:.2}",
                 one / two,
-                yard_one / yard_two
+                yard_one / yard_two,
+                wide_one / wide_two
             ),
         ));
     }
