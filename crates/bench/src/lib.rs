@@ -3,7 +3,9 @@
 
 pub mod accuracy;
 mod chromadepth;
+pub mod cost;
 pub mod depth;
+pub mod doc;
 mod finalize;
 #[cfg(feature = "gpu")]
 mod gpu;
@@ -57,13 +59,13 @@ pub struct BenchOptions {
     /// Image height.
     pub height: u32,
     /// Run only these groups (`stereo`, `raster`, `depth`, `chromadepth`, `finalize`, `sirds`,
-    /// `scaling`, `gpu`);
+    /// `scaling`, `gpu`, `cost`);
     /// empty: all.
     pub only: Vec<String>,
 }
 
 /// The benchmark groups, in the order they run.
-pub(crate) const GROUPS: [&str; 8] = [
+pub(crate) const GROUPS: [&str; 9] = [
     "stereo",
     "raster",
     "depth",
@@ -72,6 +74,7 @@ pub(crate) const GROUPS: [&str; 8] = [
     "sirds",
     "scaling",
     "gpu",
+    "cost",
 ];
 
 impl Default for BenchOptions {
@@ -177,6 +180,9 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     if want("gpu") {
         rows.extend(gpu_oneshot::rows(&scene, iters)?);
         rows.extend(gpu::rows(&scene, iters)?);
+    }
+    if want("cost") {
+        rows.extend(cost::rows(&scene, iters)?);
     }
     Ok(rows)
 }

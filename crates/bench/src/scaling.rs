@@ -1,8 +1,10 @@
 //! The `scaling` group: how the work spreads over threads and grows with its size, each as a
 //! ratio measured in the same run.
 //!
-//! - threads: the stereo pair of the real model and the SIRDS paper's Table 1 frame on a pool
-//!   of 1 thread and one of 2 (the speed-up; the bytes are the same on any count);
+//! - threads: the stereo pair of the real model, the pair + Dubois anaglyph, the anaglyph
+//!   alone and the SIRDS paper's Table 1 frame on a pool of 1 thread and one of 2 (the
+//!   speed-up; the bytes are the same on any count), and how the pair's work splits over the
+//!   bands (the speed-up that split allows on more threads);
 //! - image size: the stereo pair at 512² … 4096², as nanoseconds per pixel (flat or falling
 //!   when the time grows no faster than the pixels);
 //! - triangle count: the stereo pair of a height-field grid of 1 000 … 1 000 000 triangles at
@@ -12,13 +14,22 @@
 //! pixel and the cost per triangle stay bounded: the rows' notes give both, and the ratio of
 //! the largest to the smallest case's cost per unit.
 
-use super::{Row, median_ms};
+use std::time::Instant;
+
+use super::{Row, interleaved_medians, median_ms};
 use stereolab::fixtures::{TABLE_1, table_scene};
+use stereolab::output::produce;
 use stereolab::plan::{Output, Plan, Shading};
 use stereolab::render::{render, render_view};
 use stereolab::scene::Scene;
-use stereolab_core::{Error, Result, StereoRig, depth_range};
+use stereolab_core::{
+    AnaglyphKind, BlinnPhong, Error, Framebuffer, RasterBand, Result, StereoRig, depth_range,
+    setup_triangles, traverse,
+};
 use stereolab_core::{StripGeometry, per_vertex};
+
+/// Rows per band of the rasterizer (`stereolab::memory::BAND_ROWS`).
+const BAND_ROWS: u32 = stereolab::memory::BAND_ROWS;
 
 fn row(knob: &str, setting: impl Into<String>, ms: f64, note: impl Into<String>) -> Row {
     Row {
@@ -32,13 +43,81 @@ fn row(knob: &str, setting: impl Into<String>, ms: f64, note: impl Into<String>)
     }
 }
 
-/// Median ms of `f` inside a rayon pool of `threads` threads.
-fn on_threads(threads: usize, iters: usize, f: &(dyn Fn() -> bool + Sync)) -> Result<f64> {
-    let pool = rayon::ThreadPoolBuilder::new()
+/// A rayon pool of `threads` threads.
+fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
-        .map_err(|e| Error::internal("bench scaling", format!("thread pool: {e}")))?;
-    Ok(pool.install(|| median_ms(iters, f)))
+        .map_err(|e| Error::internal("bench scaling", format!("thread pool: {e}")))
+}
+
+/// Median ms of `f`, of [`yardstick`] and of [`wide_yardstick`] inside `pool`, timed in turns
+/// (blocks of 10, at least `iters` runs of each).
+fn on_pool(
+    pool: &rayon::ThreadPool,
+    iters: usize,
+    f: &(dyn Fn() -> bool + Sync),
+) -> Result<(f64, f64, f64)> {
+    const BLOCK: usize = 10;
+    let t = pool.install(|| {
+        interleaved_medians(
+            iters.div_ceil(BLOCK),
+            BLOCK,
+            &mut [
+                &mut || {
+                    std::hint::black_box(f());
+                    Ok(())
+                },
+                &mut || {
+                    std::hint::black_box(yardstick());
+                    Ok(())
+                },
+                &mut || {
+                    std::hint::black_box(wide_yardstick());
+                    Ok(())
+                },
+            ],
+        )
+    })?;
+    Ok((t[0], t[1], t[2]))
+}
+
+/// Work that scales by construction: two halves of a register-only loop (no memory traffic,
+/// no shared data) under `rayon::join`, about a millisecond on one thread. Its speed-up on the
+/// same pools, in the same turns as a row, is how much of the second core the machine gave
+/// during that row.
+fn yardstick() -> u64 {
+    let half = || {
+        let mut x = std::hint::black_box(0x9E37_79B9_7F4A_7C15u64);
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+        }
+        x
+    };
+    let (a, b) = rayon::join(half, half);
+    a ^ b
+}
+
+/// [`yardstick`] with eight independent chains instead of one: it keeps the core's execution
+/// units busy instead of waiting on one chain's latency. Two hardware threads of one core
+/// (SMT siblings) share those units, so this loop scales on two cores but hardly on two
+/// siblings, where the one-chain loop scales on both.
+fn wide_yardstick() -> u64 {
+    let half = || {
+        let mut x: [u64; 8] = std::hint::black_box(std::array::from_fn(|i| 0x9E37_79B9 + i as u64));
+        for _ in 0..50_000 {
+            for v in &mut x {
+                *v ^= *v << 13;
+                *v ^= *v >> 7;
+                *v ^= *v << 17;
+            }
+        }
+        x.iter().fold(0, |a, v| a ^ v)
+    };
+    let (a, b) = rayon::join(half, half);
+    a ^ b
 }
 
 /// The stereo pair (Blinn-Phong, both eyes) of `scene`: `true` when it rendered.
@@ -57,10 +136,12 @@ pub fn rows(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// 1 thread against 2 on the stereo pair and on Table 1's first row (depth pass + strips).
+/// 1 thread against 2 on the stereo pair, the pair + Dubois anaglyph, the anaglyph alone (a
+/// finalize row, on a rendered pair) and Table 1's first row (depth pass + strips); then how
+/// the pair's work splits over the bands ([`work_split`]).
 fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     // Once untimed, so that an error surfaces instead of a fast failure being timed.
-    render(scene, &Plan::new(&[Output::Left, Output::Right]))?;
+    let frame = render(scene, &Plan::new(&[DUBOIS]))?;
     let (w, h, tris, k, _) = TABLE_1[0];
     let s = table_scene(w, h, tris, k)?;
     let center = StereoRig::center(&s.camera, s.aspect())?;
@@ -73,8 +154,16 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     };
     sirds()?;
     let size = format!("{}x{}", scene.width, scene.height);
-    let cases: [(&str, String, &(dyn Fn() -> bool + Sync)); 2] = [
+    let cases: [(&str, String, &(dyn Fn() -> bool + Sync)); 4] = [
         ("stereo pair", format!("real model {size}"), &|| pair(scene)),
+        ("pair + Dubois", format!("real model {size}"), &|| {
+            render(scene, &Plan::new(&[DUBOIS])).is_ok_and(|f| produce(DUBOIS, &f, scene).is_ok())
+        }),
+        (
+            "finalize Dubois",
+            format!("anaglyph of the rendered pair {size}"),
+            &|| produce(DUBOIS, &frame, scene).is_ok(),
+        ),
         (
             "sirds",
             format!("Table 1 {w}x{h} {tris} tris k={k}"),
@@ -82,14 +171,16 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         ),
     ];
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    // The same two pools for every row.
+    let (pool_1, pool_2) = (pool(1)?, pool(2)?);
     let mut rows = Vec::new();
     for (what, setting, f) in cases {
         // At least 300 frames: a fresh pool's first tens of frames run slow on this shared
         // machine (with 40, the speed-ups read 1.1–1.5 where 300 give 1.9–2.0 in the same
         // hour), and short frames need many to steady the median.
         let n = iters.max(300);
-        let one = on_threads(1, n, f)?;
-        let two = on_threads(2, n, f)?;
+        let (one, yard_one, wide_one) = on_pool(&pool_1, n, f)?;
+        let (two, yard_two, wide_two) = on_pool(&pool_2, n, f)?;
         rows.push(row(
             "threads",
             format!("{what}, {setting}, 1 thread"),
@@ -101,12 +192,215 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             format!("{what}, {setting}, 2 threads"),
             two,
             format!(
-                "speed-up 1 -> 2 threads = {:.2} (goal >= 1.8; {cores} cores seen)",
-                one / two
+                "speed-up 1 -> 2 threads = {:.2} (goal >= 1.8; {cores} cores seen); \
+                 a register-only loop in the same turns: {:.2}, with eight chains: {:.2}",
+                one / two,
+                yard_one / yard_two,
+                wide_one / wide_two
             ),
         ));
     }
+    rows.push(sirds_stages(&pool_1, &pool_2, iters.max(300))?);
+    rows.push(work_split(scene)?);
     Ok(rows)
+}
+
+/// The frame of the pair + Dubois rows.
+const DUBOIS: Output = Output::Anaglyph(AnaglyphKind::DuboisRedCyan);
+
+/// How the stereo pair's raster work splits: each eye's bands of [`BAND_ROWS`] rows, each
+/// band's triangles traversed alone on this thread (the scalar reference
+/// [`traverse`](stereolab_core::traverse), whose costs stand in for the fast path's), and the
+/// serial list-making per eye, give a makespan for `P` threads (longest bands first onto the
+/// least loaded thread, both eyes' bands in one pool; the setup and the clears divided by
+/// `P`): the speed-up that the split allows, not a measurement on `P` cores.
+fn work_split(scene: &Scene) -> Result<Row> {
+    let eyes = scene
+        .rig
+        .eyes_for_image(&scene.camera, scene.width, scene.height)?;
+    let (w, h) = (scene.width, scene.height);
+    let opts = scene.raster;
+    let mut bands_ms: Vec<f64> = Vec::new();
+    let (mut setup_ms, mut list_ms, mut clear_ms) = (0.0, 0.0f64, 0.0);
+    pool(1)?.install(|| -> Result<()> {
+        for m in &eyes {
+            let t = Instant::now();
+            let fb = Framebuffer::new(w, h, scene.background)?;
+            clear_ms += ms_since(t);
+            let (mut color, mut depth) = (fb.color().to_vec(), fb.depth().to_vec());
+            let mut eye_list = 0.0;
+            for o in &scene.objects {
+                let mesh = &o.mesh;
+                let shader = BlinnPhong::new(
+                    &mesh.positions,
+                    &mesh.normals,
+                    o.model,
+                    m.view,
+                    m.projection,
+                    o.color,
+                    scene.light,
+                );
+                let t = Instant::now();
+                let (setups, _) =
+                    setup_triangles(&mesh.triangles, mesh.positions.len(), &shader, w, h, &opts);
+                setup_ms += ms_since(t);
+                let t = Instant::now();
+                let mut lists = vec![Vec::new(); h.div_ceil(BAND_ROWS) as usize];
+                for tri in &setups {
+                    let (r0, r1) = tri.rows();
+                    for l in &mut lists[(r0 / BAND_ROWS) as usize..=(r1 / BAND_ROWS) as usize] {
+                        l.push(tri);
+                    }
+                }
+                eye_list += ms_since(t);
+                let stride = (w * BAND_ROWS) as usize;
+                for (b, ((color, depth), list)) in color
+                    .chunks_mut(stride)
+                    .zip(depth.chunks_mut(stride))
+                    .zip(&lists)
+                    .enumerate()
+                {
+                    let mut band = RasterBand {
+                        width: w,
+                        x0: 0,
+                        y0: b as u32 * BAND_ROWS,
+                        color,
+                        depth,
+                    };
+                    // The least of a few runs from a cleared band: one run of a band is tens
+                    // of microseconds, which a shared machine's hiccup can double.
+                    let mut least = f64::INFINITY;
+                    for _ in 0..BAND_RUNS {
+                        band.color.fill(scene.background);
+                        band.depth.fill(1.0);
+                        let t = Instant::now();
+                        for tri in list {
+                            traverse(tri, &shader, &mut band, &opts);
+                        }
+                        least = least.min(ms_since(t));
+                    }
+                    bands_ms.push(least);
+                }
+            }
+            list_ms = list_ms.max(eye_list);
+        }
+        Ok(())
+    })?;
+    let total: f64 = bands_ms.iter().sum();
+    let largest = bands_ms.iter().copied().fold(0.0, f64::max);
+    let predict = |p: usize| {
+        let mut load = vec![0.0f64; p];
+        let mut sorted = bands_ms.clone();
+        sorted.sort_by(|a, b| b.total_cmp(a));
+        for b in sorted {
+            let i = (0..p)
+                .min_by(|&i, &j| load[i].total_cmp(&load[j]))
+                .unwrap_or(0);
+            load[i] += b;
+        }
+        let makespan = load.iter().copied().fold(0.0, f64::max);
+        let serial = list_ms;
+        let one = setup_ms + clear_ms + total + 2.0 * serial;
+        one / ((setup_ms + clear_ms) / p as f64 + serial + makespan)
+    };
+    let serial_share = 2.0 * list_ms / (setup_ms + clear_ms + total + 2.0 * list_ms);
+    Ok(row(
+        "work split",
+        format!(
+            "stereo pair real model {w}x{h}: {} bands of {BAND_ROWS} rows",
+            bands_ms.len()
+        ),
+        setup_ms + clear_ms + total + 2.0 * list_ms,
+        format!(
+            "1 thread, scalar traversal: bands {total:.2} ms (largest {:.1}% of them), setup \
+             {setup_ms:.2} ms, clears {clear_ms:.2} ms, band lists (serial, per eye) \
+             {list_ms:.2} ms = {:.1}% serial; the split allows 2 / 4 / 8 / 16 threads: \
+             {:.2} / {:.2} / {:.2} / {:.2}x",
+            100.0 * largest / total.max(1e-12),
+            100.0 * serial_share,
+            predict(2),
+            predict(4),
+            predict(8),
+            predict(16)
+        ),
+    ))
+}
+
+/// Table 1's row 1 stage by stage on `pool_1` and `pool_2` (median of `frames` frames each):
+/// the depth pass, the depth range, the strip geometry (one loop over the vertices, serial)
+/// and the strips; the note gives each stage's speed-up and the serial stage's share.
+fn sirds_stages(
+    pool_1: &rayon::ThreadPool,
+    pool_2: &rayon::ThreadPool,
+    frames: usize,
+) -> Result<Row> {
+    let (w, h, tris, k, _) = TABLE_1[0];
+    let s = table_scene(w, h, tris, k)?;
+    let center = StereoRig::center(&s.camera, s.aspect())?;
+    let d = s.sirds.geometry.to_pixels()?;
+    let stages = |pool: &rayon::ThreadPool| -> Result<[f64; 4]> {
+        pool.install(|| {
+            let mut t: Vec<Vec<f64>> = (0..4).map(|_| Vec::with_capacity(frames)).collect();
+            for i in 0..=frames {
+                let t0 = Instant::now();
+                let (fb, _) = render_view(&s, &center, Shading::DepthOnly)?;
+                let t1 = Instant::now();
+                let range = depth_range(&s.sirds, &fb, s.camera.near, s.camera.far)?;
+                let t2 = Instant::now();
+                let g = StripGeometry::new(&s.strip_objects(), &center, &range, &d, false);
+                let t3 = Instant::now();
+                std::hint::black_box(per_vertex(
+                    &g,
+                    w,
+                    h,
+                    &d,
+                    &s.sirds.pattern,
+                    &s.sirds.per_vertex,
+                    false,
+                )?);
+                let t4 = Instant::now();
+                if i > 0 {
+                    for (v, (a, b)) in t.iter_mut().zip([(t0, t1), (t1, t2), (t2, t3), (t3, t4)]) {
+                        v.push((b - a).as_secs_f64() * 1e3);
+                    }
+                }
+            }
+            let mut m = [0.0; 4];
+            for (m, mut v) in m.iter_mut().zip(t) {
+                v.sort_by(f64::total_cmp);
+                *m = v[v.len() / 2];
+            }
+            Ok(m)
+        })
+    };
+    let one = stages(pool_1)?;
+    let two = stages(pool_2)?;
+    let names = ["depth pass", "depth range", "strip geometry", "strips"];
+    let parts: Vec<String> = names
+        .iter()
+        .zip(one.iter().zip(&two))
+        .map(|(n, (a, b))| format!("{n} {a:.3} -> {b:.3} ms ({:.2}x)", a / b))
+        .collect();
+    let (sum_1, sum_2) = (one.iter().sum::<f64>(), two.iter().sum::<f64>());
+    Ok(row(
+        "stages",
+        format!("sirds, Table 1 {w}x{h} {tris} tris k={k}, 1 -> 2 threads"),
+        sum_2,
+        format!(
+            "{}; sum of medians {sum_1:.3} -> {sum_2:.3} ms; the serial strip geometry is \
+             {:.1}% of the 1-thread frame",
+            parts.join(", "),
+            100.0 * one[2] / sum_1
+        ),
+    ))
+}
+
+/// Runs of each band in [`work_split`] (the least is kept).
+const BAND_RUNS: usize = 5;
+
+/// Milliseconds since `t`.
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
 }
 
 /// The stereo pair of the real model at 512² … 4096²: ns per pixel, and against 512².

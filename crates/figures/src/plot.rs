@@ -4,7 +4,7 @@
 //! plotted by building one; [`pareto_front`] marks the settings no other setting beats on both
 //! error and time, and [`knob_plot`] draws it with this module's [`Canvas`].
 
-use super::canvas::{Canvas, GRAY, INK, LABEL, Rgb, SMALL, nice_step, tick_label};
+use super::canvas::{Axes, Canvas, GRAY, INK, LABEL, Rgb, SMALL, nice_step, tick_label};
 use stereolab_core::{Result, TextAlign, text_width};
 
 /// One measured setting of a knob.
@@ -394,4 +394,143 @@ mod tests {
         assert_eq!(time_scale(2e-4), ("µs", 1e-6));
         assert_eq!(time_scale(3.0), ("s", 1.0));
     }
+}
+
+/// One measured curve of a [`log_log`] panel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Its name in the legend (`CPU pair + Dubois`).
+    pub label: String,
+    /// Its color.
+    pub rgb: Rgb,
+    /// (x, y) points, both positive; others are left out.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// One panel of a [`log_log`] figure: its curves over a shared title and axis names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Panel {
+    /// Title above the panel.
+    pub title: String,
+    /// What x counts (`triangles per pair`).
+    pub x_label: String,
+    /// What y measures, with its unit (`median time (ms)`).
+    pub y_label: String,
+    /// The curves.
+    pub series: Vec<Series>,
+}
+
+/// A decade's tick value as a reader writes it: 1k, 10k, 1M, 0.1, 1, 10, 100.
+fn decade_label(d: i32) -> String {
+    match d {
+        d if d >= 9 => format!("{}G", 10i64.pow((d - 9) as u32)),
+        d if d >= 6 => format!("{}M", 10i64.pow((d - 6) as u32)),
+        d if d >= 3 => format!("{}k", 10i64.pow((d - 3) as u32)),
+        d if d >= 0 => 10i64.pow(d as u32).to_string(),
+        d => format!("{}", 10f64.powi(d)),
+    }
+}
+
+/// Panels side by side, each with both axes by decades (a cost that grows in proportion to
+/// the work is a line of slope 1), dots at the measured points joined by lines, a legend per
+/// panel, and `footer` in gray below.
+///
+/// # Errors
+/// Only a canvas failure (a bug).
+pub fn log_log(panels: &[Panel], footer: &str) -> Result<Canvas> {
+    let (pw, ph) = (450.0f32, 380.0f32);
+    let mut c = Canvas::new((pw * panels.len().max(1) as f32) as u32, ph as u32 + 40)?;
+    for (i, panel) in panels.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = panel
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().copied())
+            .filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite())
+            .collect();
+        let span = |f: &dyn Fn(&(f64, f64)) -> f64| {
+            let lo = pts.iter().map(f).fold(f64::INFINITY, f64::min);
+            let hi = pts.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+            if lo.is_finite() {
+                (
+                    lo.log10().floor() as i32,
+                    hi.log10().ceil().max(lo.log10().floor() + 1.0) as i32,
+                )
+            } else {
+                (0, 1)
+            }
+        };
+        let (x0, x1) = span(&|p| p.0);
+        let (y0, y1) = span(&|p| p.1);
+        let left = i as f32 * pw + 80.0;
+        let a = Axes {
+            frame: (left, 40.0, left + pw - 110.0, ph - 60.0),
+            x: (f64::from(x0), f64::from(x1)),
+            y: (f64::from(y0), f64::from(y1)),
+        };
+        let (l, t, r, b) = a.frame;
+        for d in x0..=x1 {
+            let (x, _) = a.px(f64::from(d), a.y.0);
+            c.line((x, t), (x, b), (232, 232, 232), 1.0);
+            c.line((x, b), (x, b + 5.0), INK, 1.0);
+            c.text(x, b + 7.0, SMALL, &decade_label(d), INK, TextAlign::Center);
+        }
+        for d in y0..=y1 {
+            let (_, y) = a.px(a.x.0, f64::from(d));
+            c.line((l, y), (r, y), (232, 232, 232), 1.0);
+            c.line((l - 5.0, y), (l, y), INK, 1.0);
+            c.text(
+                l - 8.0,
+                y - SMALL * 0.6,
+                SMALL,
+                &decade_label(d),
+                INK,
+                TextAlign::Right,
+            );
+        }
+        c.rect((l, t), (r, b), INK, 1.0);
+        c.text(
+            (l + r) / 2.0,
+            b + 26.0,
+            LABEL,
+            &panel.x_label,
+            INK,
+            TextAlign::Center,
+        );
+        c.vertical_text(l - 60.0, (t + b) / 2.0, LABEL, &panel.y_label, INK);
+        c.text(
+            (l + r) / 2.0,
+            t - 26.0,
+            LABEL,
+            &panel.title,
+            INK,
+            TextAlign::Center,
+        );
+        for s in &panel.series {
+            let p: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite())
+                .map(|(x, y)| (x.log10(), y.log10()))
+                .collect();
+            a.curve(&mut c, &p, s.rgb, 2.0);
+            for q in &p {
+                c.dot(a.px(q.0, q.1), 4.0, s.rgb);
+            }
+        }
+        let entries: Vec<(&str, Rgb)> = panel
+            .series
+            .iter()
+            .map(|s| (s.label.as_str(), s.rgb))
+            .collect();
+        a.legend(&mut c, &entries, false);
+    }
+    c.text(
+        c.width() / 2.0,
+        ph + 14.0,
+        SMALL,
+        footer,
+        GRAY,
+        TextAlign::Center,
+    );
+    Ok(c)
 }
