@@ -88,15 +88,16 @@ pub const MAX_COLOURS: usize = 256;
 pub fn candidates(layout: Layout) -> Vec<AnaglyphKind> {
     let mut kinds: Vec<AnaglyphKind> = match layout {
         Layout::AnaglyphRedCyan => {
-            let mut v = vec![
-                AnaglyphKind::True,
-                AnaglyphKind::Gray,
-                AnaglyphKind::Color,
-                AnaglyphKind::HalfColor,
-                AnaglyphKind::Optimized,
-                AnaglyphKind::DuboisRedCyan,
-                AnaglyphKind::DuboisRedCyanLcd,
-            ];
+            // stereolab's own red-cyan kinds: all but the two other glasses' Dubois.
+            let mut v: Vec<AnaglyphKind> = AnaglyphKind::ALL
+                .into_iter()
+                .filter(|k| {
+                    !matches!(
+                        k,
+                        AnaglyphKind::DuboisGreenMagenta | AnaglyphKind::DuboisAmberBlue
+                    )
+                })
+                .collect();
             for glasses in [AnaglyphGlasses::RedCyan, AnaglyphGlasses::MagentaCyan] {
                 v.extend(
                     AnaglyphMethod::ALL

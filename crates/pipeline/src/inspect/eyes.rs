@@ -52,10 +52,8 @@ pub fn eye_order(views: &Views, m: &Measured) -> EyeOrder {
     let s = m.scale;
     let d = |x: usize, y: usize| m.map.disparity[y * w + x];
     let (vw, vh) = views.left.dimensions();
-    let luma = |x: u32, y: u32| {
-        let p = views.left.get_pixel(x.min(vw - 1), y.min(vh - 1)).0;
-        0.299 * f64::from(p[0]) + 0.587 * f64::from(p[1]) + 0.114 * f64::from(p[2])
-    };
+    let gray = super::luma(&views.left);
+    let luma = |x: u32, y: u32| f64::from(gray[(y.min(vh - 1) * vw + x.min(vw - 1)) as usize]);
     // The spread of gray levels in the 5×5 window around a map pixel's block centre.
     let texture = |x: usize, y: usize| -> f64 {
         let (cx, cy) = (x as u32 * s + s / 2, y as u32 * s + s / 2);
