@@ -198,10 +198,14 @@ fn traverse_band<S: Shader>(
     {
         // SAFETY: `shade_triangle` requires AVX2, FMA and POPCNT (its only safety condition),
         // which `Kernels::avx2` has just found on this CPU (`avx2_available`).
-        return triangles
+        let (mut pending, pc) = (shade_avx2::Pending::new(), opts.perspective_correct);
+        let passed = triangles
             .iter()
-            .map(|t| unsafe { shade_avx2::shade_triangle(t, u, band, opts.perspective_correct) })
+            .map(|t| unsafe { shade_avx2::shade_triangle(t, u, band, &mut pending, pc) })
             .sum();
+        // SAFETY: as above (`flush` requires AVX2 and FMA).
+        unsafe { pending.flush(u, band, pc) };
+        return passed;
     }
     triangles
         .iter()
@@ -478,7 +482,8 @@ mod tests {
     /// counts the same fragments: grids seen from the front and from behind (back faces, lit
     /// two-sided), slanted and partly clipped, with normals of every length including zero
     /// (`normalize_or_zero`'s fallback), perspective-correct and affine, odd sizes, a light
-    /// inside the surface and a specular power of 0, 1, 32 and 1024.
+    /// inside the surface and a specular power of 0, 1, 32 and 1024; triangles smaller than a
+    /// pixel, whose fragments are shaded in batches.
     #[test]
     fn avx2_blinn_phong_matches_traverse() {
         use crate::shade::{BlinnPhong, Light};
@@ -491,6 +496,10 @@ mod tests {
             (64, 64, 10_000, 20.0, false, 0.0),
             (97, 203, 2, 80.0, true, 1024.0),
             (256, 192, 900, 160.0, true, 32.0),
+            // Triangles far smaller than a pixel, folded over one another at a grazing angle:
+            // fragments wait to be shaded eight at a time, and later ones cover earlier ones.
+            (160, 120, 60_000, 78.0, true, 32.0),
+            (96, 64, 40_000, 200.0, false, 1.0),
         ] {
             let (positions, triangles) = grid(count);
             // Normals of varied length and direction; every 7th vertex has none.
@@ -561,5 +570,100 @@ mod tests {
                 distinct.len()
             );
         }
+    }
+
+    /// Fragments that wait to be shaded in batches keep the scalar stage's order: thousands of
+    /// triangles of one to seven pixels stacked over a few pixels, each pixel won many times
+    /// over; and tiny triangles each followed by a wide one in front, whose fragments are
+    /// shaded at once while the tiny one's still waits (a batch that wrote every waiting
+    /// fragment's color would leave the tiny triangles' colors there). Colors, depths and the
+    /// fragment count equal the scalar stage's.
+    #[test]
+    fn avx2_blinn_phong_batches_keep_the_last_fragment() {
+        use crate::shade::{BlinnPhong, Light};
+        if !avx2_to_compare("avx2_blinn_phong_batches_keep_the_last_fragment") {
+            return;
+        }
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (w, h) = (48, 32);
+        let (mut positions, mut normals, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+        let mut add = |corners: [(f32, f32); 3], z: f32, next: &mut dyn FnMut() -> f32| {
+            let base = positions.len() as u32;
+            for (x, y) in corners {
+                positions.push(Vec3::new(x, y, z));
+                normals.push(Vec3::new(next() - 0.5, next() - 0.5, 1.0));
+            }
+            triangles.push([base, base + 1, base + 2]);
+        };
+        // Over a patch of about 6×4 pixels in the middle of the view (a pixel is about 0.078
+        // units wide at distance 3), triangles from under one pixel to about seven, nearer as
+        // they come, give or take: later ones mostly pass, some fail.
+        for t in 0..6_000 {
+            let (cx, cy) = ((next() - 0.5) * 0.47, (next() - 0.5) * 0.31);
+            let z = -0.7 + 1.4 * t as f32 / 6_000.0 + (next() - 0.5) * 0.01;
+            let size = 0.05 + next() * 0.5;
+            let corners = [(); 3].map(|_| (cx + (next() - 0.5) * size, cy + (next() - 0.5) * size));
+            add(corners, z, &mut next);
+        }
+        // Elsewhere, a triangle of about a pixel (its fragment waits), then at once a wide one
+        // in front of it (its fragments are shaded at once): the wide one's colors must stay.
+        for cy in [-0.85, 0.6] {
+            for cx in [-1.35, -0.45, 0.45, 1.35] {
+                let tiny = [
+                    (cx - 0.06, cy - 0.05),
+                    (cx + 0.06, cy - 0.05),
+                    (cx, cy + 0.07),
+                ];
+                add(tiny, 0.0, &mut next);
+                let wide = [(cx - 0.4, cy - 0.15), (cx + 0.4, cy - 0.15), (cx, cy + 0.3)];
+                add(wide, 0.1, &mut next);
+            }
+        }
+        let view = look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
+        let projection = perspective(45.0, w as f32 / h as f32, 1.0, 10.0);
+        let shader = BlinnPhong::new(
+            &positions,
+            &normals,
+            Mat4::IDENTITY,
+            view,
+            projection,
+            Vec3::new(0.3, 0.7, 0.9),
+            Light::default(),
+        );
+        let opts = RasterOptions {
+            cull_back: false,
+            ..RasterOptions::default()
+        };
+        let mut fast = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
+        let stats = rasterize_blinn_phong(&triangles, positions.len(), &shader, &mut fast, &opts);
+        let mut plain = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
+        let plain_stats = rasterize_bands(
+            &triangles,
+            positions.len(),
+            &shader,
+            None,
+            &mut plain,
+            &opts,
+            Kernels::Scalar,
+        );
+        let drawn = plain.color.iter().filter(|c| **c != [0, 0, 0, 255]).count();
+        assert!(
+            stats.fragments > 10 * drawn && drawn > 100,
+            "{} fragments over {drawn} pixels: too little overlap",
+            stats.fragments
+        );
+        assert_eq!(stats.fragments, plain_stats.fragments, "fragment count");
+        let bits = |fb: &Framebuffer| fb.depth.iter().map(|d| d.to_bits()).collect::<Vec<_>>();
+        assert!(bits(&fast) == bits(&plain), "depth bits differ");
+        let differ = (fast.color.iter().zip(&plain.color))
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differ, 0, "{differ} colors differ");
     }
 }

@@ -360,11 +360,16 @@ fn covers_no_center(
     if (px1 - px0 + 1) * (py1 - py0 + 1) > SMALL_BOX {
         return false;
     }
-    let covered = |px: i64, py: i64| {
-        let (x, y) = (px << bits, py << bits);
-        (0..3).all(|i| c[i] + dcdy[i] * y - dcdx[i] * x >= 0)
-    };
-    !(py0..=py1).any(|py| (px0..=px1).any(|px| covered(px, py)))
+    for py in py0..=py1 {
+        for px in px0..=px1 {
+            let (x, y) = (px << bits, py << bits);
+            let e = |i: usize| c[i] + dcdy[i] * y - dcdx[i] * x;
+            if (e(0) >= 0) & (e(1) >= 0) & (e(2) >= 0) {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 impl SetupTriangle {

@@ -12,10 +12,15 @@
 //! (`avx2_blinn_phong_matches_traverse`, the golden images and the scene hashes hold them).
 //! The scalar path stays the reference: it is what runs without AVX2 or with
 //! `STEREOLAB_SCALAR=1`.
+//!
+//! A vector costs the same to shade for one covered pixel as for eight, and a triangle smaller
+//! than a pixel covers one. Vectors where at most [`PENDING_LANES`] pixels passed the depth
+//! test therefore wait in [`Pending`], and are shaded eight fragments at a time, each lane with
+//! its own triangle's planes: the same operations per lane, so the same bytes.
 
 use std::arch::x86_64::*;
 
-use super::avx2::{clamp01, columns, covered_vectors, depth_at, load, plane_at, store};
+use super::avx2::{clamp01, columns, covered_vectors, depth_at, load, store};
 use super::{Band, Plane, SetupTriangle};
 use crate::shade::BlinnPhong;
 
@@ -60,6 +65,7 @@ pub(crate) unsafe fn shade_triangle(
     t: &SetupTriangle,
     u: &Uniforms,
     band: &mut Band,
+    pending: &mut Pending,
     perspective_correct: bool,
 ) -> usize {
     let rows = (band.depth.len() / band.width.max(1) as usize) as u32;
@@ -69,19 +75,138 @@ pub(crate) unsafe fn shade_triangle(
         let i = (y - y0) as usize * w + (x - x0) as usize;
         // SAFETY: this function runs only where AVX2 is available; `i` is the vector's first
         // pixel in the tile, and `mask` covers only pixels inside it.
-        passed += unsafe {
-            shade_vector(
-                t,
-                u,
-                (x, y),
-                mask,
-                perspective_correct,
-                &mut band.depth[i..],
-                &mut band.color[i..],
-            )
-        };
+        passed +=
+            unsafe { shade_vector(t, u, (x, y), mask, i, band, pending, perspective_correct) };
     });
     passed
+}
+
+/// Lanes of a vector that passed the depth test up to which they wait in [`Pending`] instead
+/// of being shaded at once. A vector costs the same to shade for one lane as for eight; a
+/// triangle smaller than a pixel passes one lane per vector.
+const PENDING_LANES: u32 = 3;
+
+/// Fragments of small triangles that passed the depth test (their depth written), waiting to
+/// be shaded eight at a time, each lane with its own triangle's planes.
+///
+/// A waiting fragment's color is written when the batch is shaded, if the pixel still holds
+/// its depth: the depth test is LESS, so any later fragment that passed there left a smaller
+/// depth, and its color (written at once, or waiting after this one) is the pixel's. The
+/// bytes are those of shading each fragment when it passed.
+pub(crate) struct Pending {
+    n: usize,
+    /// Per waiting fragment: its pixel in the band, its depth's bits, its `fx`.
+    pixel: [usize; 8],
+    depth: [u32; 8],
+    fx: [f32; 8],
+    /// Per plane (1/w, then the six varyings) and lane: `a0`, `dadx` and `dady·fy`, the three
+    /// terms of [`plane_at`](super::avx2::plane_at).
+    planes: [[[f32; 8]; 3]; PLANES],
+    /// −0.0 for a back face (its normal is negated), +0.0 for a front face.
+    back: [f32; 8],
+}
+
+/// The planes the lighting reads: 1/w and the six varyings of [`BlinnPhong`] (position and
+/// normal in eye space).
+const PLANES: usize = 7;
+
+impl Pending {
+    /// No fragment waiting.
+    pub(crate) fn new() -> Pending {
+        Pending {
+            n: 0,
+            pixel: [0; 8],
+            depth: [0; 8],
+            fx: [0.0; 8],
+            planes: [[[0.0; 8]; 3]; PLANES],
+            back: [0.0; 8],
+        }
+    }
+
+    /// Shades the waiting fragments (eight lanes, the unused ones ignored) and writes the
+    /// color of each whose pixel still holds its depth.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2 and FMA; `band` is the band the fragments were added from.
+    #[target_feature(enable = "avx2,fma")]
+    pub(crate) unsafe fn flush(
+        &mut self,
+        u: &Uniforms,
+        band: &mut Band,
+        perspective_correct: bool,
+    ) {
+        if self.n == 0 {
+            return;
+        }
+        // SAFETY: each array holds eight f32, the unaligned load's width.
+        let load = |a: &[f32; 8]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
+        let planes = self.planes.each_ref().map(|p| p.each_ref().map(load));
+        let rgba = lighting(
+            u,
+            load(&self.fx),
+            &planes,
+            load(&self.back),
+            perspective_correct,
+        );
+        let mut out = [0u32; 8];
+        // SAFETY: `out` holds eight u32, one 256-bit store.
+        unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), rgba) };
+        for k in 0..self.n {
+            let i = self.pixel[k];
+            if band.depth[i].to_bits() == self.depth[k] {
+                band.color[i] = out[k].to_le_bytes();
+            }
+        }
+        self.n = 0;
+    }
+
+    /// Adds the `pass` lanes of a vector of `t` at pixel `i` of the band (depths `z`, columns
+    /// `fx`, row `fy`), shading the waiting ones first when they would not fit.
+    ///
+    /// # Safety
+    /// As [`Pending::flush`].
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn add(
+        &mut self,
+        t: &SetupTriangle,
+        (i, pass): (usize, i32),
+        (z, fx, fy): (__m256, __m256, f32),
+        (u, band, perspective_correct): (&Uniforms, &mut Band, bool),
+    ) {
+        if self.n + pass.count_ones() as usize > 8 {
+            // SAFETY: as this function's own conditions.
+            unsafe { self.flush(u, band, perspective_correct) };
+        }
+        let (mut zs, mut fxs) = ([0f32; 8], [0f32; 8]);
+        // SAFETY: eight f32 each, one 256-bit store.
+        unsafe {
+            _mm256_storeu_ps(zs.as_mut_ptr(), z);
+            _mm256_storeu_ps(fxs.as_mut_ptr(), fx);
+        }
+        let plane = |k: usize| {
+            if k == 0 {
+                t.inv_w_plane()
+            } else {
+                t.varying_plane(k - 1)
+            }
+        };
+        let back = if t.front_facing { 0.0 } else { -0.0 };
+        for lane in 0..8 {
+            if pass & (1 << lane) == 0 {
+                continue;
+            }
+            let n = self.n;
+            self.pixel[n] = i + lane;
+            self.depth[n] = zs[lane].to_bits();
+            self.fx[n] = fxs[lane];
+            for (k, p) in self.planes.iter_mut().enumerate() {
+                let q = plane(k);
+                (p[0][n], p[1][n], p[2][n]) = (q.a0, q.dadx, q.dady * fy);
+            }
+            self.back[n] = back;
+            self.n += 1;
+        }
+    }
 }
 
 /// glam's `normalize_or_zero` per lane: `v · (1 / √((x·x + y·y) + z·z))` where that
@@ -142,28 +267,30 @@ fn channel(c: __m256) -> __m256i {
     _mm256_and_si256(_mm256_cvttps_epi32(q), _mm256_set1_epi32(0xff))
 }
 
-/// One vector of the stage: pixels `x .. x + 8` of row `y` where `mask` is set. Depth test
-/// LESS; where it passes, [`BlinnPhong::fragment`] per lane, then the color and depth writes.
-/// Returns how many passed.
+/// One vector of the stage: pixels `x .. x + 8` of row `y` (the first at pixel `i` of the
+/// band) where `mask` is set. Depth test LESS; where it passes, the depth write and
+/// [`BlinnPhong::fragment`] per lane, then the color write: at once, or for a vector with at
+/// most [`PENDING_LANES`] lanes passed, when `pending` is shaded. Returns how many passed.
 ///
 /// # Safety
-/// The CPU must support AVX2; `depth` and `color` start at pixel `x` and hold the `mask`
-/// lanes (all eight when they are at least eight long).
+/// The CPU must support AVX2; `mask` covers only pixels of `band` from pixel `i` on.
 #[target_feature(enable = "avx2,fma,popcnt")]
 #[inline]
+#[allow(clippy::too_many_arguments)]
 unsafe fn shade_vector(
     t: &SetupTriangle,
     u: &Uniforms,
     (x, y): (u32, u32),
     mask: __m256i,
+    i: usize,
+    band: &mut Band,
+    pending: &mut Pending,
     perspective_correct: bool,
-    depth: &mut [f32],
-    color: &mut [[u8; 4]],
 ) -> usize {
-    let full = depth.len() >= 8 && color.len() >= 8;
+    let full = band.depth.len() - i >= 8;
     let (xf, fx) = columns(t, x);
     let z = depth_at(t, xf, y);
-    let dp = depth.as_mut_ptr();
+    let dp = band.depth[i..].as_mut_ptr();
     // SAFETY: eight lanes fit when `full`; otherwise `mask` covers only pixels inside.
     let d = unsafe { load(dp, mask, full) };
     let pass = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
@@ -171,25 +298,69 @@ unsafe fn shade_vector(
     if bits == 0 {
         return 0;
     }
+    // SAFETY: as for the load.
+    unsafe { store(dp, mask, full, _mm256_blendv_ps(d, z, pass)) };
     let fy = t.fy(y);
+    if bits.count_ones() <= PENDING_LANES {
+        // SAFETY: as this function's own conditions.
+        unsafe { pending.add(t, (i, bits), (z, fx, fy), (u, band, perspective_correct)) };
+        return bits.count_ones() as usize;
+    }
+    let splat = |p: Plane| {
+        [
+            _mm256_set1_ps(p.a0),
+            _mm256_set1_ps(p.dadx),
+            _mm256_set1_ps(p.dady * fy),
+        ]
+    };
+    let planes: [[__m256; 3]; PLANES] = std::array::from_fn(|k| {
+        splat(if k == 0 {
+            t.inv_w_plane()
+        } else {
+            t.varying_plane(k - 1)
+        })
+    });
+    let back = _mm256_set1_ps(if t.front_facing { 0.0 } else { -0.0 });
+    let rgba = lighting(u, fx, &planes, back, perspective_correct);
+    let cp = band.color[i..].as_mut_ptr().cast::<f32>();
+    // SAFETY: as for the depth above; a color is four bytes, one f32 lane, moved as bits.
+    unsafe {
+        let old = load(cp, mask, full);
+        store(
+            cp,
+            mask,
+            full,
+            _mm256_blendv_ps(old, _mm256_castsi256_ps(rgba), pass),
+        );
+    }
+    bits.count_ones() as usize
+}
+
+/// [`BlinnPhong::fragment`] per lane at columns `fx`, each lane with its own planes (1/w, then
+/// the six varyings; per plane `a0`, `dadx` and `dady·fy`, evaluated as [`plane_at`](super::avx2::plane_at) does) and
+/// its face (`back`: −0.0 negates the normal): the colors as RGBA8 words.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn lighting(
+    u: &Uniforms,
+    fx: __m256,
+    planes: &[[__m256; 3]; PLANES],
+    back: __m256,
+    perspective_correct: bool,
+) -> __m256i {
+    let at = |p: &[__m256; 3]| _mm256_add_ps(_mm256_add_ps(p[0], _mm256_mul_ps(p[1], fx)), p[2]);
     // Perspective correction: `a = (a/w) · w`, `w = 1 / (1/w)`; affine: `· 1`, which changes
     // no bit.
     let wv = if perspective_correct {
-        _mm256_div_ps(_mm256_set1_ps(1.0), plane_at(&t.inv_w_plane(), fx, fy))
+        _mm256_div_ps(_mm256_set1_ps(1.0), at(&planes[0]))
     } else {
         _mm256_set1_ps(1.0)
     };
-    let var = |k: usize| {
-        let p: Plane = t.varying_plane(k);
-        _mm256_mul_ps(plane_at(&p, fx, fy), wv)
-    };
+    let var = |k: usize| _mm256_mul_ps(at(&planes[1 + k]), wv);
     let p = [var(0), var(1), var(2)];
-    let mut n = normalize_or_zero([var(3), var(4), var(5)]);
-    if !t.front_facing {
-        // Two-sided lighting: `-n` flips every sign bit, zeros included.
-        let sign = _mm256_set1_ps(-0.0);
-        n = n.map(|c| _mm256_xor_ps(c, sign));
-    }
+    // Two-sided lighting: a back face's normal is `-n`, every sign bit flipped, zeros
+    // included (a front face's is XORed with +0.0, which changes no bit).
+    let n = normalize_or_zero([var(3), var(4), var(5)]).map(|c| _mm256_xor_ps(c, back));
     let sign = _mm256_set1_ps(-0.0);
     let l = normalize_or_zero(std::array::from_fn(|k| {
         _mm256_sub_ps(_mm256_set1_ps(u.light[k]), p[k])
@@ -221,24 +392,11 @@ unsafe fn shade_vector(
         ))
     });
     // RGBA8 in memory order: r | g << 8 | b << 16 | 255 << 24 in a little-endian word.
-    let rgba = _mm256_or_si256(
+    _mm256_or_si256(
         _mm256_or_si256(c[0], _mm256_slli_epi32::<8>(c[1])),
         _mm256_or_si256(
             _mm256_slli_epi32::<16>(c[2]),
             _mm256_set1_epi32(0xff00_0000_u32 as i32),
         ),
-    );
-    let cp = color.as_mut_ptr().cast::<f32>();
-    // SAFETY: as for the depth above; a color is four bytes, one f32 lane, moved as bits.
-    unsafe {
-        store(dp, mask, full, _mm256_blendv_ps(d, z, pass));
-        let old = load(cp, mask, full);
-        store(
-            cp,
-            mask,
-            full,
-            _mm256_blendv_ps(old, _mm256_castsi256_ps(rgba), pass),
-        );
-    }
-    bits.count_ones() as usize
+    )
 }
