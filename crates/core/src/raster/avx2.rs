@@ -246,7 +246,7 @@ unsafe fn depth_vector(
     // inside `depth`.
     unsafe {
         let dp = depth.as_mut_ptr();
-        let d = load(dp, mask, full);
+        let d = opaque(load(dp, mask, full));
         let pass = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
         store(dp, mask, full, _mm256_blendv_ps(d, z, pass));
         _mm256_movemask_ps(pass).count_ones() as usize
