@@ -402,7 +402,6 @@ impl Columns {
 /// Fig. 4's texture read for every strip of one band: the strips in order, each row by row
 /// ([`resolve_strip`]), or, on the AVX2 loops, each row once for all its strips
 /// (`avx2::resolve_sweep`, the same bytes).
-#[allow(clippy::too_many_arguments)]
 fn resolve_band(
     image: &mut [[u8; 4]],
     sources: &[f32],
