@@ -4,8 +4,9 @@
 //!
 //! Each lane performs the scalar loop's IEEE operations in the same order (no fused
 //! multiply-add, which would round once instead of twice), so the bytes are the same as the
-//! scalar path's; the pipeline's `avx2_strips_match_scalar_strips` holds them equal on real scenes. Lanes past
-//! the end of a span are masked off, never loaded or stored.
+//! scalar path's; the pipeline's `avx2_strips_match_scalar_strips` holds them equal on real
+//! scenes, `reads_of_unfinished_pixels_see_the_pattern` on rows of every kind of read. Lanes
+//! past the end of a span are masked off, never loaded or stored.
 
 use std::arch::x86_64::*;
 

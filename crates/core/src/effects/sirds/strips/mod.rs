@@ -18,9 +18,12 @@
 //! 3. The strips then only read, in order (`resolve_strip`): each pixel takes the color at
 //!    its source, as the earlier strips left the image.
 //!
-//! Steps 2 and 3 run eight pixels at a time on AVX2 (`per_vertex/avx2.rs`) where
-//! the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)), with the scalar loops' bytes; [`per_vertex_reference`]
-//! (and `STEREOLAB_SCALAR=1`, see [`uses_avx2`](crate::uses_avx2)) runs the scalar ones.
+//! Steps 2 and 3 run eight pixels at a time on AVX2 (`strips/avx2.rs`) where the AVX2 loops
+//! run ([`uses_avx2`](crate::uses_avx2)), with the scalar loops' bytes; step 3 there passes
+//! over each row once for all its strips (`resolve_sweep`: every pixel a strip reads lies
+//! behind the sweep, so the strips' order is kept). [`per_vertex_reference`] (and
+//! `STEREOLAB_SCALAR=1`, see [`uses_avx2`](crate::uses_avx2)) runs the scalar ones, strip by
+//! strip.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
