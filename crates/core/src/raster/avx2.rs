@@ -8,10 +8,11 @@ use super::{Band, Plane, SetupTriangle};
 
 /// `v` unchanged, opaque to the optimizer. A lane blend of a loaded vector stored back where it
 /// came from is what a masked store does, and LLVM rewrites it into one; this keeps the full
-/// store. Only an instruction choice: the bytes are the same without it. Measured in the depth
-/// pass, the gain was within noise (the hot load stayed as hot: it waits on the cache, not on
-/// store forwarding), so the depth pass does not use it; the strip pass
-/// (`effects/sirds/strips/avx2.rs`) does.
+/// store. Only an instruction choice: the bytes are the same without it. On AMD Zen a 256-bit
+/// masked store is microcoded and slow (in a profile of the depth pass on a Zen 3 the
+/// instruction after it took the most samples of the loop); the depth pass
+/// (`depth_triangle`) and the strip pass (`effects/sirds/strips/avx2.rs`) both keep their
+/// full stores with it.
 ///
 /// # Safety
 /// The CPU must have AVX2 and FMA ([`crate::simd::avx2_available`]).
@@ -246,7 +247,7 @@ unsafe fn depth_vector(
     // inside `depth`.
     unsafe {
         let dp = depth.as_mut_ptr();
-        let d = load(dp, mask, full);
+        let d = opaque(load(dp, mask, full));
         let pass = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(z, d), _mm256_castsi256_ps(mask));
         store(dp, mask, full, _mm256_blendv_ps(d, z, pass));
         _mm256_movemask_ps(pass).count_ones() as usize

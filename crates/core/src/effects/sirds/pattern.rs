@@ -201,7 +201,13 @@ impl Pattern {
     /// Row `y` of the pattern into `row` (columns `0..row.len()`): the same colors as
     /// [`Pattern::color`], with the pattern kind decided once per row.
     pub fn fill_row(&self, y: u32, row: &mut [[u8; 4]]) {
-        let xs = row.iter_mut().zip(0u32..);
+        self.fill_span(0, y, row);
+    }
+
+    /// Columns `x0 .. x0 + span.len()` of row `y` into `span`: the same colors as
+    /// [`Pattern::color`], with the pattern kind decided once per span.
+    pub fn fill_span(&self, x0: u32, y: u32, span: &mut [[u8; 4]]) {
+        let xs = span.iter_mut().zip(x0..);
         match self {
             Pattern::BlackWhite { seed } => {
                 for (p, x) in xs {

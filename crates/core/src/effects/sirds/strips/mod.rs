@@ -18,9 +18,12 @@
 //! 3. The strips then only read, in order (`resolve_strip`): each pixel takes the color at
 //!    its source, as the earlier strips left the image.
 //!
-//! Steps 2 and 3 run eight pixels at a time on AVX2 (`per_vertex/avx2.rs`) where
-//! the AVX2 loops run ([`uses_avx2`](crate::uses_avx2)), with the scalar loops' bytes; [`per_vertex_reference`]
-//! (and `STEREOLAB_SCALAR=1`, see [`uses_avx2`](crate::uses_avx2)) runs the scalar ones.
+//! Steps 2 and 3 run eight pixels at a time on AVX2 (`strips/avx2.rs`) where the AVX2 loops
+//! run ([`uses_avx2`](crate::uses_avx2)), with the scalar loops' bytes; step 3 there passes
+//! over each row once for all its strips (`resolve_sweep`: every pixel a strip reads lies
+//! behind the sweep, so the strips' order is kept). [`per_vertex_reference`] (and
+//! `STEREOLAB_SCALAR=1`, see [`uses_avx2`](crate::uses_avx2)) runs the scalar ones, strip by
+//! strip.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -29,6 +32,8 @@ pub mod reference;
 
 use geometry::shift;
 pub use geometry::{StripGeometry, StripObject};
+
+use std::mem::MaybeUninit;
 
 use glam::Vec4;
 use rayon::prelude::*;
@@ -353,27 +358,90 @@ fn resolve_strip(
     (width, y0): (usize, u32),
     strip: &Strip,
     bilinear: bool,
-    kernels: Kernels,
     pattern: &SirdsPattern,
 ) {
-    let simd = kernels.avx2();
     let rows = image
         .chunks_exact_mut(width)
         .zip(sources.chunks_exact(width));
-    #[cfg(target_arch = "x86_64")]
-    let gray = pattern.is_gray();
     for (y, (row, src)) in (y0..).zip(rows) {
-        let pattern = |x: usize| pattern.color(x as u32, y);
-        #[cfg(target_arch = "x86_64")]
-        if simd {
-            // SAFETY: `simd` is only set where `Kernels::avx2` found AVX2; `band_sources`
-            // stored only NaN or in-bounds sources.
-            unsafe { avx2::resolve_row(row, src, strip, (bilinear, gray), pattern) };
-            continue;
-        }
-        let _ = simd;
-        resolve_row(row, src, strip, bilinear, pattern);
+        resolve_row(row, src, strip, bilinear, |x| pattern.color(x as u32, y));
     }
+}
+
+/// Per column, the strip that writes it: what the AVX2 loops' one pass over a row
+/// (`avx2::resolve_sweep`) needs to read each pixel as its own strip does.
+pub(super) struct Columns {
+    /// The index (into the strips) of the strip writing each column.
+    owner: Vec<u32>,
+    /// Per column, where its strip's final pixels begin: right-going, the strip's first
+    /// column (sources left of it are final); left-going, the strip's end (sources at or
+    /// right of it are final).
+    bound: Vec<i32>,
+    /// The first column of the right-going strips (those left of it go left).
+    split: u32,
+}
+
+impl Columns {
+    /// The columns of `strips` (every column of a `width`-pixel row written by one of them,
+    /// as [`plan_strips`] makes them), the right-going ones from `split` on.
+    fn new(strips: &[Strip], width: u32, split: u32) -> Columns {
+        let mut owner = vec![0; width as usize];
+        let mut bound = vec![0; width as usize];
+        for (k, s) in strips.iter().enumerate() {
+            let b = if s.toward > 0.0 { s.x0 } else { s.x0 + s.width };
+            for x in s.x0 as usize..(s.x0 + s.width) as usize {
+                owner[x] = k as u32;
+                bound[x] = b as i32;
+            }
+        }
+        Columns {
+            owner,
+            bound,
+            split,
+        }
+    }
+}
+
+/// Fig. 4's texture read for every strip of one band: the strips in order, each row by row
+/// ([`resolve_strip`]), or, on the AVX2 loops, each row once for all its strips
+/// (`avx2::resolve_sweep`, the same bytes).
+fn resolve_band(
+    image: &mut [[u8; 4]],
+    sources: &[f32],
+    (width, y0): (usize, u32),
+    (strips, columns): (&[Strip], &Columns),
+    bilinear: bool,
+    kernels: Kernels,
+    pattern: &SirdsPattern,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if kernels.avx2() {
+        let gray = pattern.is_gray();
+        let rows = image
+            .chunks_exact_mut(width)
+            .zip(sources.chunks_exact(width));
+        for (y, (row, src)) in (y0..).zip(rows) {
+            // SAFETY: `Kernels::avx2` found AVX2; `band_sources` stored only NaN or in-bounds
+            // sources.
+            unsafe {
+                avx2::resolve_sweep(row, src, (strips, columns), (bilinear, gray), (y, pattern))
+            };
+        }
+        return;
+    }
+    let _ = (kernels, columns);
+    for strip in strips {
+        resolve_strip(image, sources, (width, y0), strip, bilinear, pattern);
+    }
+}
+
+/// `slots` filled with `value`, as the initialized slice they then are.
+fn fill<T: Copy>(slots: &mut [MaybeUninit<T>], value: T) -> &mut [T] {
+    for slot in slots.iter_mut() {
+        slot.write(value);
+    }
+    // SAFETY: every element was just written; `MaybeUninit<T>` has `T`'s layout.
+    unsafe { &mut *(slots as *mut [MaybeUninit<T>] as *mut [T]) }
 }
 
 /// The inputs of a strip run checked (separations that fit `width`, a pattern wide enough,
@@ -488,14 +556,17 @@ fn per_vertex_on(
         .map(|s| s.x0)
         .min()
         .unwrap_or(width);
-    // Every pixel is written by its strip; this only makes the buffer (filled in parallel).
-    let mut pixels = Vec::with_capacity(w * height as usize);
-    pixels.par_extend(rayon::iter::repeat_n([0u8, 0, 0, 255], w * height as usize));
+    let columns = Columns::new(&strips, width, split);
+    let len = w * height as usize;
     let band_len = w * BAND_ROWS as usize;
-    let band_links: Vec<Vec<i32>> = pixels
+    // Each band fills its own part of the image (in its thread's cache), then the strips
+    // write every pixel.
+    let mut pixels: Vec<[u8; 4]> = Vec::with_capacity(len);
+    let band_links: Vec<Vec<i32>> = pixels.spare_capacity_mut()[..len]
         .par_chunks_mut(band_len)
         .enumerate()
         .map(|(b, image)| {
+            let image = fill(image, [0, 0, 0, 255]);
             let y0 = b as u32 * BAND_ROWS;
             let rows = (image.len() / w) as u32;
             let mut regions = Vec::with_capacity(2);
@@ -516,9 +587,8 @@ fn per_vertex_on(
                 }
             }
             let sources = band_sources(&regions, width, y0, rows, kernels);
-            for strip in &strips {
-                resolve_strip(image, &sources, (w, y0), strip, bilinear, kernels, pattern);
-            }
+            let plan = (strips.as_slice(), &columns);
+            resolve_band(image, &sources, (w, y0), plan, bilinear, kernels, pattern);
             // Which pixel each one copied depends on its source alone, not on the strip.
             let link = |p: f32| {
                 if p.is_nan() {
@@ -534,6 +604,8 @@ fn per_vertex_on(
             }
         })
         .collect();
+    // SAFETY: the bands, which together are the first `len` elements, each filled its own.
+    unsafe { pixels.set_len(len) };
     Ok(StripResult {
         pixels,
         iterations: strips.len() as u32,
