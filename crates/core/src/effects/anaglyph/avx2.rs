@@ -13,6 +13,9 @@
 //! tests hold every kind to the scalar function. The scalar loop stays the reference; it runs
 //! where the CPU has no AVX2 and for linear light (whose `powf` has no vector form here).
 //!
+//! Both paths leave out the terms whose coefficient is zero where the matrix pair has one of
+//! the [`SHAPES`] of the stored kinds (a loop each); the Dubois matrices use all eighteen.
+//!
 //! Sixteen pixel pairs equal to the last eight computed, twice over (a flat background in both
 //! eyes), reuse the last result instead of computing it again: the same bytes, since a pixel's
 //! result depends on its pair alone. The vector test runs only where a block's first pair
@@ -41,9 +44,9 @@ fn clamp01(v: __m256) -> __m256 {
 
 /// The 8-bit values `v` of one channel (already zero-extended to 32 bits in every lane), as
 /// `v as f32 / 255` exactly rounded: `q = v·r` with `r = 1/255` rounded, its residual `e = v −
-/// 255·q` (one fused multiply-add, exact), then `q + e·r` (one more). For every `v` in 0..=255
-/// this is the quotient `/` rounds to (`decode_is_the_rounded_quotient` checks all 256),
-/// without the division's latency.
+/// 255·q` (one fused multiply-add), then `q + e·r` (one more). For every `v` in 0..=255 this is
+/// the quotient `/` rounds to (`decode_is_the_rounded_quotient` checks all 256), without the
+/// division's latency.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 fn decode(v: __m256i) -> __m256 {
