@@ -533,11 +533,11 @@ pub fn anaglyph_pixel_with(
 /// times, each by at most `u` times a partial sum no larger than `255·K + ½`. The pixel
 /// function rounds `v/255` and the product (two per term) and sums left to right (five more):
 /// its sum is within `γ_7·K` of `Σ c_j·v_j/255`, within `γ_7·255·K` after `·255`, whose
-/// rounding adds at most `255·u`, and `+ ½` at most `256·u`. Both bounds are strict (`6.0001·u
-/// > γ_6`, `7.0001·u > γ_7`), so when `t` is at least `g` from every integer, `t*` is farther
-/// than `E_pixel` from every one, and both round down to the same integer. Where the clamp
-/// acts (the sum below 0 or above 1) the byte is 0 or 255, and `t` is below 1 or above 255,
-/// which saturate to the same.
+/// rounding adds at most `255·u`, and `+ ½` at most `256·u`. Both bounds are strict
+/// (`6.0001·u` exceeds `γ_6`, `7.0001·u` exceeds `γ_7`), so when `t` is at least `g` from every
+/// integer, `t*` is farther than `E_pixel` from every one, and both round down to the same
+/// integer. Where the clamp acts (the sum below 0 or above 1) the byte is 0 or 255, and `t` is
+/// below 1 or above 255, which saturate to the same.
 pub(crate) fn fused_guard(c: [f32; 6]) -> f32 {
     let u = 2f64.powi(-24);
     let k: f64 = c.iter().map(|c| f64::from(c.abs())).sum();
