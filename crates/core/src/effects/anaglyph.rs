@@ -524,7 +524,7 @@ pub fn anaglyph_pixel_with(
 /// saturated to 0..255 is [`anaglyph_pixel`]'s byte. With `K = Σ|c_j|` and `u = 2⁻²⁴` (f32's
 /// unit roundoff):
 ///
-/// `g = 2·(E_fused + E_pixel)`, `E_fused = 6.0001·u·(255·K + ½)`,
+/// `g = E_fused + E_pixel`, `E_fused = 6.0001·u·(255·K + ½)`,
 /// `E_pixel = u·(7.0001·255·K + 511)`.
 ///
 /// Each `E` bounds one computation's distance to the exact `t* = ½ + Σ c_j·v_j` (Higham,
@@ -533,17 +533,18 @@ pub fn anaglyph_pixel_with(
 /// times, each by at most `u` times a partial sum no larger than `255·K + ½`. The pixel
 /// function rounds `v/255` and the product (two per term) and sums left to right (five more):
 /// its sum is within `γ_7·K` of `Σ c_j·v_j/255`, within `γ_7·255·K` after `·255`, whose
-/// rounding adds at most `255·u`, and `+ ½` at most `256·u`. So when `t` is `g > E_fused +
-/// E_pixel` from every integer, `t*` is farther than both `E` from one, and both round down to
-/// the same integer. Where the clamp acts (the sum below 0 or above 1) the byte is 0 or 255,
-/// and `t` is below 1 or above 255, which saturate to the same. The factor 2 is margin.
+/// rounding adds at most `255·u`, and `+ ½` at most `256·u`. Both bounds are strict
+/// (`6.0001·u` exceeds `γ_6`, `7.0001·u` exceeds `γ_7`), so when `t` is at least `g` from every
+/// integer, `t*` is farther than `E_pixel` from every one, and both round down to the same
+/// integer. Where the clamp acts (the sum below 0 or above 1) the byte is 0 or 255, and `t` is
+/// below 1 or above 255, which saturate to the same.
 pub(crate) fn fused_guard(c: [f32; 6]) -> f32 {
     let u = 2f64.powi(-24);
     let k: f64 = c.iter().map(|c| f64::from(c.abs())).sum();
     let e_fused = 6.0001 * u * (255.0 * k + 0.5);
     let e_pixel = u * (7.0001 * 255.0 * k + 511.0);
     // Rounded up, so the f32 guard is no smaller.
-    ((2.0 * (e_fused + e_pixel)) as f32).next_up()
+    ((e_fused + e_pixel) as f32).next_up()
 }
 
 /// A left and a right eye's pixel.
