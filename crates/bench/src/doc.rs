@@ -360,8 +360,11 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
         }
     }
     for (what, one, two) in thread_pairs(rows) {
+        let copy = number_after(&two.note, "a 6.3 MB copy: ")
+            .map(|c| format!(", a 6.3 MB copy: {c:.2}"))
+            .unwrap_or_default();
         let yard = yardstick(two)
-            .map(|y| format!(" (a register-only loop in the same turns: {y:.2})"))
+            .map(|y| format!(" (a register-only loop in the same turns: {y:.2}{copy})"))
             .unwrap_or_default();
         let _ = writeln!(
             s,

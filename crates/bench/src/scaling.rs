@@ -51,13 +51,14 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::internal("bench scaling", format!("thread pool: {e}")))
 }
 
-/// Median ms of `f`, of [`yardstick`] and of [`wide_yardstick`] inside `pool`, timed in turns
-/// (blocks of 10, at least `iters` runs of each).
+/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of [`copy_yardstick`] inside
+/// `pool`, timed in turns (blocks of 10, at least `iters` runs of each).
 fn on_pool(
     pool: &rayon::ThreadPool,
     iters: usize,
     f: &(dyn Fn() -> bool + Sync),
-) -> Result<(f64, f64, f64)> {
+    copy: &CopyYardstick,
+) -> Result<(f64, f64, f64, f64)> {
     const BLOCK: usize = 10;
     let t = pool.install(|| {
         interleaved_medians(
@@ -76,10 +77,42 @@ fn on_pool(
                     std::hint::black_box(wide_yardstick());
                     Ok(())
                 },
+                &mut || {
+                    copy.run();
+                    Ok(())
+                },
             ],
         )
     })?;
-    Ok((t[0], t[1], t[2]))
+    Ok((t[0], t[1], t[2], t[3]))
+}
+
+/// Work bound by memory bandwidth alone: a copy of as many bytes as the anaglyph of a
+/// 1024×768 pair reads (two RGBA eyes, 6.3 MB), split in two halves under `rayon::join`. Its
+/// speed-up on the same pools, in the same turns as a row, is what the second core adds to a
+/// pass that only streams memory.
+struct CopyYardstick {
+    from: Vec<u8>,
+    to: std::sync::Mutex<Vec<u8>>,
+}
+
+impl CopyYardstick {
+    fn new() -> CopyYardstick {
+        let n = 2 * 1024 * 768 * 4;
+        CopyYardstick {
+            from: (0..n).map(|i| i as u8).collect(),
+            to: std::sync::Mutex::new(vec![0; n]),
+        }
+    }
+
+    fn run(&self) {
+        let mut to = self.to.lock().unwrap_or_else(|e| e.into_inner());
+        let half = self.from.len() / 2;
+        let (a, b) = to.split_at_mut(half);
+        let (fa, fb) = self.from.split_at(half);
+        rayon::join(|| a.copy_from_slice(fa), || b.copy_from_slice(fb));
+        std::hint::black_box(&*to);
+    }
 }
 
 /// Work that scales by construction: two halves of a register-only loop (no memory traffic,
@@ -173,14 +206,15 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     // The same two pools for every row.
     let (pool_1, pool_2) = (pool(1)?, pool(2)?);
+    let copy = CopyYardstick::new();
     let mut rows = Vec::new();
     for (what, setting, f) in cases {
         // At least 300 frames: a fresh pool's first tens of frames run slow on this shared
         // machine (with 40, the speed-ups read 1.1–1.5 where 300 give 1.9–2.0 in the same
         // hour), and short frames need many to steady the median.
         let n = iters.max(300);
-        let (one, yard_one, wide_one) = on_pool(&pool_1, n, f)?;
-        let (two, yard_two, wide_two) = on_pool(&pool_2, n, f)?;
+        let (one, yard_one, wide_one, copy_one) = on_pool(&pool_1, n, f, &copy)?;
+        let (two, yard_two, wide_two, copy_two) = on_pool(&pool_2, n, f, &copy)?;
         rows.push(row(
             "threads",
             format!("{what}, {setting}, 1 thread"),
@@ -193,10 +227,12 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             two,
             format!(
                 "speed-up 1 -> 2 threads = {:.2} (goal >= 1.8; {cores} cores seen); \
-                 a register-only loop in the same turns: {:.2}, with eight chains: {:.2}",
+                 a register-only loop in the same turns: {:.2}, with eight chains: {:.2}; \
+                 a 6.3 MB copy: {:.2}",
                 one / two,
                 yard_one / yard_two,
-                wide_one / wide_two
+                wide_one / wide_two,
+                copy_one / copy_two
             ),
         ));
     }

@@ -154,10 +154,10 @@ impl Pending {
         let mut out = [0u32; 8];
         // SAFETY: `out` holds eight u32, one 256-bit store.
         unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), rgba) };
-        for k in 0..self.n {
-            let i = self.pixel[k];
-            if band.depth[i].to_bits() == self.depth[k] {
-                band.color[i] = out[k].to_le_bytes();
+        let waiting = self.pixel.iter().zip(&self.depth).zip(&out).take(self.n);
+        for ((&i, &depth), rgba) in waiting {
+            if band.depth[i].to_bits() == depth {
+                band.color[i] = rgba.to_le_bytes();
             }
         }
         self.n = 0;
