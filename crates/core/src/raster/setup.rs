@@ -218,8 +218,8 @@ pub enum Setup {
 /// top-left tie-break, clamp the bounds to a `width`×`height` target, and build the attribute
 /// planes from the float window positions (as llvmpipe's coefficient setup does).
 ///
-/// A small triangle that covers none of the pixel centers in its box is `Empty` before its
-/// planes are built ([`covers_no_center`]).
+/// A small triangle (a box of at most eight pixel centers) that covers none of them is `Empty`
+/// before its planes are built.
 pub fn setup_triangle(
     v: [WindowVertex; 3],
     var: [&Varyings; 3],
