@@ -478,6 +478,30 @@ mod tests {
         }
     }
 
+    /// `triangles` drawn with `shader` on a black `w`×`h` target by the AVX2 Blinn-Phong stage
+    /// (`rasterize_blinn_phong`) and by the scalar `traverse`: each framebuffer and its stats.
+    fn blinn_phong_both_ways(
+        triangles: &[[u32; 3]],
+        vertex_count: usize,
+        shader: &crate::shade::BlinnPhong,
+        (w, h): (u32, u32),
+        opts: &RasterOptions,
+    ) -> ((Framebuffer, RasterStats), (Framebuffer, RasterStats)) {
+        let mut fast = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
+        let stats = rasterize_blinn_phong(triangles, vertex_count, shader, &mut fast, opts);
+        let mut plain = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
+        let plain_stats = rasterize_bands(
+            triangles,
+            vertex_count,
+            shader,
+            None,
+            &mut plain,
+            opts,
+            Kernels::Scalar,
+        );
+        ((fast, stats), (plain, plain_stats))
+    }
+
     /// The AVX2 Blinn-Phong stage writes the scalar `traverse`'s color and depth bits and
     /// counts the same fragments: grids seen from the front and from behind (back faces, lit
     /// two-sided), slanted and partly clipped, with normals of every length including zero
@@ -535,19 +559,8 @@ mod tests {
                 perspective_correct,
                 ..RasterOptions::default()
             };
-            let mut fast = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
-            let stats =
-                rasterize_blinn_phong(&triangles, positions.len(), &shader, &mut fast, &opts);
-            let mut plain = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
-            let plain_stats = rasterize_bands(
-                &triangles,
-                positions.len(),
-                &shader,
-                None,
-                &mut plain,
-                &opts,
-                Kernels::Scalar,
-            );
+            let ((fast, stats), (plain, plain_stats)) =
+                blinn_phong_both_ways(&triangles, positions.len(), &shader, (w, h), &opts);
             let what = format!("{w}x{h} {count} tilt {tilt} shininess {shininess}");
             assert!(stats.fragments > 0, "{what}: nothing drawn");
             assert_eq!(
@@ -584,13 +597,7 @@ mod tests {
         if !avx2_to_compare("avx2_blinn_phong_batches_keep_the_last_fragment") {
             return;
         }
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = super::setup::tests::uniform(0x2545_f491_4f6c_dd1d);
         let (w, h) = (48, 32);
         let (mut positions, mut normals, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
         let mut add = |corners: [(f32, f32); 3], z: f32, next: &mut dyn FnMut() -> f32| {
@@ -640,18 +647,8 @@ mod tests {
             cull_back: false,
             ..RasterOptions::default()
         };
-        let mut fast = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
-        let stats = rasterize_blinn_phong(&triangles, positions.len(), &shader, &mut fast, &opts);
-        let mut plain = Framebuffer::new(w, h, [0, 0, 0, 255]).expect("size");
-        let plain_stats = rasterize_bands(
-            &triangles,
-            positions.len(),
-            &shader,
-            None,
-            &mut plain,
-            &opts,
-            Kernels::Scalar,
-        );
+        let ((fast, stats), (plain, plain_stats)) =
+            blinn_phong_both_ways(&triangles, positions.len(), &shader, (w, h), &opts);
         let drawn = plain.color.iter().filter(|c| **c != [0, 0, 0, 255]).count();
         assert!(
             stats.fragments > 10 * drawn && drawn > 100,

@@ -466,9 +466,19 @@ impl SetupTriangle {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::{DepthPlane, RasterOptions, Setup, WindowVertex, round_ties_even};
     use super::{SMALL_BOX, setup_triangle_culling};
+
+    /// A xorshift generator of numbers in [0, 1) (24 bits), the same sequence for a seed.
+    pub(in crate::raster) fn uniform(mut seed: u64) -> impl FnMut() -> f32 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
 
     /// The small-triangle test drops only triangles that draw nothing: on random triangles of
     /// up to three pixels (most of them covering no pixel center, some one or a few), every
@@ -476,13 +486,7 @@ mod tests {
     /// triangle is set up exactly as without it. Both outcomes occur many times.
     #[test]
     fn small_triangles_are_dropped_only_when_they_cover_no_pixel() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = uniform(0x9e37_79b9_7f4a_7c15u64);
         let opts = RasterOptions::default();
         let var = [0.25f32; crate::shade::MAX_VARYINGS];
         let (mut dropped, mut kept) = (0, 0);
@@ -532,13 +536,7 @@ mod tests {
     /// and it does not depend on which vertex comes first beyond that rounding.
     #[test]
     fn depth_plane_is_the_plane_through_the_three_points() {
-        let mut seed = 0x1234_5678_9abc_def1u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = uniform(0x1234_5678_9abc_def1u64);
         for _ in 0..2000 {
             let v: [(f32, f32, f32); 3] =
                 std::array::from_fn(|_| (next() * 300.0, next() * 200.0, next()));
