@@ -113,6 +113,16 @@ pub(crate) struct Pending {
 /// normal in eye space).
 const PLANES: usize = 7;
 
+/// `t`'s plane `k` in the order [`lighting`] reads them: 1/w, then the six varyings.
+#[inline(always)]
+fn lighting_plane(t: &SetupTriangle, k: usize) -> Plane {
+    if k == 0 {
+        t.inv_w_plane()
+    } else {
+        t.varying_plane(k - 1)
+    }
+}
+
 impl Pending {
     /// No fragment waiting.
     pub(crate) fn new() -> Pending {
@@ -186,13 +196,6 @@ impl Pending {
             _mm256_storeu_ps(zs.as_mut_ptr(), z);
             _mm256_storeu_ps(fxs.as_mut_ptr(), fx);
         }
-        let plane = |k: usize| {
-            if k == 0 {
-                t.inv_w_plane()
-            } else {
-                t.varying_plane(k - 1)
-            }
-        };
         let back = if t.front_facing { 0.0 } else { -0.0 };
         for lane in 0..8 {
             if pass & (1 << lane) == 0 {
@@ -203,7 +206,7 @@ impl Pending {
             self.depth[n] = zs[lane].to_bits();
             self.fx[n] = fxs[lane];
             for (k, p) in self.planes.iter_mut().enumerate() {
-                let q = plane(k);
+                let q = lighting_plane(t, k);
                 (p[0][n], p[1][n], p[2][n]) = (q.a0, q.dadx, q.dady * fy);
             }
             self.back[n] = back;
@@ -316,13 +319,7 @@ unsafe fn shade_vector(
             _mm256_set1_ps(p.dady * fy),
         ]
     };
-    let planes: [[__m256; 3]; PLANES] = std::array::from_fn(|k| {
-        splat(if k == 0 {
-            t.inv_w_plane()
-        } else {
-            t.varying_plane(k - 1)
-        })
-    });
+    let planes: [[__m256; 3]; PLANES] = std::array::from_fn(|k| splat(lighting_plane(t, k)));
     let back = _mm256_set1_ps(if t.front_facing { 0.0 } else { -0.0 });
     let rgba = lighting(u, fx, &planes, back, perspective_correct);
     let cp = band.color[i..].as_mut_ptr().cast::<f32>();
