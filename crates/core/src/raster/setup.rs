@@ -481,7 +481,8 @@ pub(super) mod tests {
     }
 
     /// The small-triangle test drops only triangles that draw nothing: on random triangles of
-    /// up to three pixels (most of them covering no pixel center, some one or a few), every
+    /// up to three pixels (most of them covering no pixel center, some one or a few; half of
+    /// them with corners on half pixels, pixel centers on their edges), every
     /// triangle it drops covers no pixel of its box when set up without it, and every other
     /// triangle is set up exactly as without it. Both outcomes occur many times.
     #[test]
@@ -490,11 +491,20 @@ pub(super) mod tests {
         let opts = RasterOptions::default();
         let var = [0.25f32; crate::shade::MAX_VARYINGS];
         let (mut dropped, mut kept) = (0, 0);
-        for _ in 0..20_000 {
+        for n in 0..20_000 {
             let (cx, cy, size) = (next() * 40.0 - 4.0, next() * 30.0 - 4.0, next() * 3.0);
+            // Every other triangle on a grid of half pixels, so that pixel centers often lie
+            // exactly on its edges (the top-left rule decides those).
+            let at = |c: f32| {
+                if n % 2 == 0 {
+                    (c * 2.0).round() / 2.0
+                } else {
+                    c
+                }
+            };
             let v: [WindowVertex; 3] = std::array::from_fn(|_| WindowVertex {
-                x: cx + next() * size,
-                y: cy + next() * size,
+                x: at(cx + next() * size),
+                y: at(cy + next() * size),
                 z: next(),
                 inv_w: 0.5 + next(),
                 depth_x: 0.0,
