@@ -136,6 +136,13 @@ fn yardstick(two: &Row) -> Option<f64> {
     number_after(&two.note, "in the same turns: ")
 }
 
+/// The speed-ups of the consecutive runs in a 2-thread row's note (`scaling.rs`), as written.
+fn runs(two: &Row) -> Option<Vec<String>> {
+    let marker = "consecutive runs: ";
+    let tail = &two.note[two.note.find(marker)? + marker.len()..];
+    Some(tail.split(", ").map(str::to_string).collect())
+}
+
 /// The number just after `marker` in `note`.
 fn number_after(note: &str, marker: &str) -> Option<f64> {
     let tail = &note[note.find(marker)? + marker.len()..];
@@ -366,9 +373,12 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
         let yard = yardstick(two)
             .map(|y| format!(" (a register-only loop in the same turns: {y:.2}{copy})"))
             .unwrap_or_default();
+        let runs = runs(two)
+            .map(|r| format!("; {} consecutive runs: {}", r.len(), r.join(", ")))
+            .unwrap_or_default();
         let _ = writeln!(
             s,
-            "| {what}, 1 → 2 threads | {:.2} → {:.2} ms = **{:.2}**{yard} | ≥ 1.8 |",
+            "| {what}, 1 → 2 threads | {:.2} → {:.2} ms = **{:.2}**{yard}{runs} | ≥ 1.8 |",
             one.ms,
             two.ms,
             one.ms / two.ms
@@ -471,7 +481,13 @@ pub fn readme_paragraph(rows: &[Row], run: &RunInfo) -> String {
     let pairs = thread_pairs(rows);
     let mut threads: Vec<String> = pairs
         .iter()
-        .map(|(w, a, b)| format!("{} {:.2}", w.split(',').next().unwrap_or(w), a.ms / b.ms))
+        .map(|(w, a, b)| {
+            let name = w.split(',').next().unwrap_or(w);
+            match runs(b) {
+                Some(r) => format!("{name} {}", r.join(" / ")),
+                None => format!("{name} {:.2}", a.ms / b.ms),
+            }
+        })
         .collect();
     let yards: Vec<f64> = pairs.iter().filter_map(|p| yardstick(p.2)).collect();
     if !yards.is_empty() {
@@ -497,7 +513,16 @@ pub fn readme_paragraph(rows: &[Row], run: &RunInfo) -> String {
         );
     }
     if !threads.is_empty() {
-        let _ = write!(s, "; 1 → 2 threads: {}", threads.join(", "));
+        let _ = write!(
+            s,
+            "; 1 → 2 threads{}: {}",
+            if pairs.iter().any(|p| runs(p.2).is_some()) {
+                " (consecutive runs)"
+            } else {
+                ""
+            },
+            threads.join(", ")
+        );
     }
     s.push_str(". Figures and how they are made: [docs/performance.md](docs/performance.md).\n");
     s
@@ -614,10 +639,14 @@ mod tests {
             ),
         ];
         let mut rows = rows;
-        rows[5].note = "speed-up = 1.60; a register-only loop in the same turns: 1.97".into();
+        rows[5].note = "speed-up = 1.60; a register-only loop in the same turns: 1.97; \
+                        3 consecutive runs: 1.60, 1.81, 1.79"
+            .into();
         let s = section(&rows, &run(), Some("p.png"));
         assert!(
-            s.contains("(a register-only loop in the same turns: 1.97)"),
+            s.contains(
+                "(a register-only loop in the same turns: 1.97); 3 consecutive runs: 1.60, 1.81, 1.79 |"
+            ),
             "{s}"
         );
         assert!(s.contains("= **0.25** | ≤ 0.5"), "{s}");
@@ -635,7 +664,12 @@ mod tests {
             number_before("a; 0.95 of memcpy (3 MB)", " of memcpy ("),
             Some(0.95)
         );
-        assert!(readme_paragraph(&rows, &run()).contains("0.25 at grid of 4000000 tris"));
+        let readme = readme_paragraph(&rows, &run());
+        assert!(readme.contains("0.25 at grid of 4000000 tris"), "{readme}");
+        assert!(
+            readme.contains("1 → 2 threads (consecutive runs): stereo pair 1.60 / 1.81 / 1.79"),
+            "{readme}"
+        );
     }
 
     #[test]

@@ -16,7 +16,7 @@
 
 use std::time::Instant;
 
-use super::{Row, interleaved_medians, median_ms};
+use super::{Row, median_ms};
 use stereolab::fixtures::{TABLE_1, table_scene};
 use stereolab::output::produce;
 use stereolab::plan::{Output, Plan, Shading};
@@ -51,40 +51,66 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::internal("bench scaling", format!("thread pool: {e}")))
 }
 
-/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of [`copy_yardstick`] inside
-/// `pool`, timed in turns (blocks of 10, at least `iters` runs of each).
-fn on_pool(
-    pool: &rayon::ThreadPool,
+/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of the [`CopyYardstick`],
+/// each on `pool_1` and on `pool_2` (`[f, yardstick, wide, copy]` per pool), timed in turns:
+/// blocks of 10 runs of one inside its pool, then the next, every one once per round, until
+/// each has at least `iters` runs. A slow spell of the shared machine then falls on the 1- and
+/// the 2-thread runs alike, instead of on whichever pool was being timed.
+fn in_turns(
+    (pool_1, pool_2): (&rayon::ThreadPool, &rayon::ThreadPool),
     iters: usize,
     f: &(dyn Fn() -> bool + Sync),
     copy: &CopyYardstick,
-) -> Result<(f64, f64, f64, f64)> {
+) -> [[f64; 4]; 2] {
     const BLOCK: usize = 10;
-    let t = pool.install(|| {
-        interleaved_medians(
-            iters.div_ceil(BLOCK),
-            BLOCK,
-            &mut [
-                &mut || {
-                    std::hint::black_box(f());
-                    Ok(())
-                },
-                &mut || {
-                    std::hint::black_box(yardstick());
-                    Ok(())
-                },
-                &mut || {
-                    std::hint::black_box(wide_yardstick());
-                    Ok(())
-                },
-                &mut || {
-                    copy.run();
-                    Ok(())
-                },
-            ],
-        )
-    })?;
-    Ok((t[0], t[1], t[2], t[3]))
+    const IDLE: std::time::Duration = std::time::Duration::from_millis(2);
+    let work: [&(dyn Fn() + Sync); 4] = [
+        &|| {
+            std::hint::black_box(f());
+        },
+        &|| {
+            std::hint::black_box(yardstick());
+        },
+        &|| {
+            std::hint::black_box(wide_yardstick());
+        },
+        &|| copy.run(),
+    ];
+    let pools = [pool_1, pool_2];
+    let mut times = vec![vec![Vec::with_capacity(iters + BLOCK); 4]; 2];
+    // Once each untimed: the pools' threads started, the caches warm.
+    for pool in pools {
+        for w in work {
+            pool.install(w);
+        }
+    }
+    for _ in 0..iters.div_ceil(BLOCK).max(1) {
+        for (pool, t) in pools.iter().zip(&mut times) {
+            for (w, t) in work.iter().zip(t.iter_mut()) {
+                pool.install(|| {
+                    for _ in 0..BLOCK {
+                        let start = Instant::now();
+                        w();
+                        t.push(ms_since(start));
+                    }
+                });
+                // A pool's idle threads spin a while before they sleep: untimed, let them, so
+                // that they take no core from the next block.
+                std::thread::sleep(IDLE);
+            }
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut out = [[0.0; 4]; 2];
+    for (o, t) in out.iter_mut().zip(times) {
+        for (o, v) in o.iter_mut().zip(t) {
+            *o = median(v);
+        }
+    }
+    out
 }
 
 /// Work bound by memory bandwidth alone: a copy of as many bytes as the anaglyph of a
@@ -207,32 +233,43 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     // The same two pools for every row.
     let (pool_1, pool_2) = (pool(1)?, pool(2)?);
     let copy = CopyYardstick::new();
+    // Three consecutive runs of every row: a machine that gives the second core in one run
+    // and not in the next shows as runs that disagree, not as one lucky figure.
+    let mut runs: Vec<Vec<[[f64; 4]; 2]>> = vec![Vec::new(); cases.len()];
+    for _ in 0..RUNS {
+        for ((_, _, f), r) in cases.iter().zip(&mut runs) {
+            // At least 300 frames: a fresh pool's first tens of frames run slow on this shared
+            // machine (with 40, the speed-ups read 1.1–1.5 where 300 give 1.9–2.0 in the same
+            // hour), and short frames need many to steady the median.
+            r.push(in_turns((&pool_1, &pool_2), iters.max(300), *f, &copy));
+        }
+    }
     let mut rows = Vec::new();
-    for (what, setting, f) in cases {
-        // At least 300 frames: a fresh pool's first tens of frames run slow on this shared
-        // machine (with 40, the speed-ups read 1.1–1.5 where 300 give 1.9–2.0 in the same
-        // hour), and short frames need many to steady the median.
-        let n = iters.max(300);
-        let (one, yard_one, wide_one, copy_one) = on_pool(&pool_1, n, f, &copy)?;
-        let (two, yard_two, wide_two, copy_two) = on_pool(&pool_2, n, f, &copy)?;
+    for ((what, setting, _), r) in cases.iter().zip(&runs) {
+        let [one, two] = r[0];
+        let speed_ups: Vec<String> = r
+            .iter()
+            .map(|[a, b]| format!("{:.2}", a[0] / b[0]))
+            .collect();
         rows.push(row(
             "threads",
             format!("{what}, {setting}, 1 thread"),
-            one,
+            one[0],
             "",
         ));
         rows.push(row(
             "threads",
             format!("{what}, {setting}, 2 threads"),
-            two,
+            two[0],
             format!(
                 "speed-up 1 -> 2 threads = {:.2} (goal >= 1.8; {cores} cores seen); \
                  a register-only loop in the same turns: {:.2}, with eight chains: {:.2}; \
-                 a 6.3 MB copy: {:.2}",
-                one / two,
-                yard_one / yard_two,
-                wide_one / wide_two,
-                copy_one / copy_two
+                 a 6.3 MB copy: {:.2}; {RUNS} consecutive runs: {}",
+                one[0] / two[0],
+                one[1] / two[1],
+                one[2] / two[2],
+                one[3] / two[3],
+                speed_ups.join(", ")
             ),
         ));
     }
@@ -240,6 +277,9 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     rows.push(work_split(scene)?);
     Ok(rows)
 }
+
+/// Consecutive runs of each threads row (the first run's times are the rows').
+const RUNS: usize = 3;
 
 /// The frame of the pair + Dubois rows.
 const DUBOIS: Output = Output::Anaglyph(AnaglyphKind::DuboisRedCyan);
