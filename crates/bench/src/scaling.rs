@@ -77,7 +77,8 @@ fn in_turns(
         &|| copy.run(),
     ];
     let pools = [pool_1, pool_2];
-    let mut times = vec![vec![Vec::with_capacity(iters + BLOCK); 4]; 2];
+    let mut times: [[Vec<f64>; 4]; 2] =
+        std::array::from_fn(|_| std::array::from_fn(|_| Vec::with_capacity(iters + BLOCK)));
     // Once each untimed: the pools' threads started, the caches warm.
     for pool in pools {
         for w in work {
