@@ -16,7 +16,7 @@
 
 use std::time::Instant;
 
-use super::{Row, median_ms};
+use super::{Row, interleaved_medians, median_ms};
 use stereolab::fixtures::{TABLE_1, table_scene};
 use stereolab::output::produce;
 use stereolab::plan::{Output, Plan, Shading};
@@ -52,66 +52,51 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 }
 
 /// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of the [`CopyYardstick`],
-/// each on `pool_1` and on `pool_2` (`[f, yardstick, wide, copy]` per pool), timed in turns:
-/// blocks of 10 runs of one inside its pool, then the next, every one once per round, until
-/// each has at least `iters` runs. A slow spell of the shared machine then falls on the 1- and
-/// the 2-thread runs alike, instead of on whichever pool was being timed.
-fn in_turns(
-    (pool_1, pool_2): (&rayon::ThreadPool, &rayon::ThreadPool),
+/// each on `pool_1`, then each on `pool_2` (`[f, yardstick, wide, copy]` per pool): inside one
+/// pool, blocks of 10 runs of each in turns, until each has at least `iters` runs.
+///
+/// Each pool runs its frames back to back, as a program's frames follow each other: timing
+/// the two pools in turns instead (a block on one, then a block on the other) left each
+/// 2-thread block the data the 1-thread block had just written from one core, and read the
+/// memory-bound rows low (the anaglyph alone 1.48–1.66 against 1.75–1.77, the 6.3 MB copy
+/// beside the rows 0.88–1.40 against 1.24–1.83, in alternating runs of the same build). A slow spell that falls on one
+/// pool's turn shows in the yardsticks beside the row and as runs that disagree.
+fn on_pools(
+    pools: [&rayon::ThreadPool; 2],
     iters: usize,
     f: &(dyn Fn() -> bool + Sync),
     copy: &CopyYardstick,
-) -> [[f64; 4]; 2] {
+) -> Result<[[f64; 4]; 2]> {
     const BLOCK: usize = 10;
-    const IDLE: std::time::Duration = std::time::Duration::from_millis(2);
-    let work: [&(dyn Fn() + Sync); 4] = [
-        &|| {
-            std::hint::black_box(f());
-        },
-        &|| {
-            std::hint::black_box(yardstick());
-        },
-        &|| {
-            std::hint::black_box(wide_yardstick());
-        },
-        &|| copy.run(),
-    ];
-    let pools = [pool_1, pool_2];
-    let mut times: [[Vec<f64>; 4]; 2] =
-        std::array::from_fn(|_| std::array::from_fn(|_| Vec::with_capacity(iters + BLOCK)));
-    // Once each untimed: the pools' threads started, the caches warm.
-    for pool in pools {
-        for w in work {
-            pool.install(w);
-        }
-    }
-    for _ in 0..iters.div_ceil(BLOCK).max(1) {
-        for (pool, t) in pools.iter().zip(&mut times) {
-            for (w, t) in work.iter().zip(t.iter_mut()) {
-                pool.install(|| {
-                    for _ in 0..BLOCK {
-                        let start = Instant::now();
-                        w();
-                        t.push(ms_since(start));
-                    }
-                });
-                // A pool's idle threads spin a while before they sleep: untimed, let them, so
-                // that they take no core from the next block.
-                std::thread::sleep(IDLE);
-            }
-        }
-    }
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
     let mut out = [[0.0; 4]; 2];
-    for (o, t) in out.iter_mut().zip(times) {
-        for (o, v) in o.iter_mut().zip(t) {
-            *o = median(v);
-        }
+    for (pool, o) in pools.into_iter().zip(&mut out) {
+        let t = pool.install(|| {
+            interleaved_medians(
+                iters.div_ceil(BLOCK),
+                BLOCK,
+                &mut [
+                    &mut || {
+                        std::hint::black_box(f());
+                        Ok(())
+                    },
+                    &mut || {
+                        std::hint::black_box(yardstick());
+                        Ok(())
+                    },
+                    &mut || {
+                        std::hint::black_box(wide_yardstick());
+                        Ok(())
+                    },
+                    &mut || {
+                        copy.run();
+                        Ok(())
+                    },
+                ],
+            )
+        })?;
+        o.copy_from_slice(&t);
     }
-    out
+    Ok(out)
 }
 
 /// Work bound by memory bandwidth alone: a copy of as many bytes as the anaglyph of a
@@ -242,7 +227,7 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             // At least 300 frames: a fresh pool's first tens of frames run slow on this shared
             // machine (with 40, the speed-ups read 1.1–1.5 where 300 give 1.9–2.0 in the same
             // hour), and short frames need many to steady the median.
-            r.push(in_turns((&pool_1, &pool_2), iters.max(300), *f, &copy));
+            r.push(on_pools([&pool_1, &pool_2], iters.max(300), *f, &copy)?);
         }
     }
     let mut rows = Vec::new();
