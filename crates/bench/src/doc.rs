@@ -128,6 +128,20 @@ fn thread_pairs(rows: &[Row]) -> Vec<(String, &Row, &Row)> {
         .collect()
 }
 
+/// The thread rows past two threads (a machine with more cores): (what, threads, 1-thread
+/// row, that row).
+fn more_threads(rows: &[Row]) -> Vec<(String, usize, &Row, &Row)> {
+    rows.iter()
+        .filter(|r| r.area == "scaling" && r.knob == "threads")
+        .filter_map(|r| {
+            let (what, n) = r.setting.strip_suffix(" threads")?.rsplit_once(", ")?;
+            let n: usize = n.parse().ok().filter(|&n| n > 2)?;
+            let one = find(rows, "scaling", "threads", &format!("{what}, 1 thread"))?;
+            Some((what.to_string(), n, one, r))
+        })
+        .collect()
+}
+
 /// One cost point: its setting, its `cpu` row and its measured `wgpu` row.
 type CostPoint<'a> = (String, &'a Row, Option<&'a Row>);
 
@@ -384,6 +398,18 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
             one.ms / two.ms
         );
     }
+    for (what, n, one, more) in more_threads(rows) {
+        let runs = runs(more)
+            .map(|r| format!(" ({} consecutive runs: {})", r.len(), r.join(", ")))
+            .unwrap_or_default();
+        let _ = writeln!(
+            s,
+            "| {what}, 1 → {n} threads | {:.2} → {:.2} ms = **{:.2}**{runs} | — |",
+            one.ms,
+            more.ms,
+            one.ms / more.ms
+        );
+    }
     if let Some(st) = rows
         .iter()
         .find(|r| r.area == "scaling" && r.knob == "stages")
@@ -631,6 +657,7 @@ mod tests {
             r(COST, BY_PIXELS, "4096x4096, wgpu", f64::NAN),
             r("scaling", "threads", "stereo pair, x, 1 thread", 4.0),
             r("scaling", "threads", "stereo pair, x, 2 threads", 2.5),
+            r("scaling", "threads", "stereo pair, x, 4 threads", 1.25),
             r(
                 "sirds",
                 "the SIRDS paper's Table 1",
@@ -655,6 +682,10 @@ mod tests {
             "{s}"
         );
         assert!(s.contains("4.00 → 2.50 ms = **1.60**"), "{s}");
+        assert!(
+            s.contains("| stereo pair, x, 1 → 4 threads | 4.00 → 1.25 ms = **3.20** | — |"),
+            "{s}"
+        );
         // 2 000 Hz against the paper's 60.1 Hz.
         assert!(s.contains("| 0.50 ms | 33.3× |"), "{s}");
         assert!(s.contains("![time per frame against triangles and pixels](p.png)"));

@@ -51,9 +51,9 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::internal("bench scaling", format!("thread pool: {e}")))
 }
 
-/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of the [`CopyYardstick`],
-/// each on `pool_1`, then each on `pool_2` (`[f, yardstick, wide, copy]` per pool): inside one
-/// pool, blocks of 10 runs of each in turns, until each has at least `iters` runs.
+/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of the [`CopyYardstick`] on
+/// each of `pools`, one pool after the other (`[f, yardstick, wide, copy]` per pool): inside
+/// one pool, blocks of 10 runs of each in turns, until each has at least `iters` runs.
 ///
 /// Each pool runs its frames back to back, as a program's frames follow each other: timing
 /// the two pools in turns instead (a block on one, then a block on the other) left each
@@ -62,14 +62,14 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 /// beside the rows 0.88–1.40 against 1.24–1.83, in alternating runs of the same build). A slow spell that falls on one
 /// pool's turn shows in the yardsticks beside the row and as runs that disagree.
 fn on_pools(
-    pools: [&rayon::ThreadPool; 2],
+    pools: &[rayon::ThreadPool],
     iters: usize,
     f: &(dyn Fn() -> bool + Sync),
     copy: &CopyYardstick,
-) -> Result<[[f64; 4]; 2]> {
+) -> Result<Vec<[f64; 4]>> {
     const BLOCK: usize = 10;
-    let mut out = [[0.0; 4]; 2];
-    for (pool, o) in pools.into_iter().zip(&mut out) {
+    let mut out = vec![[0.0; 4]; pools.len()];
+    for (pool, o) in pools.iter().zip(&mut out) {
         let t = pool.install(|| {
             interleaved_medians(
                 iters.div_ceil(BLOCK),
@@ -216,27 +216,34 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         ),
     ];
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
-    // The same two pools for every row.
-    let (pool_1, pool_2) = (pool(1)?, pool(2)?);
+    // The same pools for every row: 1 and 2 threads, and on a larger machine up to its cores.
+    let counts = thread_counts(cores);
+    let pools = counts
+        .iter()
+        .map(|&n| pool(n))
+        .collect::<Result<Vec<_>>>()?;
     let copy = CopyYardstick::new();
     // Three consecutive runs of every row: a machine that gives the second core in one run
     // and not in the next shows as runs that disagree, not as one lucky figure.
-    let mut runs: Vec<Vec<[[f64; 4]; 2]>> = vec![Vec::new(); cases.len()];
+    let mut runs: Vec<Vec<Vec<[f64; 4]>>> = vec![Vec::new(); cases.len()];
     for _ in 0..RUNS {
         for ((_, _, f), r) in cases.iter().zip(&mut runs) {
             // At least 300 frames: a fresh pool's first tens of frames run slow on this shared
             // machine (with 40, the speed-ups read 1.1–1.5 where 300 give 1.9–2.0 in the same
             // hour), and short frames need many to steady the median.
-            r.push(on_pools([&pool_1, &pool_2], iters.max(300), *f, &copy)?);
+            r.push(on_pools(&pools, iters.max(300), *f, &copy)?);
         }
     }
     let mut rows = Vec::new();
     for ((what, setting, _), r) in cases.iter().zip(&runs) {
-        let [one, two] = r[0];
-        let speed_ups: Vec<String> = r
-            .iter()
-            .map(|[a, b]| format!("{:.2}", a[0] / b[0]))
-            .collect();
+        let (one, two) = (r[0][0], r[0][1]);
+        let speed_ups = |p: usize| -> String {
+            let s: Vec<String> = r
+                .iter()
+                .map(|t| format!("{:.2}", t[0][0] / t[p][0]))
+                .collect();
+            s.join(", ")
+        };
         rows.push(row(
             "threads",
             format!("{what}, {setting}, 1 thread"),
@@ -255,13 +262,43 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
                 one[1] / two[1],
                 one[2] / two[2],
                 one[3] / two[3],
-                speed_ups.join(", ")
+                speed_ups(1)
             ),
         ));
+        // More threads where the machine has them (the yardsticks use two halves: none here).
+        for (p, &n) in counts.iter().enumerate().skip(2) {
+            rows.push(row(
+                "threads",
+                format!("{what}, {setting}, {n} threads"),
+                r[0][p][0],
+                format!(
+                    "speed-up 1 -> {n} threads = {:.2} ({cores} cores seen); {RUNS} consecutive \
+                     runs: {}",
+                    one[0] / r[0][p][0],
+                    speed_ups(p)
+                ),
+            ));
+        }
     }
-    rows.push(sirds_stages(&pool_1, &pool_2, iters.max(300))?);
+    let (pool_1, pool_2) = (&pools[0], &pools[1]);
+    rows.push(sirds_stages(pool_1, pool_2, iters.max(300))?);
     rows.push(work_split(scene)?);
     Ok(rows)
+}
+
+/// The thread counts the threads rows time on a machine with `cores` cores: 1 and 2 always,
+/// then every power of two up to the cores, and the cores themselves.
+fn thread_counts(cores: usize) -> Vec<usize> {
+    let mut counts = vec![1, 2];
+    let mut n = 4;
+    while n <= cores {
+        counts.push(n);
+        n *= 2;
+    }
+    if cores > 2 && !counts.contains(&cores) {
+        counts.push(cores);
+    }
+    counts
 }
 
 /// Consecutive runs of each threads row (the first run's times are the rows').
@@ -529,4 +566,18 @@ fn triangle_count(iters: usize) -> Result<Vec<Row>> {
         ));
     }
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::thread_counts;
+
+    #[test]
+    fn thread_counts_are_one_two_then_powers_of_two_up_to_the_cores() {
+        assert_eq!(thread_counts(1), [1, 2]);
+        assert_eq!(thread_counts(2), [1, 2]);
+        assert_eq!(thread_counts(3), [1, 2, 3]);
+        assert_eq!(thread_counts(12), [1, 2, 4, 8, 12]);
+        assert_eq!(thread_counts(16), [1, 2, 4, 8, 16]);
+    }
 }
