@@ -2,9 +2,10 @@
 //! ratio measured in the same run.
 //!
 //! - threads: the stereo pair of the real model, the pair + Dubois anaglyph, the anaglyph
-//!   alone and the SIRDS paper's Table 1 frame on a pool of 1 thread and one of 2 (the
-//!   speed-up; the bytes are the same on any count), and how the pair's work splits over the
-//!   bands (the speed-up that split allows on more threads);
+//!   alone and the SIRDS paper's Table 1 frame on a pool of 1 thread and one of 2, and on a
+//!   larger machine of 4, 8, … up to its cores (the speed-up, in three consecutive runs; the
+//!   bytes are the same on any count), and how the pair's work splits over the bands (the
+//!   speed-up that split allows on more threads);
 //! - image size: the stereo pair at 512² … 4096², as nanoseconds per pixel (flat or falling
 //!   when the time grows no faster than the pixels);
 //! - triangle count: the stereo pair of a height-field grid of 1 000 … 1 000 000 triangles at
@@ -59,8 +60,9 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 /// the two pools in turns instead (a block on one, then a block on the other) left each
 /// 2-thread block the data the 1-thread block had just written from one core, and read the
 /// memory-bound rows low (the anaglyph alone 1.48–1.66 against 1.75–1.77, the 6.3 MB copy
-/// beside the rows 0.88–1.40 against 1.24–1.83, in alternating runs of the same build). A slow spell that falls on one
-/// pool's turn shows in the yardsticks beside the row and as runs that disagree.
+/// beside the rows 0.88–1.40 against 1.24–1.83, in alternating runs of the same build). A
+/// slow spell that falls on one pool's turn shows in the yardsticks beside the row and as
+/// runs that disagree.
 fn on_pools(
     pools: &[rayon::ThreadPool],
     iters: usize,
