@@ -17,6 +17,7 @@ mod traverse;
 pub use clip::ClipRange;
 pub(crate) use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
 pub use depth_modes::DepthMode;
+use setup::setup_triangle_into;
 pub use setup::{DepthPlane, Plane, Setup, SetupTriangle, WindowVertex, setup_triangle};
 pub use traverse::{Band, SmallBox, traverse};
 
@@ -343,10 +344,14 @@ fn setup_chunk(
             continue; // all three outside the same plane
         }
         let mut add = |w: [WindowVertex; 3], var: [&Varyings; 3]| {
-            match setup_triangle(w, var, nvar, width, height, opts) {
-                Setup::Triangle(t) => setups.push(t),
-                Setup::Culled => return true,
-                Setup::Empty => {}
+            // Set up in the list's next slot (`setup_triangle`, without moving the result).
+            setups.reserve(1);
+            let slot = &mut setups.spare_capacity_mut()[0];
+            match setup_triangle_into(w, var, nvar, (width, height), opts, slot) {
+                // SAFETY: the slot past the list's end was just written (the outcome says so).
+                setup::Outcome::Triangle => unsafe { setups.set_len(setups.len() + 1) },
+                setup::Outcome::Culled => return true,
+                setup::Outcome::Empty => {}
             }
             false
         };

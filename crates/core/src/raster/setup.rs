@@ -3,6 +3,7 @@
 //! docs/ARCHITECTURE.md "Rasterization rules"; walking the covered pixels is in `traverse.rs`.
 
 use crate::shade::{MAX_VARYINGS, Varyings};
+use std::mem::MaybeUninit;
 
 use super::RasterOptions;
 use super::clip::ClipVertex;
@@ -231,15 +232,60 @@ pub fn setup_triangle(
     setup_triangle_culling(v, var, nvar, (width, height), opts, true)
 }
 
+/// What [`setup_triangle_into`] made.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Outcome {
+    /// [`Setup::Empty`].
+    Empty,
+    /// [`Setup::Culled`].
+    Culled,
+    /// [`Setup::Triangle`]: `out` now holds it.
+    Triangle,
+}
+
+/// [`setup_triangle`], the set-up triangle written into `out` (left as it was unless the
+/// outcome is [`Outcome::Triangle`]): a caller that keeps it in a `Vec` writes it in place
+/// instead of moving the 248 bytes once more.
+pub(crate) fn setup_triangle_into(
+    v: [WindowVertex; 3],
+    var: [&Varyings; 3],
+    nvar: usize,
+    size: (u32, u32),
+    opts: &RasterOptions,
+    out: &mut MaybeUninit<SetupTriangle>,
+) -> Outcome {
+    setup_into(v, var, nvar, size, opts, true, out)
+}
+
 /// [`setup_triangle`], with the small-triangle test (`cull_small`) or without it.
 fn setup_triangle_culling(
+    v: [WindowVertex; 3],
+    var: [&Varyings; 3],
+    nvar: usize,
+    size: (u32, u32),
+    opts: &RasterOptions,
+    cull_small: bool,
+) -> Setup {
+    let mut out = MaybeUninit::uninit();
+    match setup_into(v, var, nvar, size, opts, cull_small, &mut out) {
+        Outcome::Empty => Setup::Empty,
+        Outcome::Culled => Setup::Culled,
+        // SAFETY: `setup_into` wrote `out` (its outcome says so).
+        Outcome::Triangle => Setup::Triangle(unsafe { out.assume_init() }),
+    }
+}
+
+/// The setup itself, for [`setup_triangle_culling`] and [`setup_triangle_into`]: writes `out`
+/// exactly when the outcome is [`Outcome::Triangle`].
+fn setup_into(
     v: [WindowVertex; 3],
     var: [&Varyings; 3],
     nvar: usize,
     (width, height): (u32, u32),
     opts: &RasterOptions,
     cull_small: bool,
-) -> Setup {
+    out: &mut MaybeUninit<SetupTriangle>,
+) -> Outcome {
     let bits = opts.subpixel_bits.clamp(1, 16);
     let (mut xs, mut ys) = ([0i64; 3], [0i64; 3]);
     for i in 0..3 {
@@ -248,12 +294,12 @@ fn setup_triangle_culling(
     }
     let area = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (xs[2] - xs[0]) * (ys[1] - ys[0]);
     if area == 0 {
-        return Setup::Empty; // zero area on the grid: draws nothing
+        return Outcome::Empty; // zero area on the grid: draws nothing
     }
     // Counter-clockwise in NDC (y up) is a negative area in window space (y down).
     let front_facing = area < 0;
     if opts.cull_back && !front_facing {
-        return Setup::Culled;
+        return Outcome::Culled;
     }
     if area > 0 {
         xs.swap(1, 2);
@@ -284,13 +330,13 @@ fn setup_triangle_culling(
     let py1 = floor_div(ys[0].max(ys[1]).max(ys[2])).min(height as i64 - 1);
     let bounds = [px0, px1, py0, py1];
     if px0 > px1 || py0 > py1 || (cull_small && covers_no_center(&c, &dcdx, &dcdy, bits, bounds)) {
-        return Setup::Empty;
+        return Outcome::Empty;
     }
     let (dx1, dy1) = (v[1].x - v[0].x, v[1].y - v[0].y);
     let (dx2, dy2) = (v[2].x - v[0].x, v[2].y - v[0].y);
     let det = dx1 * dy2 - dx2 * dy1;
     if det == 0.0 || !det.is_finite() {
-        return Setup::Empty;
+        return Outcome::Empty;
     }
     let plane = |a: [f32; 3]| {
         let (da1, da2) = (a[1] - a[0], a[2] - a[0]);
@@ -303,12 +349,12 @@ fn setup_triangle_culling(
     // llvmpipe's vertex order: as submitted when counter-clockwise on screen, else v0, v2, v1.
     let order = if area > 0 { [0, 2, 1] } else { [0, 1, 2] };
     let Some(z) = DepthPlane::new(order.map(|i| (v[i].depth_x, v[i].depth_y, v[i].z))) else {
-        return Setup::Empty; // no area in floating point, or gradients that overflow f32
+        return Outcome::Empty; // no area in floating point, or gradients that overflow f32
     };
     let inv_w = plane([v[0].inv_w, v[1].inv_w, v[2].inv_w]);
     let finite = |p: &Plane| p.a0.is_finite() && p.dadx.is_finite() && p.dady.is_finite();
     if !finite(&inv_w) {
-        return Setup::Empty; // a sliver so thin its gradients overflow f32
+        return Outcome::Empty; // a sliver so thin its gradients overflow f32
     }
     let mut var_planes = [inv_w; MAX_VARYINGS];
     for (k, p) in var_planes.iter_mut().enumerate().take(nvar) {
@@ -322,7 +368,7 @@ fn setup_triangle_culling(
             plane([var[0][k], var[1][k], var[2][k]])
         };
     }
-    Setup::Triangle(SetupTriangle {
+    out.write(SetupTriangle {
         c,
         dcdx,
         dcdy,
@@ -338,7 +384,8 @@ fn setup_triangle_culling(
         inv_w,
         var: var_planes,
         nvar,
-    })
+    });
+    Outcome::Triangle
 }
 
 /// Boxes of at most this many pixel centers are tested by [`covers_no_center`].
