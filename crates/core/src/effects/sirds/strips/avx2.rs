@@ -249,7 +249,8 @@ pub(super) unsafe fn resolve_sweep(
         let p = unsafe { _mm256_loadu_ps(sources.as_ptr().add(k)) };
         let has = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_ORD_Q>(p, p));
         if _mm256_movemask_ps(_mm256_castsi256_ps(has)) == 0 {
-            pattern.fill_span(k as u32, y, &mut row[k..k + 8]);
+            // SAFETY: AVX2 (this function's condition).
+            unsafe { pattern.fill_span_avx2(k as u32, y, &mut row[k..k + 8]) };
             return None;
         }
         Some((p, has))
