@@ -380,6 +380,17 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
             );
         }
     }
+    // One table line per speed-up: what, 1 → n threads, the times, what follows the ratio.
+    let mut speed_up = |what: &str, n: usize, one: &Row, other: &Row, tail: String, goal: &str| {
+        let _ = writeln!(
+            s,
+            "| {what}, 1 → {n} threads | {:.2} → {:.2} ms = **{:.2}**{tail} | {goal} |",
+            one.ms,
+            other.ms,
+            one.ms / other.ms
+        );
+    };
+    let consecutive = |r: Vec<String>| format!("{} consecutive runs: {}", r.len(), r.join(", "));
     for (what, one, two) in thread_pairs(rows) {
         let copy = number_after(&two.note, "a 6.3 MB copy: ")
             .map(|c| format!(", a 6.3 MB copy: {c:.2}"))
@@ -388,27 +399,15 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
             .map(|y| format!(" (a register-only loop in the same turns: {y:.2}{copy})"))
             .unwrap_or_default();
         let runs = runs(two)
-            .map(|r| format!("; {} consecutive runs: {}", r.len(), r.join(", ")))
+            .map(|r| format!("; {}", consecutive(r)))
             .unwrap_or_default();
-        let _ = writeln!(
-            s,
-            "| {what}, 1 → 2 threads | {:.2} → {:.2} ms = **{:.2}**{yard}{runs} | ≥ 1.8 |",
-            one.ms,
-            two.ms,
-            one.ms / two.ms
-        );
+        speed_up(&what, 2, one, two, format!("{yard}{runs}"), "≥ 1.8");
     }
     for (what, n, one, more) in more_threads(rows) {
         let runs = runs(more)
-            .map(|r| format!(" ({} consecutive runs: {})", r.len(), r.join(", ")))
+            .map(|r| format!(" ({})", consecutive(r)))
             .unwrap_or_default();
-        let _ = writeln!(
-            s,
-            "| {what}, 1 → {n} threads | {:.2} → {:.2} ms = **{:.2}**{runs} | — |",
-            one.ms,
-            more.ms,
-            one.ms / more.ms
-        );
+        speed_up(&what, n, one, more, runs, "—");
     }
     if let Some(st) = rows
         .iter()
