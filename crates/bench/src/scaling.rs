@@ -52,9 +52,12 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::internal("bench scaling", format!("thread pool: {e}")))
 }
 
-/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of the [`CopyYardstick`] on
-/// each of `pools`, one pool after the other (`[f, yardstick, wide, copy]` per pool): inside
-/// one pool, blocks of 10 runs of each in turns, until each has at least `iters` runs.
+/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of the [`CopyYardstick`],
+/// in that order, on one pool.
+type PoolTimes = [f64; 4];
+
+/// [`PoolTimes`] on each of `pools`, one pool after the other: inside one pool, blocks of 10
+/// runs of each in turns, until each has at least `iters` runs.
 ///
 /// Each pool runs its frames back to back, as a program's frames follow each other: timing
 /// the two pools in turns instead (a block on one, then a block on the other) left each
@@ -68,10 +71,9 @@ fn on_pools(
     iters: usize,
     f: &(dyn Fn() -> bool + Sync),
     copy: &CopyYardstick,
-) -> Result<Vec<[f64; 4]>> {
+) -> Result<Vec<PoolTimes>> {
     const BLOCK: usize = 10;
-    let mut out = vec![[0.0; 4]; pools.len()];
-    for (pool, o) in pools.iter().zip(&mut out) {
+    let on = |pool: &rayon::ThreadPool| -> Result<PoolTimes> {
         let t = pool.install(|| {
             interleaved_medians(
                 iters.div_ceil(BLOCK),
@@ -96,9 +98,9 @@ fn on_pools(
                 ],
             )
         })?;
-        o.copy_from_slice(&t);
-    }
-    Ok(out)
+        Ok([t[0], t[1], t[2], t[3]])
+    };
+    pools.iter().map(on).collect()
 }
 
 /// Work bound by memory bandwidth alone: a copy of as many bytes as the anaglyph of a
@@ -227,7 +229,8 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
     let copy = CopyYardstick::new();
     // Three consecutive runs of every row: a machine that gives the second core in one run
     // and not in the next shows as runs that disagree, not as one lucky figure.
-    let mut runs: Vec<Vec<Vec<[f64; 4]>>> = vec![Vec::new(); cases.len()];
+    // Per case, per run, per pool.
+    let mut runs: Vec<Vec<Vec<PoolTimes>>> = vec![Vec::new(); cases.len()];
     for _ in 0..RUNS {
         for ((_, _, f), r) in cases.iter().zip(&mut runs) {
             // At least 300 frames: a fresh pool's first tens of frames run slow on this shared

@@ -17,8 +17,8 @@ mod traverse;
 pub use clip::ClipRange;
 pub(crate) use clip::{ClipVertex, MAX_CLIPPED, clip_triangle, outcode};
 pub use depth_modes::DepthMode;
-use setup::setup_triangle_into;
 pub use setup::{DepthPlane, Plane, Setup, SetupTriangle, WindowVertex, setup_triangle};
+use setup::{Outcome, setup_into};
 pub use traverse::{Band, SmallBox, traverse};
 
 use rayon::prelude::*;
@@ -347,11 +347,11 @@ fn setup_chunk(
             // Set up in the list's next slot (`setup_triangle`, without moving the result).
             setups.reserve(1);
             let slot = &mut setups.spare_capacity_mut()[0];
-            match setup_triangle_into(w, var, nvar, (width, height), opts, slot) {
+            match setup_into(w, var, nvar, (width, height), opts, true, slot) {
                 // SAFETY: the slot past the list's end was just written (the outcome says so).
-                setup::Outcome::Triangle => unsafe { setups.set_len(setups.len() + 1) },
-                setup::Outcome::Culled => return true,
-                setup::Outcome::Empty => {}
+                Outcome::Triangle => unsafe { setups.set_len(setups.len() + 1) },
+                Outcome::Culled => return true,
+                Outcome::Empty => {}
             }
             false
         };

@@ -232,7 +232,7 @@ pub fn setup_triangle(
     setup_triangle_culling(v, var, nvar, (width, height), opts, true)
 }
 
-/// What [`setup_triangle_into`] made.
+/// What [`setup_into`] made.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Outcome {
     /// [`Setup::Empty`].
@@ -241,20 +241,6 @@ pub(crate) enum Outcome {
     Culled,
     /// [`Setup::Triangle`]: `out` now holds it.
     Triangle,
-}
-
-/// [`setup_triangle`], the set-up triangle written into `out` (left as it was unless the
-/// outcome is [`Outcome::Triangle`]): a caller that keeps it in a `Vec` writes it in place
-/// instead of moving the 248 bytes once more.
-pub(crate) fn setup_triangle_into(
-    v: [WindowVertex; 3],
-    var: [&Varyings; 3],
-    nvar: usize,
-    size: (u32, u32),
-    opts: &RasterOptions,
-    out: &mut MaybeUninit<SetupTriangle>,
-) -> Outcome {
-    setup_into(v, var, nvar, size, opts, true, out)
 }
 
 /// [`setup_triangle`], with the small-triangle test (`cull_small`) or without it.
@@ -275,9 +261,10 @@ fn setup_triangle_culling(
     }
 }
 
-/// The setup itself, for [`setup_triangle_culling`] and [`setup_triangle_into`]: writes `out`
-/// exactly when the outcome is [`Outcome::Triangle`].
-fn setup_into(
+/// [`setup_triangle`] (with the small-triangle test when `cull_small`), the set-up triangle
+/// written into `out` exactly when the outcome is [`Outcome::Triangle`]: a caller that keeps
+/// it in a `Vec` writes it in place instead of moving the 248 bytes once more.
+pub(crate) fn setup_into(
     v: [WindowVertex; 3],
     var: [&Varyings; 3],
     nvar: usize,
