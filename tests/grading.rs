@@ -4,23 +4,17 @@
 //!
 //! Every test here runs `stereolab grade`, which builds the exercise crates with cargo in this
 //! workspace's target folder (dependencies are shared, only the small exercise crates compile).
-//! The builds overwrite the same `target/debug/ex*` executables, so the tests take turns.
+//! The tests run side by side: each writes its own output folder, and the grader's build folder,
+//! which they share, takes one build at a time under its own lock, across processes too.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::{Mutex, MutexGuard};
 
 use serde_json::Value;
 
 use crate::common::{out_dir, root};
 use stereolab_grade::Exercise;
 use stereolab_grade::points;
-
-static BUILDS: Mutex<()> = Mutex::new(());
-
-pub(crate) fn take_turn() -> MutexGuard<'static, ()> {
-    BUILDS.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 /// Per-task time limit: ample for every task (they answer in milliseconds), short enough that
 /// the endless-loop mutant costs little.
@@ -154,7 +148,6 @@ pub(crate) fn full_points(t: &Value) -> f64 {
 
 #[test]
 fn solution_scores_full_marks_on_every_task() {
-    let _turn = take_turn();
     let (out, v) = grade("all", &["--solution"], &repo_exercises(), None, "solution");
     for t in tests_of(&v) {
         assert_eq!(t["status"], "passed", "{}: {}", t["name"], t["output"]);
@@ -174,7 +167,6 @@ fn solution_scores_full_marks_on_every_task() {
 
 #[test]
 fn untouched_stubs_score_zero_and_the_grader_exits_cleanly_with_the_table() {
-    let _turn = take_turn();
     let (out, v) = grade("all", &[], &repo_exercises(), None, "stubs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     for t in tests_of(&v) {
@@ -210,7 +202,6 @@ struct Planted {
 /// Plants the mistakes together (they touch disjoint tasks), grades once, and checks that each
 /// lost points on exactly its tasks with its hint while every other task kept full marks.
 fn check_planted(what: &str, planted: &[Planted], name: &str) {
-    let _turn = take_turn();
     let mutants: Vec<&str> = planted.iter().map(|p| p.mutant).collect();
     let (_, v) = grade(
         what,
@@ -545,7 +536,6 @@ fn hidden_counts(t: &Value) -> Option<(usize, usize)> {
 
 #[test]
 fn hidden_cases_come_from_the_seed_the_solution_passes_them_and_a_mutant_fails_them() {
-    let _turn = take_turn();
     let (_, v) = grade_seeded(
         "all",
         &["--solution"],
@@ -654,7 +644,6 @@ pub(crate) fn files_under(dir: &Path) -> Vec<PathBuf> {
 
 #[test]
 fn exported_handout_has_no_solutions_builds_and_grades() {
-    let _turn = take_turn();
     let handout = out_dir("handout");
     let documents = out_dir("handout_documents");
     std::fs::write(documents.join("course-copy.txt"), "the course's copy\n").unwrap();
@@ -900,7 +889,6 @@ fn exported_handout_has_no_solutions_builds_and_grades() {
 
 #[test]
 fn students_worked_examples_pass_with_the_solution() {
-    let _turn = take_turn();
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = Command::new(cargo)
         .current_dir(root())
@@ -956,7 +944,6 @@ fn bad_grade_arguments_get_clear_errors() {
 
 #[test]
 fn render_exercise_writes_the_solution_next_to_the_reference_on_any_scene() {
-    let _turn = take_turn();
     let dir = out_dir("render_exercise");
     let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
         .current_dir(root())
@@ -1030,7 +1017,6 @@ fn compare_exercise_solution_matches_the_gpu_and_swapped_eyes_exceed_the_parity_
     if crate::gpu_parity::gpu().is_none() {
         return;
     }
-    let _turn = take_turn();
     let (code, text) = compare_exercise(None, "compare_exercise_solution");
     assert_eq!(code, Some(0), "{text}");
     for side in ["left", "right"] {

@@ -8,9 +8,7 @@ use std::process::{Command, Output};
 use serde_json::Value;
 
 use crate::common::out_dir;
-use crate::grading::{
-    full_points, grade, repo_exercises, spec_totals, take_turn, target_dir, tests_of,
-};
+use crate::grading::{full_points, grade, repo_exercises, spec_totals, target_dir, tests_of};
 use stereolab_grade::Exercise;
 
 /// Gradescope's values for `visibility` (results.json and each test).
@@ -132,7 +130,6 @@ fn check_gradescope_schema(v: &Value) -> f64 {
 
 #[test]
 fn results_json_follows_gradescopes_fields_with_the_bonus_as_extra_credit() {
-    let _turn = take_turn();
     let (_, v) = grade(
         "all",
         &["--solution"],
@@ -185,7 +182,6 @@ fn results_json_follows_gradescopes_fields_with_the_bonus_as_extra_credit() {
 
 #[test]
 fn a_failing_image_check_names_its_picture_without_the_graders_folders() {
-    let _turn = take_turn();
     let (_, v) = grade(
         "ex1",
         &["--solution"],
@@ -239,7 +235,6 @@ fn read_json(path: &Path) -> Value {
 
 #[test]
 fn batch_grades_every_submission_folder_and_writes_a_sorted_csv() {
-    let _turn = take_turn();
     let base = out_dir("grading_batch");
     let subs = base.join("submissions");
     let k = "ex2_chromadepth";
@@ -413,7 +408,6 @@ fn submit(root: &Path, files: &[(String, String)]) {
 
 #[test]
 fn the_gradescope_bundle_runs_in_an_autograder_layout() {
-    let _turn = take_turn();
     let base = out_dir("grading_bundle");
     let zip = base.join("autograder.zip");
     let classroom = base.join("classroom");

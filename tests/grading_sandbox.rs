@@ -11,7 +11,7 @@ use std::time::Duration;
 use serde_json::Value;
 
 use crate::common::{out_dir, root};
-use crate::grading::{repo_exercises, take_turn, target_dir, tests_of};
+use crate::grading::{repo_exercises, target_dir, tests_of};
 
 /// The instructor's seed for the hidden cases (never to appear in anything a task can reach).
 const SEED: &str = "9173548201";
@@ -116,7 +116,6 @@ fn results_json(results: &Path, name: &str) -> Value {
 
 #[test]
 fn no_attack_in_a_batch_gains_a_point_or_reads_a_secret() {
-    let _turn = take_turn();
     let base = out_dir("grading_sandbox");
     let subs = base.join("submissions");
     let t = Targets {
@@ -306,7 +305,6 @@ fn no_attack_in_a_batch_gains_a_point_or_reads_a_secret() {
 
 #[test]
 fn a_binary_changed_after_its_build_is_not_run() {
-    let _turn = take_turn();
     let base = out_dir("grading_sandbox_swap");
     let subs = base.join("submissions");
     let solution =

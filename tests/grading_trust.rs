@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::time::{Duration, SystemTime};
 
 use crate::common::out_dir;
-use crate::grading::{grade, repo_exercises, spec_totals, take_turn, test_named, tests_of};
+use crate::grading::{grade, repo_exercises, spec_totals, test_named, tests_of};
 use stereolab_grade::Exercise;
 
 /// A submission folder holding `stubs` as `<crate>/src/stubs.rs` for each `(crate, stubs)`,
@@ -43,7 +43,6 @@ fn score(v: &serde_json::Value) -> f64 {
 
 #[test]
 fn one_shared_build_folder_grades_each_submission_by_its_own_code() {
-    let _turn = take_turn();
     let swapped = solution("ex1_stereo").replace("planted(\"swapped-eyes\")", "true");
     assert_ne!(swapped, solution("ex1_stereo"));
     let runs = [
@@ -99,7 +98,6 @@ fn noise() {
 
 #[test]
 fn a_solution_that_prints_a_megabyte_in_every_task_still_scores_full_marks() {
-    let _turn = take_turn();
     let files: Vec<(&str, String)> = ["ex1_stereo", "ex2_chromadepth", "ex3_sirds"]
         .into_iter()
         .map(|k| (k, noisy(&solution(k))))
@@ -117,7 +115,6 @@ fn a_solution_that_prints_a_megabyte_in_every_task_still_scores_full_marks() {
 
 #[test]
 fn a_submission_that_calls_stereolab_does_not_compile() {
-    let _turn = take_turn();
     let cheat = format!(
         "{}\npub fn cheat() -> glam::Mat4 {{ stereolab_core::frustum(-1.0, 1.0, -1.0, 1.0, 1.0, 10.0) }}\n",
         solution("ex2_chromadepth")
@@ -135,7 +132,6 @@ fn a_submission_that_calls_stereolab_does_not_compile() {
 
 #[test]
 fn a_process_left_behind_by_a_task_cannot_change_the_results() {
-    let _turn = take_turn();
     let dir = out_dir("grading_forged");
     let results = dir.join("results.json");
     // Two ways to outlive the task: a plain child in its process group, and one in a new
@@ -184,7 +180,6 @@ fn a_process_left_behind_by_a_task_cannot_change_the_results() {
 
 #[test]
 fn crashes_aborts_exits_and_memory_hogs_get_their_own_hint() {
-    let _turn = take_turn();
     let base = solution("ex3_sirds");
     let cases: [(&str, &str, &str); 5] = [
         ("abort", "std::process::abort();", "[abort]"),
@@ -237,7 +232,6 @@ fn crashes_aborts_exits_and_memory_hogs_get_their_own_hint() {
 /// task runs in a scratch folder of its own: the grader must still find the binaries.
 #[test]
 fn a_relative_build_folder_grades_like_an_absolute_one() {
-    let _turn = take_turn();
     let json = out_dir("grading_relative").join("results.json");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_stereolab"))
         .current_dir(crate::grading::target_dir())

@@ -538,10 +538,14 @@ fn viewer_under_xvfb_keys_mouse_and_screenshots() {
         still != turned,
         "the SIRDS did not change while the model turned"
     );
+    // T again stops it: the frames compared below (the GPU's against the CPU's) hold still.
+    v.key("t");
 
     // 6. Toe-in (M) shows vertical parallax, which off-axis never has; L switches lighting.
     v.key("1");
-    let s8 = v.wait("side by side again", |s| s["output"] == "side_by_side");
+    let s8 = v.wait("side by side again, the model still", |s| {
+        s["output"] == "side_by_side" && s["turning"] == false
+    });
     assert_eq!(s8["mode"], "off-axis");
     assert!(s8["vertical_percent"].as_f64().unwrap() < 1e-3, "{s8}");
     v.key("m");

@@ -17,15 +17,17 @@
 //!   whose dependency artifacts are hard links to those (a build cannot change them: they are
 //!   not its user's). So `include_str!` of an outside file finds nothing, and a build that does
 //!   not end stops at its limit without holding up anyone else's.
-//! - **One cargo at a time** where builds share a target folder (a student's own run): cargo
-//!   locks it anyway; the lock here also covers copying the executable out, so parallel
-//!   graders never pick up each other's binaries.
+//! - **One cargo at a time** where builds share a target folder (a student's own run, and the
+//!   shared dependencies): cargo locks it anyway; the work folder's lock file also covers
+//!   copying the executable out and mirroring the dependencies, so graders that share a work
+//!   folder, the threads of one batch or separate processes, never pick up each other's binaries
+//!   nor half-written artifacts.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Mutex, OnceLock};
 use std::time::Duration;
 
 use serde_json::Value;
@@ -148,7 +150,7 @@ fn manifest(ex: Exercise) -> Result<String, String> {
     // The repository's profiles; in a student's handout, the handout's (no optimization, no
     // debug info: the exercise crates compile fastest).
     let profile = match repository_profile()? {
-        Some(p) => Some(p),
+        Some(p) => Some(for_every_package(p)),
         None => toml::from_str::<toml::Table>(HANDOUT_PROFILE)
             .map_err(|e| format!("the handout's profile: {e}"))?
             .remove("profile"),
@@ -157,6 +159,20 @@ fn manifest(ex: Exercise) -> Result<String, String> {
         table.insert("profile".into(), p);
     }
     toml::to_string(&table).map_err(|e| format!("the build's manifest: {e}"))
+}
+
+/// `profiles` without the settings for one named package (stereolab's own command, say), which
+/// would name a package the exercise's build does not have; those for every package (`"*"`)
+/// stay.
+fn for_every_package(mut profiles: toml::Value) -> toml::Value {
+    if let Some(table) = profiles.as_table_mut() {
+        for (_, profile) in table.iter_mut() {
+            if let Some(packages) = profile.get_mut("package").and_then(|p| p.as_table_mut()) {
+                packages.retain(|name, _| name == "*");
+            }
+        }
+    }
+    profiles
 }
 
 /// The files of one build, by path inside its folder.
@@ -196,8 +212,30 @@ impl Sources {
     }
 }
 
-/// Serializes cargo and the copy of its output (see the module documentation).
-static CARGO: Mutex<()> = Mutex::new(());
+/// The work folder's build lock, held while cargo runs in it and its output is copied out or
+/// mirrored (see the module documentation). A lock on a file (`flock`), so that it holds
+/// between the threads of one grader and between graders that share the folder; it is
+/// released when the guard is dropped, or by the system when the process ends.
+struct BuildLock {
+    _file: std::fs::File,
+}
+
+impl BuildLock {
+    /// Waits for, then takes, the build lock of `work`.
+    fn take(work: &Path) -> Result<BuildLock, String> {
+        let path = work.join(".build-lock");
+        let io = |e: std::io::Error| format!("{}: {e}", path.display());
+        std::fs::create_dir_all(work).map_err(|e| format!("{}: {e}", work.display()))?;
+        let file = std::fs::File::options()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .map_err(io)?;
+        file.lock().map_err(io)?;
+        Ok(BuildLock { _file: file })
+    }
+}
 
 /// How a submission is built.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -263,7 +301,7 @@ pub(crate) fn build(
         placed?;
     } else {
         let dir = work.join("src").join(format!("{name}-{short}"));
-        let _turn = CARGO.lock().unwrap_or_else(|e| e.into_inner());
+        let _turn = BuildLock::take(work)?;
         write_sources(&dir, sources)?;
         let target = handout_target().unwrap_or_else(|| work.join("target"));
         let exe = cargo_build(&dir, name, &target, &sources.hash)?;
@@ -363,8 +401,8 @@ fn toolchain() -> Result<&'static Toolchain, String> {
 
 /// The dependencies' artifacts every sandboxed build of `ex` starts from: the handout's own
 /// stubs built (trusted code, outside the sandbox) into `work/deps/target`.
+/// The caller holds the work folder's [`BuildLock`].
 fn deps_target(ex: Exercise, work: &Path) -> Result<PathBuf, String> {
-    let _turn = CARGO.lock().unwrap_or_else(|e| e.into_inner());
     let sources = Sources::new(ex, template(ex).stubs.to_string())?;
     let dir = work.join("deps").join("src").join(ex.crate_name());
     let unchanged = sources
@@ -429,11 +467,15 @@ fn sandboxed_build(
 ) -> Result<PathBuf, String> {
     let name = ex.crate_name();
     let io = |what: &Path, e: std::io::Error| format!("{}: {e}", what.display());
-    let deps = deps_target(ex, work)?;
     let src = dir.join("src");
     write_sources(&src, sources)?;
     let target = dir.join("target");
-    mirror(&deps, &target, name).map_err(|e| io(&deps, e))?;
+    {
+        // Built and mirrored under one lock: no other build rewrites the artifacts in between.
+        let _turn = BuildLock::take(work)?;
+        let deps = deps_target(ex, work)?;
+        mirror(&deps, &target, name).map_err(|e| io(&deps, e))?;
+    }
     let sandbox = Sandbox::get();
     let user: Option<User> = sandbox.user();
     if let Some(u) = &user {

@@ -645,6 +645,7 @@ impl App {
             "user_offset": p.rig.user_offset,
             "user_balance": p.rig.user_balance,
             "turn_degrees": p.turn_degrees,
+            "turning": self.turning,
             "error": self.error,
             "status": self.status,
             "shots": self.shots.iter().map(|s| s.display().to_string()).collect::<Vec<_>>(),
