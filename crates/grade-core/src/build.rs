@@ -21,7 +21,9 @@
 //!   shared dependencies): cargo locks it anyway; the work folder's lock file also covers
 //!   copying the executable out and mirroring the dependencies, so graders that share a work
 //!   folder, the threads of one batch or separate processes, never pick up each other's binaries
-//!   nor half-written artifacts.
+//!   nor half-written artifacts. A placed binary that reports its hash is never replaced (a
+//!   grader may be running it, and checks its bytes before each run); only a missing or wrong one
+//!   is.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -283,7 +285,8 @@ pub(crate) fn build(
     let io = |what: &Path, e: std::io::Error| format!("{}: {e}", what.display());
     let bin_dir = work.join("bin");
     let bin = bin_dir.join(format!("{name}-{short}"));
-    if bin.is_file() && reported_hash(&bin).as_deref() == Some(&sources.hash) {
+    let ready = || bin.is_file() && reported_hash(&bin).as_deref() == Some(&sources.hash);
+    if ready() {
         return Binary::hashed(bin.clone()).map_err(|e| io(&bin, e));
     }
     std::fs::create_dir_all(&bin_dir).map_err(|e| io(&bin_dir, e))?;
@@ -296,16 +299,27 @@ pub(crate) fn build(
     if mode.sandboxed {
         let dir = build_dir(work, name, short);
         let built = sandboxed_build(ex, sources, work, &dir, mode.timeout);
-        let placed = built.and_then(|exe| place(&exe, &bin_dir, &bin));
+        let placed = built.and_then(|exe| {
+            // A binary another grader placed meanwhile stays: it may be running it.
+            let _turn = BuildLock::take(work)?;
+            if ready() {
+                Ok(())
+            } else {
+                place(&exe, &bin_dir, &bin)
+            }
+        });
         let _ = std::fs::remove_dir_all(&dir);
         placed?;
     } else {
         let dir = work.join("src").join(format!("{name}-{short}"));
         let _turn = BuildLock::take(work)?;
-        write_sources(&dir, sources)?;
-        let target = handout_target().unwrap_or_else(|| work.join("target"));
-        let exe = cargo_build(&dir, name, &target, &sources.hash)?;
-        place(&exe, &bin_dir, &bin)?;
+        // Another grader may have built it while this one waited for the lock.
+        if !ready() {
+            write_sources(&dir, sources)?;
+            let target = handout_target().unwrap_or_else(|| work.join("target"));
+            let exe = cargo_build(&dir, name, &target, &sources.hash)?;
+            place(&exe, &bin_dir, &bin)?;
+        }
     }
     match reported_hash(&bin) {
         Some(h) if h == sources.hash => Binary::hashed(bin.clone()).map_err(|e| io(&bin, e)),

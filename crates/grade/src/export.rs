@@ -105,10 +105,25 @@ fn write_task_data(root: &Path, data: &Path) -> Result<()> {
                 .map(|k| run.replies.get(k).and_then(|r| r.as_ref().ok().cloned()))
                 .collect();
             if run.ending.is_some() || expected.iter().any(Option::is_none) {
+                let mut why = match &run.ending {
+                    Some(e) => format!("{} ({})", e.message, e.kind),
+                    None => format!(
+                        "{} of {} inputs answered",
+                        expected.iter().flatten().count(),
+                        expected.len()
+                    ),
+                };
+                let stderr = run.stderr.0.trim();
+                if !stderr.is_empty() {
+                    why = format!("{why}; it printed: {stderr}");
+                }
                 return Err(Error::invalid(
                     ex.crate_name(),
                     spec.name,
-                    "the instructor's solution does not answer every input of its image check",
+                    format!(
+                        "the instructor's solution does not answer every input of its image \
+                         check: {why}"
+                    ),
                 ));
             }
             let written = img
