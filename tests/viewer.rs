@@ -45,6 +45,34 @@ pub(crate) struct Xvfb {
     pub(crate) display: String,
 }
 
+impl Drop for Xvfb {
+    /// SIGTERM first: Xvfb then removes its lock file and socket (SIGKILL would leave them, and
+    /// a display number with a lock file looks taken); SIGKILL after 2 s.
+    fn drop(&mut self) {
+        let server = &mut self._server.0;
+        if let Ok(pid) = i32::try_from(server.id()) {
+            // SAFETY: a plain syscall on the child this struct owns (not yet reaped).
+            unsafe { libc::kill(pid, libc::SIGTERM) };
+            let start = Instant::now();
+            while start.elapsed() < Duration::from_secs(2) {
+                if let Ok(Some(_)) = server.try_wait() {
+                    return;
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        }
+    }
+}
+
+/// Display `n` is in use: its lock file names a process that is still running. (A lock whose
+/// process is gone is stale; Xvfb removes it and takes the number.)
+fn display_in_use(n: u32) -> bool {
+    std::fs::read_to_string(format!("/tmp/.X{n}-lock"))
+        .ok()
+        .and_then(|text| text.trim().parse::<u32>().ok())
+        .is_some_and(|pid| Path::new(&format!("/proc/{pid}")).exists())
+}
+
 pub(crate) fn start_xvfb() -> Xvfb {
     use std::sync::Mutex;
     use std::sync::atomic::{AtomicU32, Ordering};
@@ -58,9 +86,7 @@ pub(crate) fn start_xvfb() -> Xvfb {
     let xdotool = need("xdotool", "xdotool");
     let first = 70 + std::process::id() % 100 + TRIED.fetch_add(40, Ordering::SeqCst);
     for n in first..first + 40 {
-        if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-            || Path::new(&format!("/tmp/.X{n}-lock")).exists()
-        {
+        if display_in_use(n) {
             continue;
         }
         let server = Command::new(&xvfb)
