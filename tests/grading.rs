@@ -18,7 +18,7 @@ use stereolab_grade::points;
 
 /// Per-task time limit: ample for every task (they answer in milliseconds), short enough that
 /// the endless-loop mutant costs little.
-const TIMEOUT: &str = "4";
+pub(crate) const TIMEOUT: &str = "4";
 
 /// Runs `stereolab grade WHAT --json …` on `exercises`, with `STEREOLAB_MUTANT` when given.
 pub(crate) fn grade(

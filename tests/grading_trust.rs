@@ -4,10 +4,14 @@
 //! behind cannot change the score.
 
 use std::path::PathBuf;
+use std::process::{Command, Stdio};
 use std::time::{Duration, SystemTime};
 
 use crate::common::out_dir;
-use crate::grading::{grade, repo_exercises, spec_totals, test_named, tests_of};
+use crate::grading::{
+    TIMEOUT, assert_verdict_exit, grade, repo_exercises, spec_totals, target_dir, test_named,
+    tests_of,
+};
 use stereolab_grade::Exercise;
 
 /// A submission folder holding `stubs` as `<crate>/src/stubs.rs` for each `(crate, stubs)`,
@@ -61,6 +65,55 @@ fn one_shared_build_folder_grades_each_submission_by_its_own_code() {
     assert_eq!(scores[0], reach + bonus, "{scores:?}");
     assert!(scores[1] > 2.0 && scores[1] < reach, "{scores:?}");
     assert_eq!(scores[2], 0.0, "{scores:?}");
+}
+
+/// Two graders at once on one build folder (the default one, which every grading test shares)
+/// and a submission no other test builds: both compile it, and both grade it to full marks. One
+/// at a time compiles the shared dependencies and places a binary (the folder's lock file), and
+/// the binary one grader placed, and may be running, is not replaced by the other's build.
+#[test]
+fn two_graders_sharing_a_build_folder_grade_the_same_new_submission() {
+    let marked = format!(
+        "{}\n// graded by two graders at once\n",
+        solution("ex2_chromadepth")
+    );
+    let dir = submission("twice", &[("ex2_chromadepth", marked)]);
+    let graders: Vec<_> = ["twice_a", "twice_b"]
+        .into_iter()
+        .map(|name| {
+            let out = out_dir(&format!("grading_{name}"));
+            let json = out.join("results.json");
+            let child = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+                .args(["grade", "ex2", "--timeout", TIMEOUT, "--json"])
+                .arg(&json)
+                .arg("--out")
+                .arg(out.join("images"))
+                .arg("--exercises")
+                .arg(&dir)
+                .env("CARGO_TARGET_DIR", target_dir())
+                .env_remove("STEREOLAB_MUTANT")
+                .env_remove("STEREOLAB_GRADER_SEED")
+                .stdout(Stdio::piped())
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("start stereolab grade");
+            (child, json)
+        })
+        .collect();
+    let (reach, bonus) = spec_totals(&[Exercise::Ex2]);
+    for (child, json) in graders {
+        let out = child.wait_with_output().expect("wait for stereolab grade");
+        assert_verdict_exit(&out, "a grader beside another");
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).expect("results.json"))
+                .expect("results.json is JSON");
+        assert_eq!(
+            score(&v),
+            reach + bonus,
+            "{}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    }
 }
 
 /// The solution with `noise();` as the first statement of every public function, and `noise`

@@ -64,10 +64,11 @@ pub fn strip_solution(text: &str) -> String {
     out
 }
 
-/// The handout workspace's build profile: no optimization and no debug info for the grader and
-/// every dependency, proc macros included. The grader's work (64×48 fixtures, a few thousand
-/// numbers per task) takes well under a second unoptimized; what a student waits for is the
-/// first build of the grader and its dependencies (docs/performance.md, "A student's first grade").
+/// The handout workspace's build profile, and every exercise build's (in the repository too):
+/// no optimization and no debug info for the grader and every dependency, proc macros
+/// included. The grader's work (64×48 fixtures, a few thousand numbers per task) takes well
+/// under a second unoptimized; what a student waits for is the first build of the grader and
+/// its dependencies (docs/performance.md, "A student's first grade").
 pub const HANDOUT_PROFILE: &str = "\
 [profile.dev]
 opt-level = 0
@@ -113,7 +114,7 @@ fn template(ex: Exercise) -> Template {
 
 /// The lock file every build resolves from: the same versions as stereolab, no network.
 const LOCK: &str = include_str!("../../../Cargo.lock");
-/// stereolab's manifest: its build profiles apply to the student's build too.
+/// stereolab's manifest: whether it has build profiles tells the repository from a handout.
 const STEREOLAB_MANIFEST: &str = include_str!("../../../Cargo.toml");
 
 /// stereolab's build profiles from its manifest: `Some` in the repository, `None` in a
@@ -132,8 +133,8 @@ pub(crate) fn exercise_api_dir() -> PathBuf {
 }
 
 /// The build's manifest: the exercise's own, without the instructor's `solution` feature, with
-/// `exercise-api` by absolute path, as a workspace of its own with stereolab's profiles (the
-/// handout's, [`HANDOUT_PROFILE`], in a handout).
+/// `exercise-api` by absolute path, as a workspace of its own with the handout's profile
+/// ([`HANDOUT_PROFILE`]), in the repository as in a handout.
 fn manifest(ex: Exercise) -> Result<String, String> {
     let text = strip_solution(template(ex).manifest);
     let mut table: toml::Table =
@@ -149,32 +150,15 @@ fn manifest(ex: Exercise) -> Result<String, String> {
         toml::Value::String(api.to_string_lossy().into_owned()),
     );
     table.insert("workspace".into(), toml::Value::Table(toml::Table::new()));
-    // The repository's profiles; in a student's handout, the handout's (no optimization, no
-    // debug info: the exercise crates compile fastest).
-    let profile = match repository_profile()? {
-        Some(p) => Some(for_every_package(p)),
-        None => toml::from_str::<toml::Table>(HANDOUT_PROFILE)
-            .map_err(|e| format!("the handout's profile: {e}"))?
-            .remove("profile"),
-    };
+    // No optimization and no debug info: the exercise crate and its dependencies compile
+    // fastest, and every task still answers in milliseconds.
+    let profile = toml::from_str::<toml::Table>(HANDOUT_PROFILE)
+        .map_err(|e| format!("the handout's profile: {e}"))?
+        .remove("profile");
     if let Some(p) = profile {
         table.insert("profile".into(), p);
     }
     toml::to_string(&table).map_err(|e| format!("the build's manifest: {e}"))
-}
-
-/// `profiles` without the settings for one named package (stereolab's own command, say), which
-/// would name a package the exercise's build does not have; those for every package (`"*"`)
-/// stay.
-fn for_every_package(mut profiles: toml::Value) -> toml::Value {
-    if let Some(table) = profiles.as_table_mut() {
-        for (_, profile) in table.iter_mut() {
-            if let Some(packages) = profile.get_mut("package").and_then(|p| p.as_table_mut()) {
-                packages.retain(|name, _| name == "*");
-            }
-        }
-    }
-    profiles
 }
 
 /// The files of one build, by path inside its folder.
