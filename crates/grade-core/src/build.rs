@@ -399,6 +399,7 @@ fn toolchain() -> Result<&'static Toolchain, String> {
 
 /// The dependencies' artifacts every sandboxed build of `ex` starts from: the handout's own
 /// stubs built (trusted code, outside the sandbox) into `work/deps/target`.
+///
 /// The caller holds the work folder's [`BuildLock`].
 fn deps_target(ex: Exercise, work: &Path) -> Result<PathBuf, String> {
     let sources = Sources::new(ex, template(ex).stubs.to_string())?;
