@@ -18,7 +18,7 @@ use stereolab_grade::points;
 
 /// Per-task time limit: ample for every task (they answer in milliseconds), short enough that
 /// the endless-loop mutant costs little.
-pub(crate) const TIMEOUT: &str = "4";
+const TIMEOUT: &str = "4";
 
 /// Runs `stereolab grade WHAT --json …` on `exercises`, with `STEREOLAB_MUTANT` when given.
 pub(crate) fn grade(
@@ -63,6 +63,27 @@ pub(crate) fn grade_seeded(
     seed: Option<&str>,
     name: &str,
 ) -> (Output, Value) {
+    let (mut cmd, json) = grade_command(what, extra, exercises, name);
+    if let Some(m) = mutant {
+        cmd.env("STEREOLAB_MUTANT", m);
+    }
+    if let Some(s) = seed {
+        cmd.env("STEREOLAB_GRADER_SEED", s);
+    }
+    let out = cmd.output().expect("run stereolab grade");
+    assert_verdict_exit(&out, &format!("grade {what} {extra:?} (mutant {mutant:?})"));
+    let v = results(&json);
+    (out, v)
+}
+
+/// `stereolab grade WHAT --json …` on `exercises` (no mutant, no seed), not yet run, with the
+/// path its results.json will have: output under `grading_{name}`.
+pub(crate) fn grade_command(
+    what: &str,
+    extra: &[&str],
+    exercises: &Path,
+    name: &str,
+) -> (Command, PathBuf) {
     let dir = out_dir(&format!("grading_{name}"));
     let json = dir.join("results.json");
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_stereolab"));
@@ -76,19 +97,13 @@ pub(crate) fn grade_seeded(
         .env("CARGO_TARGET_DIR", target_dir())
         .env_remove("STEREOLAB_MUTANT")
         .env_remove("STEREOLAB_GRADER_SEED");
-    if let Some(m) = mutant {
-        cmd.env("STEREOLAB_MUTANT", m);
-    }
-    if let Some(s) = seed {
-        cmd.env("STEREOLAB_GRADER_SEED", s);
-    }
-    let out = cmd.output().expect("run stereolab grade");
-    assert_verdict_exit(&out, &format!("grade {what} {extra:?} (mutant {mutant:?})"));
-    let text = std::fs::read_to_string(&json).expect("results.json written");
-    (
-        out,
-        serde_json::from_str(&text).expect("results.json is JSON"),
-    )
+    (cmd, json)
+}
+
+/// The results.json a grading run wrote.
+pub(crate) fn results(json: &Path) -> Value {
+    let text = std::fs::read_to_string(json).expect("results.json written");
+    serde_json::from_str(&text).expect("results.json is JSON")
 }
 
 /// The target folder this test binary was built in (`<target>/debug/stereolab`): nested builds

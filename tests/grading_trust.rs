@@ -4,12 +4,12 @@
 //! behind cannot change the score.
 
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, SystemTime};
 
 use crate::common::out_dir;
 use crate::grading::{
-    TIMEOUT, assert_verdict_exit, grade, repo_exercises, spec_totals, target_dir, test_named,
+    assert_verdict_exit, grade, grade_command, repo_exercises, results, spec_totals, test_named,
     tests_of,
 };
 use stereolab_grade::Exercise;
@@ -81,18 +81,8 @@ fn two_graders_sharing_a_build_folder_grade_the_same_new_submission() {
     let graders: Vec<_> = ["twice_a", "twice_b"]
         .into_iter()
         .map(|name| {
-            let out = out_dir(&format!("grading_{name}"));
-            let json = out.join("results.json");
-            let child = Command::new(env!("CARGO_BIN_EXE_stereolab"))
-                .args(["grade", "ex2", "--timeout", TIMEOUT, "--json"])
-                .arg(&json)
-                .arg("--out")
-                .arg(out.join("images"))
-                .arg("--exercises")
-                .arg(&dir)
-                .env("CARGO_TARGET_DIR", target_dir())
-                .env_remove("STEREOLAB_MUTANT")
-                .env_remove("STEREOLAB_GRADER_SEED")
+            let (mut cmd, json) = grade_command("ex2", &[], &dir, name);
+            let child = cmd
                 .stdout(Stdio::piped())
                 .stderr(Stdio::piped())
                 .spawn()
@@ -104,11 +94,8 @@ fn two_graders_sharing_a_build_folder_grade_the_same_new_submission() {
     for (child, json) in graders {
         let out = child.wait_with_output().expect("wait for stereolab grade");
         assert_verdict_exit(&out, "a grader beside another");
-        let v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&json).expect("results.json"))
-                .expect("results.json is JSON");
         assert_eq!(
-            score(&v),
+            score(&results(&json)),
             reach + bonus,
             "{}",
             String::from_utf8_lossy(&out.stdout)

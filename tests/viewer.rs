@@ -41,7 +41,7 @@ impl Drop for Killed {
 
 /// A virtual X server on a free display number.
 pub(crate) struct Xvfb {
-    _server: Killed,
+    server: Killed,
     pub(crate) display: String,
 }
 
@@ -49,7 +49,7 @@ impl Drop for Xvfb {
     /// SIGTERM first: Xvfb then removes its lock file and socket (SIGKILL would leave them, and
     /// a display number with a lock file looks taken); SIGKILL after 2 s.
     fn drop(&mut self) {
-        let server = &mut self._server.0;
+        let server = &mut self.server.0;
         if let Ok(pid) = i32::try_from(server.id()) {
             // SAFETY: a plain syscall on the child this struct owns (not yet reaped).
             unsafe { libc::kill(pid, libc::SIGTERM) };
@@ -120,7 +120,7 @@ pub(crate) fn start_xvfb() -> Xvfb {
             };
             if socket.exists() && serving() {
                 return Xvfb {
-                    _server: server,
+                    server,
                     display: format!(":{n}"),
                 };
             }

@@ -150,17 +150,21 @@ fn yardstick(two: &Row) -> Option<f64> {
     number_after(&two.note, "in the same turns: ")
 }
 
-/// The speed-ups of the consecutive runs in a 2-thread row's note (`scaling.rs`), as written.
-fn runs(two: &Row) -> Option<Vec<String>> {
-    let marker = "consecutive runs: ";
-    let tail = &two.note[two.note.find(marker)? + marker.len()..];
+/// The speed-ups of the consecutive runs in a threads row's note (`scaling.rs`), as written.
+fn runs(row: &Row) -> Option<Vec<String>> {
+    let tail = after(&row.note, "consecutive runs: ")?;
     Some(tail.split(", ").map(str::to_string).collect())
+}
+
+/// What follows the first `marker` in `note`.
+fn after<'a>(note: &'a str, marker: &str) -> Option<&'a str> {
+    Some(&note[note.find(marker)? + marker.len()..])
 }
 
 /// The number just after `marker` in `note`.
 fn number_after(note: &str, marker: &str) -> Option<f64> {
-    let tail = &note[note.find(marker)? + marker.len()..];
-    tail.split(|c: char| c != '.' && !c.is_ascii_digit())
+    after(note, marker)?
+        .split(|c: char| c != '.' && !c.is_ascii_digit())
         .next()?
         .parse()
         .ok()
