@@ -52,9 +52,9 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::internal("bench scaling", format!("thread pool: {e}")))
 }
 
-/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of the [`CopyYardstick`],
-/// in that order, on one pool.
-type PoolTimes = [f64; 4];
+/// Median ms of `f`, of [`yardstick`], of [`wide_yardstick`] and of the [`CopyYardstick`], and
+/// the median [`round_trip_ns`] (nanoseconds), in that order, on one pool.
+type PoolTimes = [f64; 5];
 
 /// [`PoolTimes`] on each of `pools`, one pool after the other: inside one pool, blocks of 10
 /// runs of each in turns, until each has at least `iters` runs.
@@ -74,6 +74,7 @@ fn on_pools(
 ) -> Result<Vec<PoolTimes>> {
     const BLOCK: usize = 10;
     let on = |pool: &rayon::ThreadPool| -> Result<PoolTimes> {
+        let mut trips = Vec::new();
         let t = pool.install(|| {
             interleaved_medians(
                 iters.div_ceil(BLOCK),
@@ -95,10 +96,15 @@ fn on_pools(
                         copy.run();
                         Ok(())
                     },
+                    &mut || {
+                        trips.push(round_trip_ns());
+                        Ok(())
+                    },
                 ],
             )
         })?;
-        Ok([t[0], t[1], t[2], t[3]])
+        trips.sort_by(f64::total_cmp);
+        Ok([t[0], t[1], t[2], t[3], trips[trips.len() / 2]])
     };
     pools.iter().map(on).collect()
 }
@@ -167,6 +173,43 @@ fn wide_yardstick() -> u64 {
     };
     let (a, b) = rayon::join(half, half);
     a ^ b
+}
+
+/// Round trips of one cache line between two threads in [`round_trip_ns`].
+const ROUND_TRIPS: u64 = 1000;
+
+/// How far apart the machine's cores are: nanoseconds for one cache line to go from one thread
+/// to another and back (two threads taking turns to write one atomic counter,
+/// [`ROUND_TRIPS`] times). Where a pass hands data from one thread to the next (set-up written
+/// by one thread and read by the other, a buffer one thread wrote last frame and the other
+/// writes now), each such line costs about this. A virtual machine's two CPUs may sit on cores
+/// that share a cache or on cores far apart, and its host may move them while a program runs.
+fn round_trip_ns() -> f64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let turn = AtomicU64::new(0);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            // The other side: waits for each odd turn and answers with the next even one.
+            for i in 0..=ROUND_TRIPS {
+                while turn.load(Ordering::Acquire) != 2 * i + 1 {
+                    std::hint::spin_loop();
+                }
+                turn.store(2 * i + 2, Ordering::Release);
+            }
+        });
+        let mut start = Instant::now();
+        for i in 0..=ROUND_TRIPS {
+            // The first trip waits for the other thread to start; the clock starts after it.
+            if i == 1 {
+                start = Instant::now();
+            }
+            turn.store(2 * i + 1, Ordering::Release);
+            while turn.load(Ordering::Acquire) != 2 * i + 2 {
+                std::hint::spin_loop();
+            }
+        }
+        start.elapsed().as_secs_f64() * 1e9 / ROUND_TRIPS as f64
+    })
 }
 
 /// The stereo pair (Blinn-Phong, both eyes) of `scene`: `true` when it rendered.
@@ -255,6 +298,11 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             one[0],
             "",
         ));
+        // Each run's speed-up with the cores' distance during its 2-thread turn.
+        let runs_with_distance: Vec<String> = r
+            .iter()
+            .map(|t| format!("{:.2} ({:.0} ns)", t[0][0] / t[1][0], t[1][4]))
+            .collect();
         rows.push(row(
             "threads",
             format!("{what}, {setting}, 2 threads"),
@@ -262,12 +310,13 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
             format!(
                 "speed-up 1 -> 2 threads = {:.2} (goal >= 1.8; {cores} cores seen); \
                  a register-only loop in the same turns: {:.2}, with eight chains: {:.2}; \
-                 a 6.3 MB copy: {:.2}; {RUNS} consecutive runs: {}",
+                 a 6.3 MB copy: {:.2}; beside each run, a cache line's round trip between \
+                 two threads in its turns; {RUNS} consecutive runs: {}",
                 one[0] / two[0],
                 one[1] / two[1],
                 one[2] / two[2],
                 one[3] / two[3],
-                speed_ups(1)
+                runs_with_distance.join(", ")
             ),
         ));
         // More threads where the machine has them (the yardsticks use two halves: none here).
@@ -479,6 +528,8 @@ fn sirds_stages(
     };
     let one = stages(pool_1)?;
     let two = stages(pool_2)?;
+    let mut trips: Vec<f64> = (0..5).map(|_| round_trip_ns()).collect();
+    trips.sort_by(f64::total_cmp);
     let names = ["depth pass", "depth range", "strip geometry", "strips"];
     let parts: Vec<String> = names
         .iter()
@@ -492,9 +543,11 @@ fn sirds_stages(
         sum_2,
         format!(
             "{}; sum of medians {sum_1:.3} -> {sum_2:.3} ms; the serial strip geometry is \
-             {:.1}% of the 1-thread frame",
+             {:.1}% of the 1-thread frame; a cache line's round trip between two threads just \
+             after: {:.0} ns",
             parts.join(", "),
-            100.0 * one[2] / sum_1
+            100.0 * one[2] / sum_1,
+            trips[2]
         ),
     ))
 }
