@@ -18,6 +18,19 @@ pub mod remap;
 pub mod shear_rotate;
 pub mod sirds;
 
+/// Rows per task of [`par_fill_rows`]: about [`PIXELS_PER_TASK`] pixels. Rayon splits a range
+/// into as many pieces as threads (and again when a piece is stolen), so a thread runs its last
+/// piece alone; rows that cost unequal work (an anaglyph's flat background against the model's
+/// pixels) left the other thread idle at the end of a pass while the first finished a piece of up to a
+/// quarter of the rows. Small
+/// tasks keep both busy to the end; the bytes do not depend on the split.
+fn rows_per_task(width: usize) -> usize {
+    (PIXELS_PER_TASK / width.max(1)).max(1)
+}
+
+/// Pixels per task of [`par_fill_rows`]: a few microseconds of the cheapest finalize pass.
+const PIXELS_PER_TASK: usize = 16 * 1024;
+
 /// A new RGBA8 buffer of `pixels` pixels (bytes in memory order), filled row by row in
 /// parallel by `fill(y, row)` on rows of `width` pixels (the last one shorter when `width`
 /// does not divide `pixels`), without being zeroed first: the finalize passes write every byte
@@ -38,6 +51,7 @@ pub(crate) unsafe fn par_fill_rows(
     out.spare_capacity_mut()[..pixels]
         .par_chunks_mut(width.max(1))
         .enumerate()
+        .with_max_len(rows_per_task(width))
         .for_each(|(y, row)| fill(y, row));
     // SAFETY: the first `pixels` elements are within the capacity, and `fill` initialized
     // every one of them (the caller's promise; a panic in `fill` propagates before this).

@@ -150,6 +150,7 @@ fn rasterize_bands<S: Shader>(
         .zip(fb.depth.par_chunks_mut(width * BAND_ROWS))
         .zip(&bins)
         .enumerate()
+        .with_max_len(1)
         .map(|(b, ((color, depth), bin))| {
             let mut band = Band {
                 width: fb.width,
@@ -262,6 +263,7 @@ pub fn setup_triangles<S: Shader>(
     // any thread count.
     let parts: Vec<(Vec<SetupTriangle>, RasterStats)> = triangles
         .par_chunks(SETUP_CHUNK)
+        .with_max_len(1)
         .map(|chunk| setup_chunk(chunk, &verts, nvar, width, height, opts))
         .collect();
     let mut stats = RasterStats {

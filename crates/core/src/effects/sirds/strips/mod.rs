@@ -565,6 +565,7 @@ fn per_vertex_on(
     let band_links: Vec<Vec<i32>> = pixels.spare_capacity_mut()[..len]
         .par_chunks_mut(band_len)
         .enumerate()
+        .with_max_len(1)
         .map(|(b, image)| {
             let image = fill(image, [0, 0, 0, 255]);
             let y0 = b as u32 * BAND_ROWS;
