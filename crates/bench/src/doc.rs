@@ -431,8 +431,21 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
             s,
             "\nThe rows of Table 1 (the paper's per-vertex strip algorithm, left start, \
              bilinear; × is stereolab's rate over the paper's GeForce4 Ti 4600), with \
-             `pamstereogram`'s time in the same run ({}) as the machine's phase:\n",
-            ms(pam)
+             `pamstereogram`'s time in the same run ({}) as the machine's phase{}:\n",
+            ms(pam),
+            find(
+                rows,
+                "sirds",
+                "the SIRDS paper's Table 1",
+                crate::sirds::ROUND_TRIP
+            )
+            .map(|r| format!(
+                ", and a cache line's round trip between two threads in the rows' turns \
+                     ({:.0} ns: about 75 where the two cores share a cache, 400–500 where they \
+                     do not)",
+                r.ms * 1e6
+            ))
+            .unwrap_or_default()
         );
         let _ = writeln!(
             s,

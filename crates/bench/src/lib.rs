@@ -136,6 +136,43 @@ pub(crate) fn interleaved_medians(
         .collect())
 }
 
+/// Round trips of one cache line between two threads in [`round_trip_ns`].
+const ROUND_TRIPS: u64 = 1000;
+
+/// How far apart the machine's cores are: nanoseconds for one cache line to go from one thread
+/// to another and back (two threads taking turns to write one atomic counter,
+/// [`ROUND_TRIPS`] times). Where a pass hands data from one thread to the next (set-up written
+/// by one thread and read by the other, a buffer one thread wrote last frame and the other
+/// writes now), each such line costs about this. A virtual machine's two CPUs may sit on cores
+/// that share a cache or on cores far apart, and its host may move them while a program runs.
+pub(crate) fn round_trip_ns() -> f64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let turn = AtomicU64::new(0);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            // The other side: waits for each odd turn and answers with the next even one.
+            for i in 0..=ROUND_TRIPS {
+                while turn.load(Ordering::Acquire) != 2 * i + 1 {
+                    std::hint::spin_loop();
+                }
+                turn.store(2 * i + 2, Ordering::Release);
+            }
+        });
+        let mut start = Instant::now();
+        for i in 0..=ROUND_TRIPS {
+            // The first trip waits for the other thread to start; the clock starts after it.
+            if i == 1 {
+                start = Instant::now();
+            }
+            turn.store(2 * i + 1, Ordering::Release);
+            while turn.load(Ordering::Acquire) != 2 * i + 2 {
+                std::hint::spin_loop();
+            }
+        }
+        start.elapsed().as_secs_f64() * 1e9 / ROUND_TRIPS as f64
+    })
+}
+
 /// Runs every benchmark group `opts.only` asks for (all when empty).
 ///
 /// # Errors

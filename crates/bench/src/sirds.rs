@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{Row, interleaved_medians, median_ms};
+use super::{Row, interleaved_medians, median_ms, round_trip_ns};
 use stereolab::fixtures::{TABLE_1, scene_from_text, sphere_over_ramp, table_scene};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::{Output, Plan, Shading};
@@ -73,10 +73,21 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
             }
         })
         .collect();
+    // The machine's phase in the same turns: how far apart its cores are.
+    let mut trips = Vec::new();
+    let mut trip = || {
+        trips.push(round_trip_ns());
+        Ok(())
+    };
     let mut fs: Vec<&mut dyn FnMut() -> Result<()>> =
         frames.iter_mut().map(|f| &mut **f as _).collect();
+    fs.push(&mut trip);
     const BLOCK: usize = 20;
-    let ms = interleaved_medians(iters.max(300).div_ceil(BLOCK), BLOCK, &mut fs)?;
+    let mut ms = interleaved_medians(iters.max(300).div_ceil(BLOCK), BLOCK, &mut fs)?;
+    ms.pop();
+    drop(fs);
+    trips.sort_by(f64::total_cmp);
+    let trip_ns = trips[trips.len() / 2];
     let loops = |simd: bool| {
         if !simd {
             ", scalar loops"
@@ -86,36 +97,49 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
             ", scalar loops (no AVX2 here, or STEREOLAB_SCALAR set)"
         }
     };
-    Ok(timed
-        .iter()
-        .zip(ms)
-        .map(|(&(i, range, simd), ms)| {
-            let (w, h, tris, k, paper_hz) = TABLE_1[i];
-            let (setting, what) = if range.is_some() {
-                (
-                    format!("{w}x{h} {tris} tris k={k}, range fixed"),
-                    "strips only (the paper's frame: no depth pass)",
-                )
-            } else {
-                (format!("{w}x{h} {tris} tris k={k}"), "depth pass + strips")
-            };
-            let hz = 1e3 / ms;
-            Row {
-                area: "sirds".into(),
-                knob: "the SIRDS paper's Table 1".into(),
-                setting,
-                error: None,
-                error_unit: String::new(),
-                ms,
-                note: format!(
-                    "{hz:.0} Hz vs paper {paper_hz} Hz (GeForce4): {:.1}x, {what}{}",
-                    hz / paper_hz,
-                    loops(simd)
-                ),
-            }
-        })
-        .collect())
+    let phase = Row {
+        area: "sirds".into(),
+        knob: "the SIRDS paper's Table 1".into(),
+        setting: ROUND_TRIP.into(),
+        error: None,
+        error_unit: String::new(),
+        ms: trip_ns / 1e6,
+        note: format!(
+            "{trip_ns:.0} ns: a cache line's round trip between two threads, timed in the rows' \
+             turns (the median); the machine's phase, as far apart as its cores are"
+        ),
+    };
+    let rows = timed.iter().zip(ms).map(|(&(i, range, simd), ms)| {
+        let (w, h, tris, k, paper_hz) = TABLE_1[i];
+        let (setting, what) = if range.is_some() {
+            (
+                format!("{w}x{h} {tris} tris k={k}, range fixed"),
+                "strips only (the paper's frame: no depth pass)",
+            )
+        } else {
+            (format!("{w}x{h} {tris} tris k={k}"), "depth pass + strips")
+        };
+        let hz = 1e3 / ms;
+        Row {
+            area: "sirds".into(),
+            knob: "the SIRDS paper's Table 1".into(),
+            setting,
+            error: None,
+            error_unit: String::new(),
+            ms,
+            note: format!(
+                "{hz:.0} Hz vs paper {paper_hz} Hz (GeForce4): {:.1}x, {what}{}",
+                hz / paper_hz,
+                loops(simd)
+            ),
+        }
+    });
+    Ok(rows.chain([phase]).collect())
 }
+
+/// The setting of Table 1's row that holds the cores' round trip ([`round_trip_ns`]) in its
+/// `ms` (as milliseconds).
+pub(crate) const ROUND_TRIP: &str = "round trip between two threads";
 
 /// The Fig. 5 ramp: a 20×20 plane (16×16 quads) turned 35° about y, 512×256, black-white
 /// dots with seed 5; the scene of every SIRDS accuracy knob.
