@@ -19,11 +19,11 @@ pub mod shear_rotate;
 pub mod sirds;
 
 /// Rows per task of [`par_fill_rows`]: about [`PIXELS_PER_TASK`] pixels. Rayon splits a range
-/// into as many pieces as threads (and again when a piece is stolen), so a thread runs its last
-/// piece alone; rows that cost unequal work (an anaglyph's flat background against the model's
-/// pixels) left the other thread idle at the end of a pass while the first finished a piece of up to a
-/// quarter of the rows. Small
-/// tasks keep both busy to the end; the bytes do not depend on the split.
+/// into a few pieces per thread and splits a piece again only when another thread steals it,
+/// so with its default pieces the thread that finishes first would sit idle while the other
+/// runs its last piece, up to a quarter of the rows, whenever rows cost unequal work (an
+/// anaglyph's flat background against the model's pixels). Small tasks keep both busy to the
+/// end; the bytes do not depend on the split.
 fn rows_per_task(width: usize) -> usize {
     (PIXELS_PER_TASK / width.max(1)).max(1)
 }
