@@ -136,3 +136,47 @@ fn scalar_and_avx2_loops_write_the_same_files() {
         }
     }
 }
+
+/// The finalize passes fill their rows in parallel tasks: each image's bytes on 1, 2 and 3
+/// threads (an anaglyph of every matrix shape's loop, the remap and the parallax map).
+#[test]
+fn finalize_images_do_not_depend_on_the_thread_count() {
+    use stereolab::output::{Image, produce};
+    use stereolab_core::AnaglyphKind;
+    let mut scene = Scene::load(&asset("scenes/wuson.toml"), &[]).unwrap();
+    scene.set_size(203, 150).unwrap();
+    let outputs = [
+        Output::Anaglyph(AnaglyphKind::DuboisRedCyan),
+        Output::Anaglyph(AnaglyphKind::Optimized),
+        Output::Anaglyph(AnaglyphKind::Gray),
+        Output::RemapLeft,
+        Output::Parallax,
+    ];
+    let images = |threads: usize| -> Vec<Vec<u8>> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let frame = render(&scene, &Plan::new(&outputs)).unwrap();
+            outputs
+                .iter()
+                .map(|&o| match produce(o, &frame, &scene).unwrap() {
+                    Image::Rgba(img) => img.into_raw(),
+                    _ => panic!("{o:?}: not an RGBA image"),
+                })
+                .collect()
+        })
+    };
+    let one = images(1);
+    assert!(
+        one[0]
+            .chunks(4)
+            .collect::<std::collections::HashSet<_>>()
+            .len()
+            > 100,
+        "the anaglyph should show the model"
+    );
+    assert_eq!(one, images(2), "2 threads differ from 1");
+    assert_eq!(one, images(3), "3 threads differ from 1");
+}
