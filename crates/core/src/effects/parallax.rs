@@ -458,6 +458,7 @@ fn parallax_image_on(fb: &Framebuffer, rig: &ParallaxRig, kernels: Kernels) -> R
         || {
             rows.par_chunks_mut(w.max(1))
                 .enumerate()
+                .with_max_len(super::rows_per_task(w))
                 .for_each(|(y, row)| fill(y, row))
         },
     );
