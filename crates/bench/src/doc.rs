@@ -544,6 +544,21 @@ pub fn readme_paragraph(rows: &[Row], run: &RunInfo) -> String {
              second core gave)"
         ));
     }
+    // The cores' distance in the runs' turns: the number in parentheses after each run.
+    let trips: Vec<f64> = pairs
+        .iter()
+        .filter_map(|p| runs(p.2))
+        .flatten()
+        .filter_map(|r| number_after(&r, "("))
+        .collect();
+    if !trips.is_empty() {
+        let lo = trips.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = trips.iter().copied().fold(0.0, f64::max);
+        threads.push(format!(
+            "a cache line's round trip between the two threads {lo:.0}–{hi:.0} ns (about 75 \
+             where the cores share a cache)"
+        ));
+    }
     let mut s = format!(
         "On a shared 2-core machine (load average {} at the start), the CPU stereo pair + Dubois \
          anaglyph takes {r} of a plain wgpu program's time on lavapipe",
@@ -719,6 +734,10 @@ mod tests {
         assert!(readme.contains("0.25 at grid of 4000000 tris"), "{readme}");
         assert!(
             readme.contains("1 → 2 threads (consecutive runs): stereo pair 1.60 / 1.81 / 1.79"),
+            "{readme}"
+        );
+        assert!(
+            readme.contains("round trip between the two threads 75–440 ns"),
             "{readme}"
         );
     }
