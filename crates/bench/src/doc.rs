@@ -439,6 +439,7 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
                 "the SIRDS paper's Table 1",
                 crate::sirds::ROUND_TRIP
             )
+            .filter(|r| r.ms.is_finite())
             .map(|r| format!(
                 ", and a cache line's round trip between two threads in the rows' turns \
                      ({:.0} ns: about 75 where the two cores share a cache, 400–500 where they \

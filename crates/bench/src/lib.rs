@@ -139,23 +139,32 @@ pub(crate) fn interleaved_medians(
 /// Round trips of one cache line between two threads in [`round_trip_ns`].
 const ROUND_TRIPS: u64 = 1000;
 
+/// The longest one [`round_trip_ns`] may take: on a machine where the two threads share one
+/// core, each turn waits for the scheduler, and the measurement gives up instead.
+const ROUND_TRIP_LIMIT: std::time::Duration = std::time::Duration::from_millis(200);
+
 /// How far apart the machine's cores are: nanoseconds for one cache line to go from one thread
 /// to another and back (two threads taking turns to write one atomic counter,
 /// [`ROUND_TRIPS`] times). Where a pass hands data from one thread to the next (set-up written
 /// by one thread and read by the other, a buffer one thread wrote last frame and the other
 /// writes now), each such line costs about this. A virtual machine's two CPUs may sit on cores
 /// that share a cache or on cores far apart, and its host may move them while a program runs.
+/// NaN where the machine has one core, or the turns took longer than [`ROUND_TRIP_LIMIT`].
 pub(crate) fn round_trip_ns() -> f64 {
-    use std::sync::atomic::{AtomicU64, Ordering};
+    use std::sync::atomic::AtomicU64;
+    if std::thread::available_parallelism().map_or(1, |n| n.get()) < 2 {
+        return f64::NAN;
+    }
     let turn = AtomicU64::new(0);
+    let deadline = Instant::now() + ROUND_TRIP_LIMIT;
     std::thread::scope(|s| {
         s.spawn(|| {
             // The other side: waits for each odd turn and answers with the next even one.
             for i in 0..=ROUND_TRIPS {
-                while turn.load(Ordering::Acquire) != 2 * i + 1 {
-                    std::hint::spin_loop();
+                if !wait_for(&turn, 2 * i + 1, deadline) {
+                    return;
                 }
-                turn.store(2 * i + 2, Ordering::Release);
+                turn.store(2 * i + 2, std::sync::atomic::Ordering::Release);
             }
         });
         let mut start = Instant::now();
@@ -164,13 +173,40 @@ pub(crate) fn round_trip_ns() -> f64 {
             if i == 1 {
                 start = Instant::now();
             }
-            turn.store(2 * i + 1, Ordering::Release);
-            while turn.load(Ordering::Acquire) != 2 * i + 2 {
-                std::hint::spin_loop();
+            turn.store(2 * i + 1, std::sync::atomic::Ordering::Release);
+            if !wait_for(&turn, 2 * i + 2, deadline) {
+                return f64::NAN;
             }
         }
         start.elapsed().as_secs_f64() * 1e9 / ROUND_TRIPS as f64
     })
+}
+
+/// Spins until `turn` holds `want` (true), or gives up at `deadline` (false), yielding the
+/// core now and then so that a thread sharing it can take its turn.
+fn wait_for(turn: &std::sync::atomic::AtomicU64, want: u64, deadline: Instant) -> bool {
+    let mut spins = 0u32;
+    while turn.load(std::sync::atomic::Ordering::Acquire) != want {
+        spins = spins.wrapping_add(1);
+        if spins.is_multiple_of(256) {
+            if Instant::now() > deadline {
+                return false;
+            }
+            std::thread::yield_now();
+        } else {
+            std::hint::spin_loop();
+        }
+    }
+    true
+}
+
+/// A [`round_trip_ns`] figure for a note: `75 ns`, or `—` where none was measured.
+pub(crate) fn ns(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.0} ns")
+    } else {
+        "—".into()
+    }
 }
 
 /// Runs every benchmark group `opts.only` asks for (all when empty).
@@ -505,4 +541,31 @@ pub fn write_csv(rows: &[Row], path: &Path) -> Result<()> {
         );
     }
     stereolab_core::write_bytes(path, s.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wait nobody answers gives up at its deadline instead of spinning on.
+    #[test]
+    fn an_unanswered_turn_gives_up_at_the_deadline() {
+        let turn = std::sync::atomic::AtomicU64::new(0);
+        let start = Instant::now();
+        let deadline = start + std::time::Duration::from_millis(20);
+        assert!(!wait_for(&turn, 1, deadline));
+        let waited = start.elapsed();
+        assert!(waited >= std::time::Duration::from_millis(20), "{waited:?}");
+        assert!(waited < std::time::Duration::from_secs(2), "{waited:?}");
+    }
+
+    /// A measured round trip is a positive time; on one core there is none (NaN), and the
+    /// measurement still ends.
+    #[test]
+    fn a_round_trip_is_positive_or_not_measured() {
+        let v = round_trip_ns();
+        assert!(v.is_nan() || v > 0.0, "{v}");
+        assert_eq!(ns(f64::NAN), "—");
+        assert_eq!(ns(74.6), "75 ns");
+    }
 }

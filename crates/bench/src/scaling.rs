@@ -17,7 +17,7 @@
 
 use std::time::Instant;
 
-use super::{Row, interleaved_medians, median_ms, round_trip_ns};
+use super::{Row, interleaved_medians, median_ms, ns, round_trip_ns};
 use stereolab::fixtures::{TABLE_1, table_scene};
 use stereolab::output::produce;
 use stereolab::plan::{Output, Plan, Shading};
@@ -264,7 +264,7 @@ fn threads(scene: &Scene, iters: usize) -> Result<Vec<Row>> {
         // Each run's speed-up with the cores' distance during its 2-thread turn.
         let runs_with_distance: Vec<String> = r
             .iter()
-            .map(|t| format!("{:.2} ({:.0} ns)", t[0][0] / t[1][0], t[1][4]))
+            .map(|t| format!("{:.2} ({})", t[0][0] / t[1][0], ns(t[1][4])))
             .collect();
         rows.push(row(
             "threads",
@@ -507,10 +507,10 @@ fn sirds_stages(
         format!(
             "{}; sum of medians {sum_1:.3} -> {sum_2:.3} ms; the serial strip geometry is \
              {:.1}% of the 1-thread frame; a cache line's round trip between two threads just \
-             after: {:.0} ns",
+             after: {}",
             parts.join(", "),
             100.0 * one[2] / sum_1,
-            trips[2]
+            ns(trips[2])
         ),
     ))
 }

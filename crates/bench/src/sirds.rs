@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{Row, interleaved_medians, median_ms, round_trip_ns};
+use super::{Row, interleaved_medians, median_ms, ns, round_trip_ns};
 use stereolab::fixtures::{TABLE_1, scene_from_text, sphere_over_ramp, table_scene};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::{Output, Plan, Shading};
@@ -105,8 +105,9 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
         error_unit: String::new(),
         ms: trip_ns / 1e6,
         note: format!(
-            "{trip_ns:.0} ns: a cache line's round trip between two threads, timed in the rows' \
-             turns (the median); the machine's phase, as far apart as its cores are"
+            "{}: a cache line's round trip between two threads, timed in the rows' turns (the \
+             median); the machine's phase, as far apart as its cores are",
+            ns(trip_ns)
         ),
     };
     let rows = timed.iter().zip(ms).map(|(&(i, range, simd), ms)| {
