@@ -17,7 +17,8 @@ mod sirds;
 
 use std::fmt::Write as _;
 use std::path::Path;
-use std::time::Instant;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3, Vec4};
 
@@ -92,15 +93,21 @@ impl Default for BenchOptions {
 /// Median milliseconds of `iters` runs of `f` (after one warm-up run).
 pub(crate) fn median_ms<T>(iters: usize, mut f: impl FnMut() -> T) -> f64 {
     std::hint::black_box(f());
-    let mut v: Vec<f64> = (0..iters.max(1))
-        .map(|_| {
-            let t = Instant::now();
-            std::hint::black_box(f());
-            t.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
+    median(
+        (0..iters.max(1))
+            .map(|_| {
+                let t = Instant::now();
+                std::hint::black_box(f());
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect(),
+    )
+}
+
+/// The median of `v` (the upper one of an even count; NaN sorts last), NaN when `v` is empty.
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// Medians of `rounds · block` runs of each of `fs` (after one warm-up run of each), taken in
@@ -127,13 +134,7 @@ pub(crate) fn interleaved_medians(
             }
         }
     }
-    Ok(times
-        .into_iter()
-        .map(|mut v| {
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        })
-        .collect())
+    Ok(times.into_iter().map(median).collect())
 }
 
 /// Round trips of one cache line between two threads in [`round_trip_ns`].
@@ -141,7 +142,7 @@ const ROUND_TRIPS: u64 = 1000;
 
 /// The longest one [`round_trip_ns`] may take: on a machine where the two threads share one
 /// core, each turn waits for the scheduler, and the measurement gives up instead.
-const ROUND_TRIP_LIMIT: std::time::Duration = std::time::Duration::from_millis(200);
+const ROUND_TRIP_LIMIT: Duration = Duration::from_millis(200);
 
 /// How far apart the machine's cores are: nanoseconds for one cache line to go from one thread
 /// to another and back (two threads taking turns to write one atomic counter,
@@ -151,7 +152,6 @@ const ROUND_TRIP_LIMIT: std::time::Duration = std::time::Duration::from_millis(2
 /// that share a cache or on cores far apart, and its host may move them while a program runs.
 /// NaN where the machine has one core, or the turns took longer than [`ROUND_TRIP_LIMIT`].
 pub(crate) fn round_trip_ns() -> f64 {
-    use std::sync::atomic::AtomicU64;
     if std::thread::available_parallelism().map_or(1, |n| n.get()) < 2 {
         return f64::NAN;
     }
@@ -164,7 +164,7 @@ pub(crate) fn round_trip_ns() -> f64 {
                 if !wait_for(&turn, 2 * i + 1, deadline) {
                     return;
                 }
-                turn.store(2 * i + 2, std::sync::atomic::Ordering::Release);
+                turn.store(2 * i + 2, Ordering::Release);
             }
         });
         let mut start = Instant::now();
@@ -173,7 +173,7 @@ pub(crate) fn round_trip_ns() -> f64 {
             if i == 1 {
                 start = Instant::now();
             }
-            turn.store(2 * i + 1, std::sync::atomic::Ordering::Release);
+            turn.store(2 * i + 1, Ordering::Release);
             if !wait_for(&turn, 2 * i + 2, deadline) {
                 return f64::NAN;
             }
@@ -184,9 +184,9 @@ pub(crate) fn round_trip_ns() -> f64 {
 
 /// Spins until `turn` holds `want` (true), or gives up at `deadline` (false), yielding the
 /// core now and then so that a thread sharing it can take its turn.
-fn wait_for(turn: &std::sync::atomic::AtomicU64, want: u64, deadline: Instant) -> bool {
+fn wait_for(turn: &AtomicU64, want: u64, deadline: Instant) -> bool {
     let mut spins = 0u32;
-    while turn.load(std::sync::atomic::Ordering::Acquire) != want {
+    while turn.load(Ordering::Acquire) != want {
         spins = spins.wrapping_add(1);
         if spins.is_multiple_of(256) {
             if Instant::now() > deadline {
@@ -550,13 +550,13 @@ mod tests {
     /// A wait nobody answers gives up at its deadline instead of spinning on.
     #[test]
     fn an_unanswered_turn_gives_up_at_the_deadline() {
-        let turn = std::sync::atomic::AtomicU64::new(0);
+        let turn = AtomicU64::new(0);
         let start = Instant::now();
-        let deadline = start + std::time::Duration::from_millis(20);
+        let deadline = start + Duration::from_millis(20);
         assert!(!wait_for(&turn, 1, deadline));
         let waited = start.elapsed();
-        assert!(waited >= std::time::Duration::from_millis(20), "{waited:?}");
-        assert!(waited < std::time::Duration::from_secs(2), "{waited:?}");
+        assert!(waited >= Duration::from_millis(20), "{waited:?}");
+        assert!(waited < Duration::from_secs(2), "{waited:?}");
     }
 
     /// A measured round trip is a positive time; on one core there is none (NaN), and the

@@ -17,7 +17,7 @@
 
 use std::time::Instant;
 
-use super::{Row, interleaved_medians, median_ms, ns, round_trip_ns};
+use super::{Row, interleaved_medians, median, median_ms, ns, round_trip_ns};
 use stereolab::fixtures::{TABLE_1, table_scene};
 use stereolab::output::produce;
 use stereolab::plan::{Output, Plan, Shading};
@@ -103,8 +103,7 @@ fn on_pools(
                 ],
             )
         })?;
-        trips.sort_by(f64::total_cmp);
-        Ok([t[0], t[1], t[2], t[3], trips[trips.len() / 2]])
+        Ok([t[0], t[1], t[2], t[3], median(trips)])
     };
     pools.iter().map(on).collect()
 }
@@ -482,17 +481,15 @@ fn sirds_stages(
                 }
             }
             let mut m = [0.0; 4];
-            for (m, mut v) in m.iter_mut().zip(t) {
-                v.sort_by(f64::total_cmp);
-                *m = v[v.len() / 2];
+            for (m, v) in m.iter_mut().zip(t) {
+                *m = median(v);
             }
             Ok(m)
         })
     };
     let one = stages(pool_1)?;
     let two = stages(pool_2)?;
-    let mut trips: Vec<f64> = (0..5).map(|_| round_trip_ns()).collect();
-    trips.sort_by(f64::total_cmp);
+    let trip = median((0..5).map(|_| round_trip_ns()).collect());
     let names = ["depth pass", "depth range", "strip geometry", "strips"];
     let parts: Vec<String> = names
         .iter()
@@ -510,7 +507,7 @@ fn sirds_stages(
              after: {}",
             parts.join(", "),
             100.0 * one[2] / sum_1,
-            ns(trips[2])
+            ns(trip)
         ),
     ))
 }

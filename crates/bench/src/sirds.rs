@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{Row, interleaved_medians, median_ms, ns, round_trip_ns};
+use super::{Row, interleaved_medians, median, median_ms, ns, round_trip_ns};
 use stereolab::fixtures::{TABLE_1, scene_from_text, sphere_over_ramp, table_scene};
 use stereolab::output::sirds::{from_frame, scene_depth};
 use stereolab::plan::{Output, Plan, Shading};
@@ -86,8 +86,10 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     let mut ms = interleaved_medians(iters.max(300).div_ceil(BLOCK), BLOCK, &mut fs)?;
     ms.pop();
     drop(fs);
-    trips.sort_by(f64::total_cmp);
-    let trip_ns = trips[trips.len() / 2];
+    let phase = format!(
+        "; a cache line's round trip between two threads in the rows' turns: {}",
+        ns(median(trips))
+    );
     let loops = |simd: bool| {
         if !simd {
             ", scalar loops"
@@ -97,50 +99,36 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
             ", scalar loops (no AVX2 here, or STEREOLAB_SCALAR set)"
         }
     };
-    let phase = Row {
-        area: "sirds".into(),
-        knob: "the SIRDS paper's Table 1".into(),
-        setting: ROUND_TRIP.into(),
-        error: None,
-        error_unit: String::new(),
-        ms: trip_ns / 1e6,
-        note: format!(
-            "{}: a cache line's round trip between two threads, timed in the rows' turns (the \
-             median); the machine's phase, as far apart as its cores are",
-            ns(trip_ns)
-        ),
-    };
-    let rows = timed.iter().zip(ms).map(|(&(i, range, simd), ms)| {
-        let (w, h, tris, k, paper_hz) = TABLE_1[i];
-        let (setting, what) = if range.is_some() {
-            (
-                format!("{w}x{h} {tris} tris k={k}, range fixed"),
-                "strips only (the paper's frame: no depth pass)",
-            )
-        } else {
-            (format!("{w}x{h} {tris} tris k={k}"), "depth pass + strips")
-        };
-        let hz = 1e3 / ms;
-        Row {
-            area: "sirds".into(),
-            knob: "the SIRDS paper's Table 1".into(),
-            setting,
-            error: None,
-            error_unit: String::new(),
-            ms,
-            note: format!(
-                "{hz:.0} Hz vs paper {paper_hz} Hz (GeForce4): {:.1}x, {what}{}",
-                hz / paper_hz,
-                loops(simd)
-            ),
-        }
-    });
-    Ok(rows.chain([phase]).collect())
+    Ok(timed
+        .iter()
+        .zip(ms)
+        .map(|(&(i, range, simd), ms)| {
+            let (w, h, tris, k, paper_hz) = TABLE_1[i];
+            let (setting, what) = if range.is_some() {
+                (
+                    format!("{w}x{h} {tris} tris k={k}, range fixed"),
+                    "strips only (the paper's frame: no depth pass)",
+                )
+            } else {
+                (format!("{w}x{h} {tris} tris k={k}"), "depth pass + strips")
+            };
+            let hz = 1e3 / ms;
+            Row {
+                area: "sirds".into(),
+                knob: "the SIRDS paper's Table 1".into(),
+                setting,
+                error: None,
+                error_unit: String::new(),
+                ms,
+                note: format!(
+                    "{hz:.0} Hz vs paper {paper_hz} Hz (GeForce4): {:.1}x, {what}{}{phase}",
+                    hz / paper_hz,
+                    loops(simd)
+                ),
+            }
+        })
+        .collect())
 }
-
-/// The setting of Table 1's row that holds the cores' round trip ([`round_trip_ns`]) in its
-/// `ms` (as milliseconds).
-pub(crate) const ROUND_TRIP: &str = "round trip between two threads";
 
 /// The Fig. 5 ramp: a 20×20 plane (16×16 quads) turned 35° about y, 512×256, black-white
 /// dots with seed 5; the scene of every SIRDS accuracy knob.
@@ -359,8 +347,7 @@ fn process_ms(
         run()?;
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    times.sort_by(f64::total_cmp);
-    Ok(times[times.len() / 2])
+    Ok(median(times))
 }
 
 /// TIW as a whole process against netpbm's `pamstereogram` on the same 4096×3072 16-bit PGM (a
