@@ -18,12 +18,12 @@ pub mod remap;
 pub mod shear_rotate;
 pub mod sirds;
 
-/// Rows per task of [`par_fill_rows`] (and of the parallax map's rows): about [`PIXELS_PER_TASK`] pixels. Rayon splits a range
-/// into a few pieces per thread and splits a piece again only when another thread steals it,
-/// so with its default pieces the thread that finishes first would sit idle while the other
-/// runs its last piece, up to a quarter of the rows, whenever rows cost unequal work (an
-/// anaglyph's flat background against the model's pixels). Small tasks keep both busy to the
-/// end; the bytes do not depend on the split.
+/// Rows per task of [`par_fill_rows`] and of the parallax map's rows: about
+/// [`PIXELS_PER_TASK`] pixels. Rayon splits a range into a few pieces per thread and splits a
+/// piece again only when another thread steals it, so with its default pieces the thread that
+/// finishes first would sit idle while the other runs its last piece, up to a quarter of the
+/// rows, whenever rows cost unequal work (an anaglyph's flat background against the model's
+/// pixels). Small tasks keep both busy to the end; the bytes do not depend on the split.
 pub(crate) fn rows_per_task(width: usize) -> usize {
     (PIXELS_PER_TASK / width.max(1)).max(1)
 }
