@@ -341,3 +341,34 @@ fn a_binary_changed_after_its_build_is_not_run() {
     let csv = std::fs::read_to_string(base.join("r2/scores.csv")).unwrap();
     assert!(csv.contains("\na,5.00,"), "{csv}");
 }
+
+/// Build settings in the instructor's environment reach neither the build of the handout's own
+/// stubs, whose artifacts every sandboxed build starts from, nor the sandboxed build itself:
+/// set for one and not the other, cargo would rebuild those (read-only) artifacts in the
+/// sandbox and every submission would score 0.
+#[test]
+fn build_settings_in_the_graders_environment_change_no_score() {
+    let base = out_dir("grading_sandbox_env");
+    let subs = base.join("submissions");
+    let solution =
+        std::fs::read_to_string(repo_exercises().join(KRATE).join("src/solution.rs")).unwrap();
+    write(&subs.join("a").join(KRATE).join("src/stubs.rs"), &solution);
+    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
+        .args(["grade", "batch"])
+        .arg(&subs)
+        .arg("--out")
+        .arg(base.join("results"))
+        .arg("--build-dir")
+        .arg(base.join("work"))
+        .args(["--jobs", "1", "--exercises-list", "ex2"])
+        .env("CARGO_TARGET_DIR", target_dir())
+        .env("RUSTC_BOOTSTRAP", "1")
+        .env("RUSTFLAGS", "-C debug-assertions=off")
+        .env("CARGO_INCREMENTAL", "1")
+        .output()
+        .expect("run stereolab");
+    assert!(out.status.success(), "{out:?}");
+    let csv = std::fs::read_to_string(base.join("results/scores.csv")).unwrap();
+    let report = std::fs::read_to_string(base.join("results/a/report.txt")).unwrap();
+    assert!(csv.contains("\na,5.00,"), "{csv}\n{report}");
+}

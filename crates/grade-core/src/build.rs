@@ -25,6 +25,7 @@
 //!   grader may be running it, and checks its bytes before each run); only a missing or wrong one
 //!   is.
 
+use std::ffi::OsString;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -410,9 +411,52 @@ fn deps_target(ex: Exercise, work: &Path) -> Result<PathBuf, String> {
         write_sources(&dir, &sources)?;
     }
     let target = work.join("deps").join("target");
-    cargo_build(&dir, ex.crate_name(), &target, &sources.hash)
+    let tc = toolchain()?;
+    let out = tracked_output(
+        Command::new(tc.sysroot.join("bin/cargo"))
+            .arg("build")
+            .arg("--manifest-path")
+            .arg(dir.join("Cargo.toml"))
+            .args([
+                "--bin",
+                ex.crate_name(),
+                "--message-format=json-render-diagnostics",
+            ])
+            .current_dir(&dir)
+            .env_clear()
+            .envs(build_env(tc, &dir, &target, &sources.hash))
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped()),
+    )
+    .map_err(|e| format!("cannot run cargo: {e}"))?;
+    artifact(&out, &dir, ex.crate_name())
         .map_err(|e| format!("the handout's own {} does not build: {e}", ex.crate_name()))?;
     Ok(target)
+}
+
+/// The environment of both builds of an exercise crate in the grader: the dependencies' (the
+/// handout's own stubs, [`deps_target`]) and each submission's in the sandbox, which starts
+/// from their artifacts. Nothing else from the grader's environment: a variable cargo or a
+/// build script takes into its fingerprints (`RUSTFLAGS`, `RUSTC_BOOTSTRAP`,
+/// `CARGO_INCREMENTAL`, a profile override, `CC`) set for one build and not the other would
+/// make cargo rebuild the dependencies in the sandbox, where they are read-only, and every
+/// submission would fail to build. `home` is the build's own folder. Both run offline: the
+/// sandboxed build has no network, so the registry's cache must hold every dependency anyway.
+fn build_env(tc: &Toolchain, home: &Path, target: &Path, hash: &str) -> Vec<(String, OsString)> {
+    vec![
+        (
+            "PATH".into(),
+            format!("{}/bin:/usr/bin:/bin", tc.sysroot.display()).into(),
+        ),
+        ("HOME".into(), home.into()),
+        ("CARGO_HOME".into(), tc.home.clone().into()),
+        ("RUSTC".into(), tc.sysroot.join("bin/rustc").into()),
+        ("CARGO_TARGET_DIR".into(), target.into()),
+        ("CARGO_NET_OFFLINE".into(), "true".into()),
+        ("CARGO_TERM_COLOR".into(), "never".into()),
+        ("STEREOLAB_SOURCE_HASH".into(), hash.into()),
+    ]
 }
 
 /// Mirrors the artifacts under `from` into `to` as hard links, leaving out the crate `own`'s
@@ -483,19 +527,7 @@ fn sandboxed_build(
         ro: vec![exercise_api_dir()],
         rw: vec![dir.to_path_buf()],
         tmpfs: vec![tc.home.clone()],
-        env: vec![
-            (
-                "PATH".into(),
-                format!("{}/bin:/usr/bin:/bin", tc.sysroot.display()).into(),
-            ),
-            ("HOME".into(), dir.into()),
-            ("CARGO_HOME".into(), tc.home.clone().into()),
-            ("RUSTC".into(), tc.sysroot.join("bin/rustc").into()),
-            ("CARGO_TARGET_DIR".into(), target.clone().into()),
-            ("CARGO_NET_OFFLINE".into(), "true".into()),
-            ("CARGO_TERM_COLOR".into(), "never".into()),
-            ("STEREOLAB_SOURCE_HASH".into(), sources.hash.clone().into()),
-        ],
+        env: build_env(tc, dir, &target, &sources.hash),
         cwd: dir.to_path_buf(),
     };
     if !tc.sysroot.starts_with("/usr") {
@@ -611,8 +643,9 @@ fn tracked_output(cmd: &mut Command) -> std::io::Result<std::process::Output> {
     out
 }
 
-/// `cargo build` of the crate in `dir` into `target`, outside the sandbox (the handout's own
-/// stubs, or a student's run on their own machine).
+/// `cargo build` of the crate in `dir` into `target`, outside the sandbox and in the caller's
+/// environment (but for `RUSTFLAGS`): a build not sandboxed, as a student's run on their own
+/// machine.
 fn cargo_build(dir: &Path, name: &str, target: &Path, hash: &str) -> Result<PathBuf, String> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let out = tracked_output(
