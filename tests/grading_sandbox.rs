@@ -303,24 +303,38 @@ fn no_attack_in_a_batch_gains_a_point_or_reads_a_secret() {
     assert!(link.contains("symbolic link"), "{link}");
 }
 
-#[test]
-fn a_binary_changed_after_its_build_is_not_run() {
-    let base = out_dir("grading_sandbox_swap");
+/// Under `base`, a folder of one submission, `a`, whose stubs are the instructor's ex2
+/// solution; its path.
+fn solution_only(base: &Path) -> PathBuf {
     let subs = base.join("submissions");
     let solution =
         std::fs::read_to_string(repo_exercises().join(KRATE).join("src/solution.rs")).unwrap();
     write(&subs.join("a").join(KRATE).join("src/stubs.rs"), &solution);
+    subs
+}
+
+/// `grade batch` of the submissions in `subs`, ex2 only, one job, results into `results`,
+/// built in `work` (the command, not yet run).
+fn batch_of_ex2(subs: &Path, results: &Path, work: &Path) -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_stereolab"));
+    cmd.args(["grade", "batch"])
+        .arg(subs)
+        .arg("--out")
+        .arg(results)
+        .arg("--build-dir")
+        .arg(work)
+        .args(["--jobs", "1", "--exercises-list", "ex2"])
+        .env("CARGO_TARGET_DIR", target_dir());
+    cmd
+}
+
+#[test]
+fn a_binary_changed_after_its_build_is_not_run() {
+    let base = out_dir("grading_sandbox_swap");
+    let subs = solution_only(&base);
     let work = base.join("work");
     let batch = |results: &Path| {
-        Command::new(env!("CARGO_BIN_EXE_stereolab"))
-            .args(["grade", "batch"])
-            .arg(&subs)
-            .arg("--out")
-            .arg(results)
-            .arg("--build-dir")
-            .arg(&work)
-            .args(["--jobs", "1", "--exercises-list", "ex2"])
-            .env("CARGO_TARGET_DIR", target_dir())
+        batch_of_ex2(&subs, results, &work)
             .output()
             .expect("run stereolab")
     };
@@ -349,19 +363,8 @@ fn a_binary_changed_after_its_build_is_not_run() {
 #[test]
 fn build_settings_in_the_graders_environment_change_no_score() {
     let base = out_dir("grading_sandbox_env");
-    let subs = base.join("submissions");
-    let solution =
-        std::fs::read_to_string(repo_exercises().join(KRATE).join("src/solution.rs")).unwrap();
-    write(&subs.join("a").join(KRATE).join("src/stubs.rs"), &solution);
-    let out = Command::new(env!("CARGO_BIN_EXE_stereolab"))
-        .args(["grade", "batch"])
-        .arg(&subs)
-        .arg("--out")
-        .arg(base.join("results"))
-        .arg("--build-dir")
-        .arg(base.join("work"))
-        .args(["--jobs", "1", "--exercises-list", "ex2"])
-        .env("CARGO_TARGET_DIR", target_dir())
+    let subs = solution_only(&base);
+    let out = batch_of_ex2(&subs, &base.join("results"), &base.join("work"))
         .env("RUSTC_BOOTSTRAP", "1")
         .env("RUSTFLAGS", "-C debug-assertions=off")
         .env("CARGO_INCREMENTAL", "1")
