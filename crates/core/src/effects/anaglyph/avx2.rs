@@ -27,11 +27,12 @@
 //! about 14 shifts, blends, shuffles and compares out. Measured on a Zen 3 core (loops of each
 //! instruction, `asm!`): two multiply-adds a cycle, the conversions, masks and blends on two
 //! more pipes, two aligned 32-byte loads a cycle. A block of two groups loads each coefficient
-//! once for both (nine loads per eight pixels, not eighteen), so neither pipes nor loads need
-//! more than about 12 cycles per eight pixels; the loop takes about 23 (0.91 ns a pixel on one
-//! thread at 3.2 GHz). A block's chain (six dependent multiply-adds, the rounding, the tie
-//! test) is some 45 cycles long, which points at latency rather than issue; blocks of three or
-//! four groups, and two shorter sums per channel (left eye, right eye), measured slower.
+//! once for both (nine loads per eight pixels, not eighteen). Its instructions over four a
+//! cycle give about 12 cycles per eight pixels; a copy of the block looping over data in the
+//! first-level cache takes about 20 (its sums alone 12), the loop here about 23 (0.91 ns a
+//! pixel on one thread at 3.2 GHz). Measured slower: blocks of three or four groups, two
+//! shorter sums per channel (left eye, right eye; so not the chain's latency), each block's
+//! rounding deferred into the next block's sums.
 
 use std::arch::x86_64::*;
 use std::mem::MaybeUninit;
@@ -484,8 +485,8 @@ unsafe fn blocks<const SHAPE: u32, const G: usize>(
 }
 
 /// One row of the stored-value anaglyph: `out[k] = anaglyph_pixel(m, left[k], right[k],
-/// false)` for every pixel, `fused` being `Fused::new(m)` (the last partial block through the
-/// scalar function).
+/// false)` for every pixel, `fused` being `Fused::new(m)` (the last pixels short of a group of
+/// eight through the scalar function).
 ///
 /// # Safety
 /// The CPU must support AVX2 and FMA ([`avx2_available`](crate::simd::avx2_available)).
