@@ -24,15 +24,14 @@
 //!
 //! What bounds the fused path on random colours with all eighteen coefficients (Dubois): per
 //! eight pixels 18 multiply-adds, 6 channel extractions and 6 conversions in, 3 conversions and
-//! about 14 shifts, blends, shuffles and compares out. Measured on a Zen 3 core (loops of each
-//! instruction, `asm!`): two multiply-adds a cycle, the conversions, masks and blends on two
-//! more pipes, two aligned 32-byte loads a cycle. A block of two groups loads each coefficient
-//! once for both (nine loads per eight pixels, not eighteen). Its instructions over four a
-//! cycle give about 12 cycles per eight pixels; a copy of the block looping over data in the
-//! first-level cache takes about 20 (its sums alone 12), the loop here about 23 (0.91 ns a
-//! pixel on one thread at 3.2 GHz). Measured slower: blocks of three or four groups, two
-//! shorter sums per channel (left eye, right eye; so not the chain's latency), each block's
-//! rounding deferred into the next block's sums.
+//! about 14 shifts, blends, shuffles and compares out, with the loads, copies and stores some 60
+//! instructions on the vector pipes. Measured on a Zen 3 core (loops of each instruction,
+//! `asm!`): two multiply-adds a cycle, the conversions, masks and blends on two more pipes, two
+//! aligned 32-byte loads a cycle: about 15 cycles at best, about 22 measured. Measured slower
+//! in the release build: blocks whose input channel is the outer loop, each coefficient loaded
+//! once for two, three or four groups (two groups were faster only in a build of one codegen
+//! unit), each channel's sum in two shorter chains (left eye, right eye), each block's rounding
+//! deferred into the next block's sums.
 
 use std::arch::x86_64::*;
 use std::mem::MaybeUninit;
@@ -117,8 +116,10 @@ impl Fused {
 
 /// [`Fused`] broadcast to every lane, and the flag test's constants.
 struct Lanes {
-    /// The scaled coefficients ([`Fused::scaled`]).
-    scaled: [[__m256; 6]; 3],
+    /// The scaled coefficients, once per group of a block: each load then feeds one
+    /// multiply-add as its memory operand (a reload into a register shared by the two groups
+    /// would be one more instruction each).
+    scaled: [[[__m256; 6]; 3]; 2],
     /// The coefficients as [`exact`] multiplies them.
     coefficients: [[__m256; 6]; 3],
     /// Per 16-bit word of a group's red-green fractions (red low, green high) and of its blue
@@ -147,7 +148,7 @@ impl Lanes {
         let words = |lo: i32, hi: i32| _mm256_set1_epi32((lo & 0xffff) | (hi << 16));
         let (off, lim) = (|g: i32| g + 0x8000, |g: i32| 2 * g - 0x8000 - 1);
         Lanes {
-            scaled,
+            scaled: [scaled, scaled],
             coefficients,
             off_rg: words(off(r), off(g)),
             lim_rg: words(lim(r), lim(g)),
@@ -279,59 +280,56 @@ const SHAPES: [u32; 5] = [
     shape(&[(0, 1), (0, 2), (1, 4), (2, 5)]),
 ];
 
-/// `G` groups of eight pixels the fast way (`left`/`right` pointing at the first): per group
-/// and channel `t = ½ + Σ c_j·v_j`, the terms in `ML`, `MR` order, each a fused multiply-add,
-/// all scaled by 2¹⁶ ([`Fused::scaled`], exact), rounded to integers and [`finish`]ed. Terms
-/// outside `SHAPE` are left out (their coefficient is zero, and a fused multiply-add of zero
-/// returns its addend).
-///
-/// The input channel `j` is the outer loop: each coefficient is loaded once and multiplies
-/// all `G` groups' values. Each channel's sum takes its terms in `j` order, so the bytes do not
-/// depend on `G`.
+/// Sixteen pixels the fast way (two groups of eight, `left`/`right` pointing at the first):
+/// per group and channel `t = ½ + Σ c_j·v_j`, the terms in `ML`, `MR` order, each a fused
+/// multiply-add, all scaled by 2¹⁶ ([`Fused::scaled`], exact), rounded to integers and
+/// [`finish`]ed. Terms outside `SHAPE` are left out (their coefficient is zero, and a fused
+/// multiply-add of zero returns its addend).
 ///
 /// # Safety
-/// `8·G` pixels must be readable at `left` and `right`.
+/// Sixteen pixels must be readable at `left` and `right`.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
-unsafe fn block<const SHAPE: u32, const G: usize>(
+unsafe fn block<const SHAPE: u32>(
     w: &Lanes,
     left: *const [u8; 4],
     right: *const [u8; 4],
-) -> [(__m256i, __m256i); G] {
+) -> [(__m256i, __m256i); 2] {
     let masks = [
         _mm256_set1_epi32(0xff),
         _mm256_set1_epi32(0xff00),
         _mm256_set1_epi32(0xff_0000),
     ];
     let half = _mm256_set1_ps(32768.0);
-    let mut t = [[half; 3]; G];
+    let mut t = [[half; 3]; 2];
     for j in 0..6 {
         if SHAPE & (0b1_000001_000001 << j) == 0 {
             continue;
         }
         let eye = if j < 3 { left } else { right };
-        let c = [0, 1, 2].map(|i| w.scaled[i][j]);
         for (g, t) in t.iter_mut().enumerate() {
-            // SAFETY: the caller's `8·G` pixels; the unaligned load needs no alignment.
+            // SAFETY: the caller's sixteen pixels; the unaligned load needs no alignment.
             let p = unsafe { _mm256_loadu_si256(eye.add(8 * g).cast()) };
             let x = _mm256_cvtepi32_ps(_mm256_and_si256(p, masks[j % 3]));
-            for i in 0..3 {
+            for (i, t) in t.iter_mut().enumerate() {
                 if SHAPE & (1 << (6 * i + j)) != 0 {
-                    t[i] = _mm256_fmadd_ps(c[i], x, t[i]);
+                    *t = _mm256_fmadd_ps(w.scaled[g][i][j], x, *t);
                 }
             }
         }
     }
-    t.map(|t| {
-        finish(
+    let mut out = [(_mm256_setzero_si256(), _mm256_setzero_si256()); 2];
+    for (out, t) in out.iter_mut().zip(t) {
+        *out = finish(
             w,
             [
                 _mm256_cvtps_epi32(t[0]),
                 _mm256_cvtps_epi32(t[1]),
                 _mm256_cvtps_epi32(t[2]),
             ],
-        )
-    })
+        );
+    }
+    out
 }
 
 /// The rest of a row on [`exact`] alone, from pixel `k` on in groups of eight (eight pairs equal
@@ -368,27 +366,27 @@ unsafe fn exact_rest<const SHAPE: u32>(
     k
 }
 
-/// The groups of the block at pixel `k` whose mask in `ok` is not all ones, again on
+/// The groups of the block at pixel `k` whose mask (`ok0`, `ok1`) is not all ones, again on
 /// [`exact`]; returns how many. Out of line: the fused loop keeps its registers.
 ///
 /// # Safety
-/// `8·G` pixels must be readable at `left + k` and `right + k` and writable at `out + k`.
+/// Sixteen pixels must be readable at `left + k` and `right + k` and writable at `out + k`.
 #[cold]
 #[inline(never)]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn redo<const SHAPE: u32, const G: usize>(
+unsafe fn redo<const SHAPE: u32>(
     w: &Lanes,
     left: *const [u8; 4],
     right: *const [u8; 4],
     out: *mut MaybeUninit<[u8; 4]>,
     k: usize,
-    ok: [__m256i; G],
+    ok: [__m256i; 2],
 ) -> u32 {
     let mut redone = 0;
     for (g, ok) in ok.into_iter().enumerate() {
         if _mm256_movemask_epi8(ok) != -1 {
             let at = k + 8 * g;
-            // SAFETY: the caller's `8·G` pixels; the unaligned forms need no alignment.
+            // SAFETY: the caller's sixteen pixels; the unaligned forms need no alignment.
             unsafe {
                 let l = _mm256_loadu_si256(left.add(at).cast());
                 let r = _mm256_loadu_si256(right.add(at).cast());
@@ -400,93 +398,9 @@ unsafe fn redo<const SHAPE: u32, const G: usize>(
     redone
 }
 
-/// Groups of eight pixels in a block of the fused loop (the module notes say why two).
-const GROUPS: usize = 2;
-
-/// What the fused loop carries from block to block along a row.
-struct Sweep {
-    /// Where the last eight pixel pairs computed start, and their result: the output is a
-    /// function of the pair alone, so pairs equal to them (a flat background, both eyes) reuse
-    /// it. A block whose first pair differs from the first of those (two scalar compares) is
-    /// computed without the vector test.
-    last_at: Option<usize>,
-    last: __m256i,
-    /// Groups the fused path computed, and those it had to compute again.
-    groups: u32,
-    redone: u32,
-}
-
-/// The fused loop over blocks of `G` groups from pixel `k` on while a whole block fits (or,
-/// once too many groups were recomputed, [`exact_rest`]); returns where it stopped.
-///
-/// A matrix whose sums often land on a tie (Optimized's 0.7·G + 0.3·B ends in .5 for one pair
-/// in ten, an exact tie the f32 roundings decide) would compute most groups twice: once over a
-/// quarter of a row's groups are recomputed, the rest of the row runs on the exact lanes
-/// alone. The bytes are the same either way.
-///
-/// # Safety
-/// `n` pixels must be readable at `pl` and `pr` and writable at `po`; `sweep.last_at`, if
-/// set, at least eight pixels before `k`.
-#[target_feature(enable = "avx2,fma")]
-#[inline]
-unsafe fn blocks<const SHAPE: u32, const G: usize>(
-    w: &Lanes,
-    (pl, pr, po): (*const [u8; 4], *const [u8; 4], *mut MaybeUninit<[u8; 4]>),
-    mut k: usize,
-    n: usize,
-    sweep: &mut Sweep,
-) -> usize {
-    while k + 8 * G <= n {
-        // SAFETY: `k + 8·G <= n` and `at + 8 <= k`, so the block's pixels at `k` and the eight
-        // at `at` are in bounds in all three slices; the unaligned forms need no alignment.
-        unsafe {
-            if let Some(at) = sweep.last_at
-                && *pl.add(k) == *pl.add(at)
-                && *pr.add(k) == *pr.add(at)
-            {
-                let ll = _mm256_loadu_si256(pl.add(at).cast());
-                let lr = _mm256_loadu_si256(pr.add(at).cast());
-                let mut all = _mm256_set1_epi32(-1);
-                for g in 0..G {
-                    let l = _mm256_loadu_si256(pl.add(k + 8 * g).cast());
-                    let r = _mm256_loadu_si256(pr.add(k + 8 * g).cast());
-                    all = _mm256_and_si256(all, same(l, r, ll, lr));
-                }
-                if _mm256_movemask_epi8(all) == -1 {
-                    for g in 0..G {
-                        _mm256_storeu_si256(po.add(k + 8 * g).cast(), sweep.last);
-                    }
-                    k += 8 * G;
-                    continue;
-                }
-            }
-            sweep.groups += G as u32;
-            let computed = block::<SHAPE, G>(w, pl.add(k), pr.add(k));
-            let mut ok = -1;
-            for (g, (p, o)) in computed.iter().enumerate() {
-                _mm256_storeu_si256(po.add(k + 8 * g).cast(), *p);
-                ok &= _mm256_movemask_epi8(*o);
-            }
-            let end = k + 8 * (G - 1);
-            (sweep.last_at, sweep.last) = (Some(end), computed[G - 1].0);
-            if ok != -1 {
-                let ok = computed.map(|(_, o)| o);
-                sweep.redone += redo::<SHAPE, G>(w, pl, pr, po, k, ok);
-                sweep.last = _mm256_loadu_si256(po.add(end).cast());
-            }
-        }
-        k += 8 * G;
-        if sweep.redone > 4 && 4 * sweep.redone > sweep.groups {
-            // SAFETY: as above.
-            return unsafe { exact_rest::<SHAPE>(w, pl, pr, po, k, n) };
-        }
-    }
-    k
-}
-
 /// One row of the stored-value anaglyph: `out[k] = anaglyph_pixel(m, left[k], right[k],
-/// false)` for every pixel, `fused` being `Fused::new(m)` (the last pixels short of a group of
-/// eight through the scalar function).
+/// false)` for every pixel, `fused` being `Fused::new(m)` (the last partial block through the
+/// scalar function).
 ///
 /// # Safety
 /// The CPU must support AVX2 and FMA ([`avx2_available`](crate::simd::avx2_available)).
@@ -526,23 +440,63 @@ unsafe fn row_on<const SHAPE: u32>(
 ) {
     let w = Lanes::new(fused);
     let n = out.len().min(left.len()).min(right.len());
-    let ptrs = (left.as_ptr(), right.as_ptr(), out.as_mut_ptr());
-    let mut sweep = Sweep {
-        last_at: None,
-        last: _mm256_setzero_si256(),
-        groups: 0,
-        redone: 0,
-    };
+    let (pl, pr, po) = (left.as_ptr(), right.as_ptr(), out.as_mut_ptr());
+    // Where the last eight pixel pairs computed start, and their result: the output is a
+    // function of the pair alone, so pairs equal to them (a flat background, both eyes) reuse
+    // it. A block whose first pair differs from the first of those (two scalar compares) is
+    // computed without the vector test.
+    let mut last_at = None;
+    let mut last = _mm256_setzero_si256();
+    // Groups the fused path computed, and those it had to compute again. A matrix whose sums
+    // often land on a tie (Optimized's 0.7·G + 0.3·B ends in .5 for one pair in ten, an exact
+    // tie the f32 roundings decide) would compute most groups twice: once over a quarter of a
+    // row's groups are recomputed, the rest of the row runs on the exact lanes alone. The bytes
+    // are the same either way.
+    let (mut groups, mut redone) = (0u32, 0u32);
     let mut k = 0;
-    // SAFETY (all three): `n` pixels are in bounds in all three slices; `blocks` sets
-    // `last_at` at most at its last block's last group.
-    unsafe {
-        if !fused.fused {
-            k = exact_rest::<SHAPE>(&w, ptrs.0, ptrs.1, ptrs.2, k, n);
+    if !fused.fused {
+        // SAFETY: `n` pixels are in bounds in all three slices.
+        k = unsafe { exact_rest::<SHAPE>(&w, pl, pr, po, k, n) };
+    }
+    while k + 16 <= n {
+        // SAFETY: `k + 16 <= n` and `at + 8 <= k`, so the sixteen pixels (64 bytes) at `k` and
+        // the eight at `at` are in bounds in all three slices; the unaligned forms need no
+        // alignment.
+        unsafe {
+            if let Some(at) = last_at
+                && *pl.add(k) == *pl.add(at)
+                && *pr.add(k) == *pr.add(at)
+            {
+                let ll = _mm256_loadu_si256(pl.add(at).cast());
+                let lr = _mm256_loadu_si256(pr.add(at).cast());
+                let (l0, r0) = (pl.add(k).cast(), pr.add(k).cast());
+                let (l1, r1) = (pl.add(k + 8).cast(), pr.add(k + 8).cast());
+                let both = _mm256_and_si256(
+                    same(_mm256_loadu_si256(l0), _mm256_loadu_si256(r0), ll, lr),
+                    same(_mm256_loadu_si256(l1), _mm256_loadu_si256(r1), ll, lr),
+                );
+                if _mm256_movemask_epi8(both) == -1 {
+                    _mm256_storeu_si256(po.add(k).cast(), last);
+                    _mm256_storeu_si256(po.add(k + 8).cast(), last);
+                    k += 16;
+                    continue;
+                }
+            }
+            groups += 2;
+            let [(p0, ok0), (p1, ok1)] = block::<SHAPE>(&w, pl.add(k), pr.add(k));
+            _mm256_storeu_si256(po.add(k).cast(), p0);
+            _mm256_storeu_si256(po.add(k + 8).cast(), p1);
+            (last_at, last) = (Some(k + 8), p1);
+            if _mm256_movemask_epi8(_mm256_and_si256(ok0, ok1)) != -1 {
+                redone += redo::<SHAPE>(&w, pl, pr, po, k, [ok0, ok1]);
+                last = _mm256_loadu_si256(po.add(k + 8).cast());
+            }
         }
-        // Blocks of `GROUPS` groups, then the last groups one at a time.
-        k = blocks::<SHAPE, GROUPS>(&w, ptrs, k, n, &mut sweep);
-        k = blocks::<SHAPE, 1>(&w, ptrs, k, n, &mut sweep);
+        k += 16;
+        if redone > 4 && 4 * redone > groups {
+            // SAFETY: as above.
+            k = unsafe { exact_rest::<SHAPE>(&w, pl, pr, po, k, n) };
+        }
     }
     for k in k..n {
         out[k].write(super::anaglyph_pixel(m, left[k], right[k], false));
