@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 
 use super::Row;
 use super::cost::{AREA as COST, BY_PIXELS, BY_TRIANGLES};
+use super::sirds::ROUND_TRIP;
 use stereolab::fixtures::TABLE_1;
 use stereolab_core::{Error, Result};
 use stereolab_figures::plot::{Panel, Series, log_log};
@@ -434,10 +435,7 @@ pub fn section(rows: &[Row], run: &RunInfo, plot: Option<&str>) -> String {
              `pamstereogram`'s time in the same run ({}) as the machine's phase{}:\n",
             ms(pam),
             t1.iter()
-                .find_map(|(_, _, full, _)| full.and_then(|r| number_after(
-                    &r.note,
-                    "round trip between two threads in the rows' turns: "
-                )))
+                .find_map(|(_, _, full, _)| full.and_then(|r| number_after(&r.note, ROUND_TRIP)))
                 .map(|trip| format!(
                     ", and a cache line's round trip between two threads in the rows' turns \
                      ({trip:.0} ns: about 75 where the two cores share a cache, 400–500 where \
@@ -703,9 +701,9 @@ mod tests {
                         3 consecutive runs: 1.60 (75 ns), 1.81 (440 ns), 1.79 (76 ns)"
             .into();
         let last = rows.len() - 1;
-        rows[last].note = "2000 Hz vs paper 60.1 Hz (GeForce4): 33.3x, depth pass + strips; a \
-                           cache line's round trip between two threads in the rows' turns: 65 ns"
-            .into();
+        rows[last].note = format!(
+            "2000 Hz vs paper 60.1 Hz (GeForce4): 33.3x, depth pass + strips; {ROUND_TRIP}65 ns"
+        );
         let s = section(&rows, &run(), Some("p.png"));
         assert!(
             s.contains("two threads in the rows' turns (65 ns: about 75 where"),

@@ -16,6 +16,11 @@ use stereolab_core::{
 };
 use stereolab_core::{StripGeometry, per_vertex, per_vertex_reference};
 
+/// What precedes the round trip timed in Table 1's turns in each of its rows' notes (the
+/// doc's Table 1 paragraph reads it back).
+pub(crate) const ROUND_TRIP: &str =
+    "a cache line's round trip between two threads in the rows' turns: ";
+
 /// The SIRDS paper's Table 1, two rows per line of the table, each rate also as a multiple of
 /// the paper's:
 /// - **depth pass + strips**: stereolab's frame with the scene's automatic depth range (a depth
@@ -86,10 +91,7 @@ fn table_1(iters: usize) -> Result<Vec<Row>> {
     let mut ms = interleaved_medians(iters.max(300).div_ceil(BLOCK), BLOCK, &mut fs)?;
     ms.pop();
     drop(fs);
-    let phase = format!(
-        "; a cache line's round trip between two threads in the rows' turns: {}",
-        ns(median(trips))
-    );
+    let phase = format!("; {ROUND_TRIP}{}", ns(median(trips)));
     let loops = |simd: bool| {
         if !simd {
             ", scalar loops"

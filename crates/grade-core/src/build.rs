@@ -412,25 +412,12 @@ fn deps_target(ex: Exercise, work: &Path) -> Result<PathBuf, String> {
     }
     let target = work.join("deps").join("target");
     let tc = toolchain()?;
-    let out = tracked_output(
-        Command::new(tc.sysroot.join("bin/cargo"))
-            .arg("build")
-            .arg("--manifest-path")
-            .arg(dir.join("Cargo.toml"))
-            .args([
-                "--bin",
-                ex.crate_name(),
-                "--message-format=json-render-diagnostics",
-            ])
-            .current_dir(&dir)
-            .env_clear()
-            .envs(build_env(tc, &dir, &target, &sources.hash))
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped()),
-    )
-    .map_err(|e| format!("cannot run cargo: {e}"))?;
-    artifact(&out, &dir, ex.crate_name())
+    let mut cargo = Command::new(tc.sysroot.join("bin/cargo"));
+    cargo
+        .current_dir(&dir)
+        .env_clear()
+        .envs(build_env(tc, &dir, &target, &sources.hash));
+    unsandboxed_build(cargo, &dir, ex.crate_name())
         .map_err(|e| format!("the handout's own {} does not build: {e}", ex.crate_name()))?;
     Ok(target)
 }
@@ -539,15 +526,8 @@ fn sandboxed_build(
             jail.ro.push(p);
         }
     }
-    let args: Vec<std::ffi::OsString> = vec![
-        "build".into(),
-        "--offline".into(),
-        "--manifest-path".into(),
-        src.join("Cargo.toml").into(),
-        "--bin".into(),
-        name.into(),
-        "--message-format=json-render-diagnostics".into(),
-    ];
+    let mut args = build_args(&src, name);
+    args.insert(1, "--offline".into());
     let limits = Rlimits {
         memory: None,
         cpu_seconds: Some(timeout.as_secs() * 4 + 1),
@@ -647,23 +627,40 @@ fn tracked_output(cmd: &mut Command) -> std::io::Result<std::process::Output> {
 /// environment (but for `RUSTFLAGS`): a build not sandboxed, as a student's run on their own
 /// machine.
 fn cargo_build(dir: &Path, name: &str, target: &Path, hash: &str) -> Result<PathBuf, String> {
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    cargo
+        .env("CARGO_TARGET_DIR", target)
+        .env("STEREOLAB_SOURCE_HASH", hash)
+        .env_remove("RUSTFLAGS")
+        .env_remove("CARGO_BUILD_RUSTFLAGS");
+    unsandboxed_build(cargo, dir, name)
+}
+
+/// `cargo`, its environment set, run with [`build_args`] outside the sandbox: the executable
+/// it built, or the compiler's errors.
+fn unsandboxed_build(mut cargo: Command, dir: &Path, name: &str) -> Result<PathBuf, String> {
     let out = tracked_output(
-        Command::new(cargo)
-            .arg("build")
-            .arg("--manifest-path")
-            .arg(dir.join("Cargo.toml"))
-            .args(["--bin", name, "--message-format=json-render-diagnostics"])
-            .env("CARGO_TARGET_DIR", target)
-            .env("STEREOLAB_SOURCE_HASH", hash)
-            .env_remove("RUSTFLAGS")
-            .env_remove("CARGO_BUILD_RUSTFLAGS")
+        cargo
+            .args(build_args(dir, name))
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped()),
     )
     .map_err(|e| format!("cannot run cargo: {e}"))?;
     artifact(&out, dir, name)
+}
+
+/// `cargo build`'s arguments for the binary `name` of the crate in `dir`, its messages as the
+/// JSON [`artifact`] reads.
+fn build_args(dir: &Path, name: &str) -> Vec<OsString> {
+    vec![
+        "build".into(),
+        "--manifest-path".into(),
+        dir.join("Cargo.toml").into(),
+        "--bin".into(),
+        name.into(),
+        "--message-format=json-render-diagnostics".into(),
+    ]
 }
 
 /// The error lines of a failed build (warnings and progress left out), at most 40 lines, with
